@@ -1,0 +1,34 @@
+"""Errors raised by mbdsim: each names the offending entity and field."""
+from __future__ import annotations
+
+
+class MbdsimError(Exception):
+    """Base class of every mbdsim error."""
+
+
+class ModelError(MbdsimError, ValueError):
+    """Invalid model input: names the entity and the field at fault."""
+
+    def __init__(self, entity: str, field: str, message: str):
+        self.entity, self.field = entity, field
+        super().__init__(f"{entity}.{field}: {message}")
+
+
+class AssemblyError(MbdsimError):
+    """The constraints cannot be satisfied (assembly or kinematic position analysis)."""
+
+    def __init__(self, message: str, time: float | None = None, joints=(), state=None):
+        self.time, self.joints, self.state = time, tuple(joints), state
+        where = f" at t = {time:.9g} s" if time is not None else ""
+        names = f" (joints involved: {', '.join(self.joints)})" if self.joints else ""
+        super().__init__(f"{message}{where}{names}")
+
+
+class SolverError(MbdsimError):
+    """A solver failed (lock-up, singular equations, step size underflow)."""
+
+    def __init__(self, message: str, time: float | None = None, joints=(), state=None):
+        self.time, self.joints, self.state = time, tuple(joints), state
+        where = f" at t = {time:.9g} s" if time is not None else ""
+        names = f" (joints involved: {', '.join(self.joints)})" if self.joints else ""
+        super().__init__(f"{message}{where}{names}")

@@ -1,0 +1,88 @@
+"""Euler parameters (unit quaternions, scalar first) and rotation helpers.
+
+Convention: p = (e0, e1, e2, e3) maps body vectors to ground, v_G = A(p) v_B, and
+pdot = 1/2 p (x) (0, w_B) with w_B the angular velocity expressed in body axes [rad/s].
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+
+def skew(a: np.ndarray) -> np.ndarray:
+    """Skew matrices a~ with a~ b = a x b; a of shape (..., 3) -> (..., 3, 3)."""
+    a = np.asarray(a, dtype=float)
+    z = np.zeros(a.shape[:-1])
+    return np.stack([
+        np.stack([z, -a[..., 2], a[..., 1]], -1),
+        np.stack([a[..., 2], z, -a[..., 0]], -1),
+        np.stack([-a[..., 1], a[..., 0], z], -1),
+    ], -2)
+
+
+def quat_to_matrix(p: np.ndarray) -> np.ndarray:
+    """Rotation matrices A(p), body -> ground, from Euler parameters (..., 4) -> (..., 3, 3)."""
+    p = np.asarray(p, dtype=float)
+    e0, e1, e2, e3 = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
+    return np.stack([
+        np.stack([e0*e0 + e1*e1 - e2*e2 - e3*e3, 2*(e1*e2 - e0*e3), 2*(e1*e3 + e0*e2)], -1),
+        np.stack([2*(e1*e2 + e0*e3), e0*e0 - e1*e1 + e2*e2 - e3*e3, 2*(e2*e3 - e0*e1)], -1),
+        np.stack([2*(e1*e3 - e0*e2), 2*(e2*e3 + e0*e1), e0*e0 - e1*e1 - e2*e2 + e3*e3], -1),
+    ], -2)
+
+
+def matrix_to_quat(A: np.ndarray) -> np.ndarray:
+    """Euler parameters (scalar first, e0 >= 0) of a rotation matrix (3, 3)."""
+    x, y, z, w = Rotation.from_matrix(np.asarray(A, dtype=float)).as_quat()
+    p = np.array([w, x, y, z])
+    return p if p[0] >= 0 else -p
+
+
+def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Quaternion products a (x) b, scalar first, broadcasting over leading axes."""
+    a0, av = a[..., :1], a[..., 1:]
+    b0, bv = b[..., :1], b[..., 1:]
+    s = a0 * b0 - np.sum(av * bv, -1, keepdims=True)
+    v = a0 * bv + b0 * av + np.cross(av, bv)
+    return np.concatenate([s, v], -1)
+
+
+def quat_exp(theta: np.ndarray) -> np.ndarray:
+    """Unit quaternion of the rotation vector theta (..., 3) [rad]."""
+    theta = np.asarray(theta, dtype=float)
+    ang = np.linalg.norm(theta, axis=-1, keepdims=True)
+    half = 0.5 * ang
+    # sin(x/2)/x with a series near zero
+    with np.errstate(invalid="ignore", divide="ignore"):
+        k = np.where(ang > 1e-8, np.sin(half) / np.where(ang > 0, ang, 1.0), 0.5 - ang**2 / 48.0)
+    return np.concatenate([np.cos(half), k * theta], -1)
+
+
+def quat_rate(p: np.ndarray, w_B: np.ndarray) -> np.ndarray:
+    """Time derivative of Euler parameters, pdot = 1/2 p (x) (0, w_B) [1/s]."""
+    w4 = np.concatenate([np.zeros(w_B.shape[:-1] + (1,)), w_B], -1)
+    return 0.5 * quat_mul(p, w4)
+
+
+def as_matrix(orientation) -> np.ndarray:
+    """Accept None, a 3x3 matrix or a scipy Rotation; return a proper orthonormal 3x3 matrix."""
+    if orientation is None:
+        return np.eye(3)
+    if isinstance(orientation, Rotation):
+        return orientation.as_matrix()
+    A = np.asarray(orientation, dtype=float)
+    if A.shape != (3, 3):
+        raise ValueError(f"orientation must be a 3x3 matrix or scipy Rotation, got shape {A.shape}")
+    if not np.allclose(A @ A.T, np.eye(3), atol=1e-9) or np.linalg.det(A) < 0:
+        raise ValueError("orientation matrix is not a proper rotation (orthonormal, det = +1)")
+    return A
+
+
+def perpendicular_frame(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Right-handed orthonormal (f, g, h) with h the given unit axis (deterministic choice of f)."""
+    h = np.asarray(h, dtype=float) / np.linalg.norm(h)
+    trial = np.eye(3)[int(np.argmin(np.abs(h)))]
+    f = np.cross(trial, h)
+    f /= np.linalg.norm(f)
+    g = np.cross(h, f)
+    return f, g, h

@@ -1,0 +1,55 @@
+"""Input checks that name the offending entity and field."""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+
+
+def vec3(entity: str, field: str, value, unit: bool = False) -> np.ndarray:
+    """A finite 3-vector (a unit vector when unit=True), else ModelError."""
+    try:
+        v = np.asarray(value, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ModelError(entity, field, f"expected 3 numbers, got {value!r}") from None
+    if v.shape != (3,):
+        raise ModelError(entity, field, f"expected 3 numbers, got {value!r}")
+    if not np.all(np.isfinite(v)):
+        raise ModelError(entity, field, f"values must be finite, got {value!r}")
+    if unit:
+        n = np.linalg.norm(v)
+        if n < 1e-12:
+            raise ModelError(entity, field, "direction vector must be non-zero")
+        v = v / n
+    return v
+
+
+def scalar(entity: str, field: str, value, minimum: float | None = None, strict: bool = False) -> float:
+    """A finite float, optionally bounded below, else ModelError."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError(entity, field, f"expected a number, got {value!r}") from None
+    if not np.isfinite(x):
+        raise ModelError(entity, field, f"must be finite, got {value!r}")
+    if minimum is not None and (x < minimum or (strict and x == minimum)):
+        rel = ">" if strict else ">="
+        raise ModelError(entity, field, f"must be {rel} {minimum}, got {x!r}")
+    return x
+
+
+def inertia_matrix(entity: str, value) -> np.ndarray:
+    """Inertia about the centre of mass in body axes: (ixx, iyy, izz) or a symmetric 3x3 [kg m^2]."""
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got {value!r}") from None
+    J = np.diag(a) if a.shape == (3,) else a
+    if J.shape != (3, 3) or not np.all(np.isfinite(J)):
+        raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got {value!r}")
+    if not np.allclose(J, J.T, atol=1e-12 * max(1.0, np.abs(J).max())):
+        raise ModelError(entity, "inertia", "matrix must be symmetric")
+    ev = np.linalg.eigvalsh(J)
+    if ev.min() < -1e-12 * max(1.0, ev.max()):
+        raise ModelError(entity, "inertia", f"must be positive semi-definite, eigenvalues {ev}")
+    return J

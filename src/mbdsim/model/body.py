@@ -1,0 +1,85 @@
+"""Bodies, particles and markers (frames fixed on a body)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..errors import ModelError
+from ..math.rotation import as_matrix
+from ._check import inertia_matrix, scalar, vec3
+
+
+@dataclass(eq=False)
+class Marker:
+    """A frame fixed on a body. `point` [m] and `orientation` (marker->ground) are given in ground at t=0."""
+
+    name: str
+    body: "Body"
+    point: np.ndarray
+    orientation: np.ndarray
+
+    @property
+    def s_B(self) -> np.ndarray:
+        """Marker origin in body axes, relative to the body's centre of mass [m]."""
+        return self.body.orientation.T @ (self.point - self.body.position)
+
+    @property
+    def R_BM(self) -> np.ndarray:
+        """Marker axes relative to the body axes (3x3)."""
+        return self.body.orientation.T @ self.orientation
+
+    def __repr__(self) -> str:
+        return f"Marker({self.body.name}.{self.name})"
+
+
+@dataclass(eq=False)
+class Body:
+    """A rigid body or particle; all initial values in ground at t=0 (SI units).
+
+    position: centre of mass [m]; orientation: body->ground 3x3; velocity: of the centre of mass [m/s];
+    angular_velocity: in ground axes [rad/s]; inertia: about the centre of mass in body axes [kg m^2].
+    """
+
+    name: str
+    mass: float = 0.0
+    inertia: np.ndarray = field(default_factory=lambda: np.zeros((3, 3)))
+    position: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    orientation: np.ndarray = field(default_factory=lambda: np.eye(3))
+    velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    angular_velocity: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    is_particle: bool = False
+    is_ground: bool = False
+    markers: dict = field(default_factory=dict)
+
+    def add_marker(self, name: str, point=None, orientation=None) -> Marker:
+        """Add a frame fixed on this body; point [m] and orientation (marker->ground) in ground at t=0."""
+        entity = f"marker '{self.name}.{name}'"
+        if name in self.markers:
+            raise ModelError(entity, "name", "a marker of this name already exists on the body")
+        pt = self.position.copy() if point is None else vec3(entity, "point", point)
+        try:
+            R = as_matrix(orientation)
+        except ValueError as exc:
+            raise ModelError(entity, "orientation", str(exc)) from None
+        m = Marker(name, self, pt, R)
+        self.markers[name] = m
+        return m
+
+    def __repr__(self) -> str:
+        kind = "Ground" if self.is_ground else ("Particle" if self.is_particle else "Body")
+        return f"{kind}({self.name!r})"
+
+
+def make_body(name, mass, inertia, position, orientation, velocity, angular_velocity, particle=False) -> Body:
+    """Validate user input and build a Body (or a particle when particle=True)."""
+    entity = f"{'particle' if particle else 'body'} '{name}'"
+    m = scalar(entity, "mass", mass, minimum=0.0, strict=particle)
+    J = np.zeros((3, 3)) if particle else inertia_matrix(entity, inertia)
+    try:
+        R = np.eye(3) if particle else as_matrix(orientation)
+    except ValueError as exc:
+        raise ModelError(entity, "orientation", str(exc)) from None
+    return Body(name, m, J, vec3(entity, "position", position), R, vec3(entity, "velocity", velocity),
+                np.zeros(3) if particle else vec3(entity, "angular_velocity", angular_velocity),
+                is_particle=particle)

@@ -1,0 +1,1 @@
+"""Report writers (validation report: Markdown + self-contained HTML)."""

@@ -1,0 +1,126 @@
+"""Shared numerical kernels of the solvers: manifold increments, projections, accelerations."""
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import scipy.linalg as sla
+
+from ..errors import SolverError
+from ..math.rotation import quat_exp, quat_mul, quat_rate
+from ..system.dynamics import applied_forces, solve_kkt
+from ..system.equations import constraint_terms
+from ..system.frames import body_frames
+
+
+def increment(sys, q, dx):
+    """q (+) dx: translate CMs by dx [m], rotate bodies by the body-axes rotation vector dx [rad]."""
+    q = q.copy()
+    q[sys.r_idx] += dx[sys.rd_idx]
+    if len(sys.p_idx):
+        p = quat_mul(q[sys.p_idx], quat_exp(dx[sys.w_idx]))
+        q[sys.p_idx] = p / np.linalg.norm(p, axis=-1, keepdims=True)
+    return q
+
+
+def normalize(sys, q):
+    """Unit-normalise the Euler parameters of q (copy)."""
+    q = q.copy()
+    if len(sys.p_idx):
+        p = q[sys.p_idx]
+        q[sys.p_idx] = p / np.linalg.norm(p, axis=-1, keepdims=True)
+    return q
+
+
+def qdot(sys, q, v):
+    """dq/dt from velocity variables: rd for positions, 1/2 p (x) (0, w_B) for Euler parameters."""
+    qd = np.zeros(sys.nq)
+    qd[sys.r_idx] = v[sys.rd_idx]
+    if len(sys.p_idx):
+        qd[sys.p_idx] = quat_rate(q[sys.p_idx], v[sys.w_idx])
+    return qd
+
+
+def independent_rows(J, tol=1e-9):
+    """Indices of a maximal independent subset of the rows of J (rank-revealing pivoted QR)."""
+    if J.shape[0] == 0:
+        return np.arange(0)
+    _, R, piv = sla.qr(J.T, mode="economic", pivoting=True)
+    d = np.abs(np.diag(R))
+    rank = int(np.sum(d > tol * max(1.0, d[0] if len(d) else 1.0)))
+    return np.sort(piv[:rank])
+
+
+def dependent_owners(sys, J, rows):
+    """Names of the joints/motions whose rows take part in the dependencies of J."""
+    removed = np.setdiff1d(np.arange(J.shape[0]), rows)
+    if len(removed) == 0:
+        return []
+    ns = sla.null_space(J.T)
+    involved = np.where(np.any(np.abs(ns) > 1e-8, axis=1))[0]
+    names = []
+    for r in np.concatenate([involved, removed]):
+        if sys.row_owner[r] not in names:
+            names.append(sys.row_owner[r])
+    return names
+
+
+def project_positions(sys, q, t, rows, tol=1e-12, maxit=25):
+    """Newton (minimum-norm steps) onto phi(q, t) = 0 for the given rows; returns (q, residual, iterations)."""
+    zero = np.zeros(sys.nv)
+    res = np.inf
+    for it in range(maxit):
+        phi, J, _, _ = constraint_terms(sys, q, zero, t)
+        phi, J = phi[rows], J[rows]
+        res = float(np.max(np.abs(phi))) if len(phi) else 0.0
+        if res <= tol:
+            return q, res, it
+        dx = -np.linalg.lstsq(J, phi, rcond=None)[0]
+        q = increment(sys, q, dx)
+        if it > 3 and float(np.max(np.abs(dx))) < 1e-15:
+            break
+    return q, res, maxit
+
+
+def project_velocities(sys, q, v, t, rows):
+    """Minimum-norm correction of v so that phi_q v = nu on the given rows."""
+    _, J, nu, _ = constraint_terms(sys, q, v, t)
+    J, nu = J[rows], nu[rows]
+    if len(nu) == 0:
+        return v
+    return v - np.linalg.lstsq(J, J @ v - nu, rcond=None)[0]
+
+
+def accelerations(sys, q, v, t, rows, state_factory=None):
+    """vd and lambda_ (full nc, minimum-norm where redundant) from the equations of motion at (q, v, t)."""
+    fr = body_frames(sys, q, v)
+    state = state_factory(t, q, v) if state_factory else None
+    Q = applied_forces(sys, fr, t, state)
+    _, J, _, gamma = constraint_terms(sys, q, v, t)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", sla.LinAlgWarning)
+        try:
+            vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
+        except (sla.LinAlgError, sla.LinAlgWarning, ValueError) as exc:
+            raise SolverError(f"singular equations of motion (lock-up or singular configuration): {exc}",
+                              time=t, joints=_worst_joints(sys, J, rows)) from None
+    lam = np.zeros(sys.nc)
+    if len(rows) == sys.nc:
+        lam = lam_i
+    else:
+        lam = np.linalg.lstsq(J.T, Q - sys.M @ vd, rcond=None)[0]
+    return vd, lam
+
+
+def _worst_joints(sys, J, rows):
+    """Joints whose rows are (nearly) dependent at this configuration."""
+    Jr = J[rows]
+    if Jr.shape[0] == 0:
+        return []
+    u, s, vt = np.linalg.svd(Jr.T, full_matrices=False)
+    weak = vt[-1]
+    names = []
+    for k in np.argsort(-np.abs(weak)):
+        if abs(weak[k]) > 1e-3 and sys.row_owner[rows[k]] not in names:
+            names.append(sys.row_owner[rows[k]])
+    return names

@@ -1,0 +1,146 @@
+"""Build the frozen System (coordinate layout, row layout, mass data) from a Model.
+
+Coordinates q per rigid body: CM position r [m] then Euler parameters p (4); per particle: r.
+Velocities v per rigid body: CM velocity [m/s] then angular velocity in body axes w_B [rad/s];
+per particle: CM velocity.  Frame index 0 is ground, k+1 is system body k.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from ..errors import ModelError
+from ..math.rotation import matrix_to_quat, perpendicular_frame
+from .constraints.base import JointGeom, RowSpec
+from .constraints.driver import driver_rows
+from .constraints.registry import JOINT_TYPES
+
+
+@dataclass
+class Group:
+    """All rows of one primitive kind: frame indices, stacked body-axes vectors, first-row addresses."""
+
+    kind: str
+    bi: np.ndarray
+    bj: np.ndarray
+    vecs: tuple
+    row_adr: np.ndarray
+    fns: list = field(default_factory=list)
+
+
+@dataclass
+class System:
+    """Assembled equations of a Model; see module docstring for the coordinate layout."""
+
+    model: Any
+    bodies: list
+    fid: dict                  # Body -> frame index
+    nq: int
+    nv: int
+    nc: int
+    r_idx: np.ndarray          # (nbody, 3) into q
+    p_idx: np.ndarray          # (nrigid, 4) into q
+    rd_idx: np.ndarray         # (nbody, 3) into v
+    w_idx: np.ndarray          # (nrigid, 3) into v
+    rigid_fid: np.ndarray      # (nrigid,) frame indices of rigid bodies
+    frame_v_adr: np.ndarray    # (nbody+1,) start of each frame's velocity block, -1 for ground
+    frame_rigid: np.ndarray    # (nbody+1,) bool
+    mass: np.ndarray           # (nbody+1,) [kg]
+    inertia_B: np.ndarray      # (nbody+1, 3, 3) [kg m^2] about the CM, body axes
+    M: np.ndarray              # (nv, nv) constant mass matrix
+    groups: list
+    row_owner: list            # name of the joint/motion of each row
+    owner_rows: dict           # name -> row indices
+    geoms: dict                # joint name -> JointGeom
+    q0: np.ndarray
+    v0: np.ndarray
+
+    @property
+    def nbody(self) -> int:
+        return len(self.bodies)
+
+
+def assemble_system(model) -> System:
+    """Assemble the System of a Model (layout, constraint rows, mass matrix, initial q and v)."""
+    bodies = [b for b in model.bodies.values() if not b.is_ground]
+    fid = {model.ground: 0}
+    fid.update({b: k + 1 for k, b in enumerate(bodies)})
+    q0, v0, r_idx, p_idx, rd_idx, w_idx, rigid, v_adr = [], [], [], [], [], [], [], [-1]
+    for k, b in enumerate(bodies):
+        r_idx.append(range(len(q0), len(q0) + 3)); q0 += list(b.position)
+        rd_idx.append(range(len(v0), len(v0) + 3)); v_adr.append(len(v0)); v0 += list(b.velocity)
+        if not b.is_particle:
+            p_idx.append(range(len(q0), len(q0) + 4)); q0 += list(matrix_to_quat(b.orientation))
+            w_idx.append(range(len(v0), len(v0) + 3)); v0 += list(b.orientation.T @ b.angular_velocity)
+            rigid.append(k + 1)
+    nv = len(v0)
+    mass = np.array([0.0] + [b.mass for b in bodies])
+    J = np.zeros((len(bodies) + 1, 3, 3))
+    M = np.zeros((nv, nv))
+    for k, b in enumerate(bodies):
+        a = v_adr[k + 1]
+        M[a:a + 3, a:a + 3] = b.mass * np.eye(3)
+        if not b.is_particle:
+            J[k + 1] = b.inertia
+            M[a + 3:a + 6, a + 3:a + 6] = b.inertia
+    specs, geoms = _row_specs(model, fid)
+    groups, owners, owner_rows = _groups(specs, fid)
+    as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
+    return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
+                  as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
+                  np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
+                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float))
+
+
+def joint_geometry(joint, fid) -> JointGeom:
+    """Joint point and axes expressed on each of its bodies at t=0."""
+    bi, bj = joint.body_i, joint.body_j
+    f, g, h = perpendicular_frame(joint.axis)
+    Ai, Aj = bi.orientation, bj.orientation
+    loc = lambda A, x: A.T @ x  # noqa: E731
+    extra = None if joint.axis_j is None else loc(Aj, joint.axis_j)
+    return JointGeom(joint.name, fid[bi], fid[bj], bi.is_particle, bj.is_particle,
+                     loc(Ai, joint.point - bi.position), loc(Aj, joint.point - bj.position),
+                     loc(Ai, f), loc(Ai, g), loc(Ai, h), loc(Aj, f), loc(Aj, g), loc(Aj, h), extra)
+
+
+def _row_specs(model, fid):
+    specs, geoms = [], {}
+    for jt in model.joints.values():
+        if jt.body_i.is_particle and not jt.body_j.is_particle and jt.kind not in ("spherical",):
+            raise ModelError(f"joint '{jt.name}'", "body_i", "a particle must be body_j of a "
+                             f"{jt.kind} joint (it has no orientation to carry the joint axes)")
+        g = joint_geometry(jt, fid)
+        geoms[jt.name] = g
+        specs += _placed(JOINT_TYPES[jt.kind].rows(g), g)
+    for m in model.motions.values():
+        g = geoms[m.joint.name]
+        if m.dof == "rotation" and g.particle_j:
+            raise ModelError(f"motion '{m.name}'", "joint", "cannot drive a rotation of a particle")
+        specs += _placed(driver_rows(g, m.dof, m.function, m.name), g)
+    return specs, geoms
+
+
+def _placed(rows, g):
+    for s in rows:
+        s.frames = (g.bi, g.bj)
+    return rows
+
+
+def _groups(specs: list[RowSpec], fid):
+    owners, owner_rows, row = [], {}, 0
+    buckets: dict[str, list] = {}
+    for s in specs:
+        buckets.setdefault(s.kind, []).append((s, row))
+        owners += [s.owner] * s.nrow
+        owner_rows.setdefault(s.owner, []).extend(range(row, row + s.nrow))
+        row += s.nrow
+    groups = []
+    for kind, items in buckets.items():
+        vecs = tuple(np.array([s.vecs[k] for s, _ in items], dtype=float) for k in range(len(items[0][0].vecs)))
+        groups.append(Group(kind, np.array([s.frames[0] for s, _ in items]),
+                            np.array([s.frames[1] for s, _ in items]), vecs,
+                            np.array([r for _, r in items]), [s.fn for s, _ in items]))
+    return groups, owners, {k: np.array(v) for k, v in owner_rows.items()}

@@ -1,0 +1,1 @@
+"""Constraint equations: vectorised primitives and one small class per joint type."""

@@ -1,0 +1,41 @@
+"""Generalized applied forces Q (nv,) and the augmented (KKT) solve of the equations of motion.
+
+Equations (velocity variables v = [rd, w_B] per body): M vd + phi_q^T lambda_ = Q, phi_q vd = gamma,
+with Q = gravity + applied loads + force elements - w_B x (J w_B) (gyroscopic, body axes).
+"""
+from __future__ import annotations
+
+import numpy as np
+import scipy.linalg as sla
+
+from .force_elements import evaluator
+from .force_elements import loads  # noqa: F401  (registers the built-in evaluators)
+from .frames import Frames
+
+
+def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
+    """Q (nv,): gravity, gyroscopic terms and every force element at one state (frames without time axis)."""
+    Q = np.zeros(sys.nv)
+    g = sys.model.gravity
+    a = sys.rd_idx
+    Q[a] += sys.mass[1:, None] * g
+    rig = sys.rigid_fid
+    if len(rig):
+        w_B = np.einsum("nji,nj->ni", fr.A[rig], fr.w[rig])
+        Q[sys.w_idx] -= np.cross(w_B, np.einsum("nij,nj->ni", sys.inertia_B[rig], w_B))
+    for elem in sys.model.forces.values():
+        Q += evaluator(elem).generalized(sys, fr, elem, t, state)
+    return Q
+
+
+def solve_kkt(M, J, Q, gamma):
+    """Solve [[M, J^T], [J, 0]] [vd, lambda_] = [Q, gamma]; returns (vd, lambda_)."""
+    nv, nc = M.shape[0], J.shape[0]
+    if nc == 0:
+        return sla.solve(M, Q, assume_a="pos"), np.zeros(0)
+    K = np.zeros((nv + nc, nv + nc))
+    K[:nv, :nv] = M
+    K[:nv, nv:] = J.T
+    K[nv:, :nv] = J
+    x = sla.solve(K, np.concatenate([Q, gamma]))
+    return x[:nv], x[nv:]

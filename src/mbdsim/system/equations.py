@@ -1,0 +1,85 @@
+"""System-level constraint equations: scatter the vectorised primitive rows into global arrays.
+
+phi (nc,): residual; phi_q (nc, nv): Jacobian with respect to the velocity variables (CM translation
+[m] and body-axes virtual rotation [rad] per body); nu (nc,) = -phi_t; gamma (nc,): acceleration
+right-hand side so that phi_q vd = gamma.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .constraints import primitives as pr
+from .frames import Frames, body_frames
+
+
+def _rows_of(group):
+    if group.kind == "sph":
+        return (group.row_adr[:, None] + np.arange(3)).reshape(-1)
+    return group.row_adr
+
+
+def group_rows(sys, fr: Frames, group):
+    """Evaluate one group: returns (Rows, nu, extra_gamma) with driver targets applied."""
+    v = group.vecs
+    nu = extra = None
+    if group.kind == "sph":
+        rows = pr.spherical(fr, group.bi, group.bj, v[0], v[1])
+    elif group.kind == "dot1":
+        rows = pr.dot1(fr, group.bi, group.bj, v[0], v[1])
+    elif group.kind == "dot2":
+        rows = pr.dot2(fr, group.bi, group.bj, v[0], v[1], v[2])
+    elif group.kind in ("angle", "slide"):
+        if group.kind == "angle":
+            _, rows, _ = pr.angle(fr, group.bi, group.bj, v[0], v[1], v[2])
+        else:
+            rows = pr.dot2(fr, group.bi, group.bj, v[0], v[1], v[2])
+        t = fr.t
+        f = np.array([fn.value(t) for fn in group.fns], dtype=float)
+        nu = np.array([fn.d1(t) for fn in group.fns], dtype=float)
+        extra = np.array([fn.d2(t) for fn in group.fns], dtype=float)
+        d = rows.phi - f
+        rows.phi = (d + np.pi) % (2 * np.pi) - np.pi if group.kind == "angle" else d
+    else:  # pragma: no cover
+        raise ValueError(f"unknown constraint primitive {group.kind!r}")
+    return rows, nu, extra
+
+
+def scatter_jacobian(sys, fr: Frames, idx, rows, out):
+    """Add the row blocks of both bodies into out (nc, nv) at row indices idx."""
+    for b, J_r, J_p in ((rows.bi, rows.J_ri, rows.J_pi), (rows.bj, rows.J_rj, rows.J_pj)):
+        m = b > 0
+        if not np.any(m):
+            continue
+        col = sys.frame_v_adr[b[m]]
+        r = idx[m]
+        np.add.at(out, (r[:, None], col[:, None] + np.arange(3)), J_r[m])
+        rig = m & sys.frame_rigid[b]
+        if np.any(rig):
+            Jb = np.einsum("ni,nij->nj", J_p[rig], fr.A[b[rig]])
+            np.add.at(out, (idx[rig][:, None], sys.frame_v_adr[b[rig]][:, None] + 3 + np.arange(3)), Jb)
+
+
+def constraint_terms(sys, q, v, t, jacobian=True):
+    """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False."""
+    fr = body_frames(sys, q, v)
+    fr.t = t
+    phi_ = np.zeros(sys.nc)
+    nu = np.zeros(sys.nc)
+    gamma = np.zeros(sys.nc)
+    J = np.zeros((sys.nc, sys.nv)) if jacobian else None
+    for g in sys.groups:
+        rows, nu_g, extra = group_rows(sys, fr, g)
+        idx = _rows_of(g)
+        phi_[idx] = rows.phi
+        gamma[idx] = -rows.quad
+        if nu_g is not None:
+            nu[idx] = nu_g
+            gamma[idx] += extra
+        if jacobian:
+            scatter_jacobian(sys, fr, idx, rows, J)
+    return phi_, J, nu, gamma
+
+
+def phi(sys, q, t):
+    """Constraint residual phi(q, t), shape (nc,)."""
+    return constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0]

@@ -1,0 +1,99 @@
+"""Point forces, torques and translational spring-dampers."""
+from __future__ import annotations
+
+import numpy as np
+
+from ...errors import ModelError
+from ...model.forces import Force, SpringDamper, Torque
+from ..frames import point_state
+from . import register
+
+
+def add_point_force(sys, fr, Q, fid, s_ground, F):
+    """Add a ground-axes force F [N] applied at offset s_ground [m] from the CM of frame fid into Q."""
+    if fid == 0:
+        return
+    a = sys.frame_v_adr[fid]
+    Q[a:a + 3] += F
+    if sys.frame_rigid[fid]:
+        Q[a + 3:a + 6] += fr.A[fid].T @ np.cross(s_ground, F)
+
+
+def add_torque(sys, fr, Q, fid, T):
+    """Add a ground-axes torque T [N m] on frame fid into Q."""
+    if fid == 0 or not sys.frame_rigid[fid]:
+        return
+    a = sys.frame_v_adr[fid]
+    Q[a + 3:a + 6] += fr.A[fid].T @ T
+
+
+def _vector(elem, value, t, state, fr, sys, what):
+    v = value(t, state) if callable(value) else value
+    v = np.asarray(v, dtype=float).reshape(-1)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ModelError(f"{what} '{elem.name}'", what, f"callable returned {v!r} at t={t}; expected 3 finite numbers")
+    if elem.frame is not None:
+        from ..measures import locate
+        fid, _, R_BM = locate(sys, elem.frame)
+        v = fr.A[fid] @ (R_BM @ v)
+    return v
+
+
+@register(Force)
+class ForceEval:
+    @staticmethod
+    def generalized(sys, fr, elem, t, state):
+        Q = np.zeros(sys.nv)
+        fid = sys.fid[elem.body]
+        F = _vector(elem, elem.force, t, state, fr, sys, "force")
+        add_point_force(sys, fr, Q, fid, fr.A[fid] @ elem.s_B, F)
+        return Q
+
+
+@register(Torque)
+class TorqueEval:
+    @staticmethod
+    def generalized(sys, fr, elem, t, state):
+        Q = np.zeros(sys.nv)
+        add_torque(sys, fr, Q, sys.fid[elem.body], _vector(elem, elem.torque, t, state, fr, sys, "torque"))
+        return Q
+
+
+def spring_state(sys, fr, elem):
+    """Length L [m], rate dL/dt [m/s], unit vector i->j, ground points and offsets (single state)."""
+    fi, fj = sys.fid[elem.marker_i.body], sys.fid[elem.marker_j.body]
+    pi, vi, _ = point_state(fr, fi, elem.marker_i.s_B)
+    pj, vj, _ = point_state(fr, fj, elem.marker_j.s_B)
+    d = pj - pi
+    L = np.linalg.norm(d, axis=-1)
+    u = d / np.where(L > 0, L, 1.0)[..., None]
+    Ld = np.einsum("...i,...i->...", u, vj - vi)
+    return L, Ld, u, (fi, pi), (fj, pj)
+
+
+@register(SpringDamper)
+class SpringEval:
+    @staticmethod
+    def tension(elem, L, Ld):
+        """Tension [N], positive pulling the points together."""
+        return elem.stiffness * (L - elem.free_length) + elem.damping * Ld + elem.preload
+
+    @staticmethod
+    def generalized(sys, fr, elem, t, state):
+        Q = np.zeros(sys.nv)
+        L, Ld, u, (fi, pi), (fj, pj) = spring_state(sys, fr, elem)
+        T = SpringEval.tension(elem, L, Ld)
+        add_point_force(sys, fr, Q, fi, pi - fr.r[fi], T * u)
+        add_point_force(sys, fr, Q, fj, pj - fr.r[fj], -T * u)
+        return Q
+
+    @staticmethod
+    def potential(sys, fr, elem):
+        L = spring_state(sys, fr, elem)[0]
+        x = L - elem.free_length
+        return 0.5 * elem.stiffness * x**2 + elem.preload * x
+
+    @staticmethod
+    def dissipation(sys, fr, elem, t):
+        Ld = spring_state(sys, fr, elem)[1]
+        return elem.damping * Ld**2

@@ -1,0 +1,108 @@
+"""Pure measure functions of (system, frames): positions, velocities, joint coordinates, energies.
+
+Frames carry a leading time axis (N, nframes, ...).  Vectors are in ground axes unless `frame`
+names a Body or Marker, in which case they are expressed in that frame's axes (positions are then
+measured from the frame's origin; velocities/accelerations stay absolute, i.e. relative to ground).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from ..model.body import Body, Marker
+from .constraints import primitives as pr
+from .frames import Frames
+
+
+def locate(sys, target):
+    """(frame index, s_B, R_BM) of a Body (its CM) or Marker."""
+    if isinstance(target, Marker):
+        return sys.fid[_known(sys, target.body)], target.s_B, target.R_BM
+    if isinstance(target, Body):
+        return sys.fid[_known(sys, target)], np.zeros(3), np.eye(3)
+    if isinstance(target, str):
+        for b in sys.fid:
+            if b.name == target:
+                return sys.fid[b], np.zeros(3), np.eye(3)
+    raise ModelError(f"measure target {target!r}", "target", "expected a Body, particle or Marker of the model")
+
+
+def _known(sys, body):
+    if body not in sys.fid:
+        raise ModelError(f"body '{body.name}'", "body", "is not part of the analysed model")
+    return body
+
+
+def frame_rotation(sys, fr: Frames, frame):
+    """Rotation (N, 3, 3) frame->ground of a Body/Marker (identity for None)."""
+    if frame is None:
+        return None
+    fid, _, R_BM = locate(sys, frame)
+    return fr.A[:, fid] @ R_BM
+
+
+def express(sys, fr, vec, frame):
+    """Express ground vectors (N, 3) in the axes of `frame`."""
+    R = frame_rotation(sys, fr, frame)
+    return vec if R is None else np.einsum("nji,nj->ni", R, vec)
+
+
+def point_kinematics(sys, fr, target):
+    """Ground position, velocity, acceleration (N, 3) of a body CM or marker origin."""
+    fid, s_B, _ = locate(sys, target)
+    A = fr.A[:, fid]
+    s = A @ s_B
+    w = fr.w[:, fid]
+    pos = fr.r[:, fid] + s
+    vel = fr.rd[:, fid] + np.cross(w, s)
+    acc = None
+    if fr.rdd is not None:
+        acc = fr.rdd[:, fid] + np.cross(fr.alpha[:, fid], s) + np.cross(w, np.cross(w, s))
+    return pos, vel, acc
+
+
+def position(sys, fr, target, frame=None):
+    """Position [m] of target, in ground or relative to `frame` in its axes."""
+    pos = point_kinematics(sys, fr, target)[0]
+    if frame is None:
+        return pos
+    return express(sys, fr, pos - point_kinematics(sys, fr, frame)[0], frame)
+
+
+def flat(fr: Frames, bi, bj):
+    """Flatten time into the frame axis so per-row primitives run over all samples at once."""
+    N, nf = fr.r.shape[:2]
+    out = Frames(fr.r.reshape(-1, 3), fr.A.reshape(-1, 3, 3), fr.rd.reshape(-1, 3), fr.w.reshape(-1, 3))
+    base = np.arange(N) * nf
+    return out, base + bi, base + bj
+
+
+def joint_coordinate(sys, fr, joint, dof=None):
+    """Joint coordinate samples: angle [rad] of j about the axis (wrapped) and/or slide [m].
+
+    Returns (angle (N,) or None, angle_rate (N,) or None, slide (N,) or None, slide_rate (N,) or None)."""
+    g = sys.geoms[joint.name]
+    N = fr.r.shape[0]
+    ff, bi, bj = flat(fr, g.bi, g.bj)
+    rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
+    ang = angd = sl = sld = None
+    if joint.kind in ("revolute", "cylindrical") and not g.particle_j:
+        ang, _, angd = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
+    if joint.kind in ("translational", "cylindrical"):
+        sl = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)).phi
+        sld = pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
+    return ang, angd, sl, sld
+
+
+def kinetic_energy(sys, fr) -> np.ndarray:
+    """Total kinetic energy (N,) [J]."""
+    m = sys.mass
+    T = 0.5 * np.einsum("f,nfi,nfi->n", m, fr.rd, fr.rd)
+    w_B = np.einsum("nfji,nfj->nfi", fr.A, fr.w)
+    T += 0.5 * np.einsum("nfi,fij,nfj->n", w_B, sys.inertia_B, w_B)
+    return T
+
+
+def gravity_potential(sys, fr) -> np.ndarray:
+    """Gravity potential energy (N,) [J], zero at the ground origin."""
+    return -np.einsum("f,nfi,i->n", sys.mass, fr.r, sys.model.gravity)
