@@ -201,6 +201,9 @@ def call(name, args, order=0, table=None):
 
 
 # ----------------------------------------------------------------------------- evaluation
+_UFUNC = {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.true_divide, "**": np.power}
+
+
 def _eval(n, env):
     if isinstance(n, Const):
         return n.value
@@ -208,7 +211,7 @@ def _eval(n, env):
         return env[n.name]
     if isinstance(n, Bin):
         a, b = _eval(n.a, env), _eval(n.b, env)
-        return {"+": np.add, "-": np.subtract, "*": np.multiply, "/": np.true_divide, "**": np.power}[n.op](a, b)
+        return _UFUNC[n.op](a, b)
     if isinstance(n, Neg):
         return np.negative(_eval(n.a, env))
     if isinstance(n, Fn):

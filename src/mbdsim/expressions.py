@@ -30,7 +30,7 @@ from ._exprtree import (FUNCTIONS, LIBRARY_FUNCTIONS, Const, ExpressionError, Va
 __all__ = ["ExpressionError", "Expr", "parse", "FUNCTIONS", "LIBRARY_FUNCTIONS",
            "TimeFunction", "time_function", "integrated", "double_integrated"]
 
-MAX_LENGTH, MAX_DEPTH = 10_000, 200
+MAX_LENGTH, MAX_DEPTH, MAX_ORDER = 10_000, 200, 20
 
 
 # ----------------------------------------------------------------------------- Expr
@@ -190,8 +190,8 @@ def parse(text: str, variables=("t",), *, tables=None) -> Expr:
         order = 0
         for kw in n.keywords:
             if name in _NP or kw.arg != "order" or not (isinstance(kw.value, ast.Constant) and type(kw.value.value) is int
-                                                        and kw.value.value >= 0):
-                fail("keyword argument not allowed (only order=<int> for library functions and tables):", kw)
+                                                        and 0 <= kw.value.value <= MAX_ORDER):
+                fail(f"keyword argument not allowed (only order=<0..{MAX_ORDER}> for library functions and tables):", kw)
             order = kw.value.value
         args = [walk(a, depth + 1) for a in n.args]
         if name in tables:
@@ -204,12 +204,12 @@ def parse(text: str, variables=("t",), *, tables=None) -> Expr:
             fail(f"{name} takes {lo if lo == hi else f'at least {lo}'} argument(s), got {len(args)}:", n)
         if name in _NP:
             return finite(n, fn(name, *args), args)
-        try:
-            if lib and all(isinstance(a, Const) for a in args[1:]):     # check constant parameters now
+        if lib and all(isinstance(a, Const) for a in args[1:]):         # check constant parameters now
+            try:
                 _lib.LIBRARY[lib].fn(0.0, *(a.value for a in args[1:]))
-            return finite(n, call(lib or name, tuple(args), order, tables.get(name)), args)
-        except ValueError as exc:                      # e.g. STEP with x1 <= x0
-            fail(f"invalid arguments ({exc}):", n)
+            except ValueError as exc:                                    # e.g. STEP with x1 <= x0
+                fail(f"invalid arguments ({exc}):", n)
+        return finite(n, call(lib or name, tuple(args), order, tables.get(name)), args)
 
     return Expr(walk(tree.body, 0), variables, text)
 

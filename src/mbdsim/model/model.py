@@ -9,10 +9,12 @@ from ..errors import ModelError
 from ._check import scalar, vec3
 from .body import Body, Marker, make_body
 from .forces import Force, SpringDamper, Torque
+from .elements import ForceElementsMixin
+from .friction_path import FrictionPathMixin
 from .joints import Joint, Motion
 
 
-class Model:
+class Model(ForceElementsMixin, FrictionPathMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0)):

@@ -52,11 +52,11 @@ def scatter_jacobian(sys, fr: Frames, idx, rows, out):
             continue
         col = sys.frame_v_adr[b[m]]
         r = idx[m]
-        np.add.at(out, (r[:, None], col[:, None] + np.arange(3)), J_r[m])
+        out[r[:, None], col[:, None] + np.arange(3)] += J_r[m]  # (row, col) pairs are unique here
         rig = m & sys.frame_rigid[b]
         if np.any(rig):
             Jb = np.einsum("ni,nij->nj", J_p[rig], fr.A[b[rig]])
-            np.add.at(out, (idx[rig][:, None], sys.frame_v_adr[b[rig]][:, None] + 3 + np.arange(3)), Jb)
+            out[idx[rig][:, None], sys.frame_v_adr[b[rig]][:, None] + 3 + np.arange(3)] += Jb
 
 
 def constraint_terms(sys, q, v, t, jacobian=True):

@@ -116,9 +116,9 @@ def run() -> CaseOutcome:
     model = build_model()
     rod, crank_joint = model.bodies["rod"], model.joints["rev_O"]
     period = 2 * np.pi / OMEGA
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 200)
+    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
     # the instant theta = 60 deg again, one revolution after the start
-    t60 = res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0]
+    t60 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
     at = res.at(t60)
     v_G = float(np.linalg.norm(at.velocity(rod)[0]))
     w_AB = float(at.angular_velocity(rod)[0, 2])

@@ -101,8 +101,8 @@ def run() -> CaseOutcome:
     model = build_model()
     arm, crank_joint = model.bodies["arm"], model.joints["rev_O"]
     period = 2 * np.pi / OMEGA
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 200)
-    t45 = res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0]
+    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
+    t45 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
     w = float(res.at(t45).angular_velocity(arm)[0, 2])
     th = theory()
     q = [Quantity("omega_AB", "rad/s", th["omega_AB"], *MANUAL["omega_AB"], w,

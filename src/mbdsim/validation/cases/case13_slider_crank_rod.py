@@ -92,8 +92,8 @@ def run() -> CaseOutcome:
     model = build_model()
     rod, crank_joint = model.bodies["rod"], model.joints["rev_O"]
     period = 2 * np.pi / OMEGA0
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 200)
-    t60 = res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0]
+    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
+    t60 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
     at = res.at(t60)
     w = float(at.angular_velocity(rod)[0, 2])
     a = float(at.angular_acceleration(rod)[0, 2])

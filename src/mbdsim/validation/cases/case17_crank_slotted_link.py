@@ -107,8 +107,8 @@ def run() -> CaseOutcome:
     link, crank_joint = model.bodies["link_CB"], model.joints["rev_O"]
     mB = link.add_marker("B", point=B)          # end B of the link
     period = 2 * np.pi / OMEGA_OA
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 200)
-    t30 = res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0]
+    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
+    t30 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
     at = res.at(t30)
     w = float(at.angular_velocity(link)[0, 2])
     v_B = float(np.linalg.norm(at.velocity(mB)[0]))

@@ -1,0 +1,134 @@
+"""Model methods for the force-element library (torsion springs, bushings, contact, stops).
+
+Mixed into mbdsim.Model; each method validates its input, builds a spec and registers it with
+`self.add_element(spec)`.  Errors are ModelError naming the entity and the field.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+from ._check import scalar
+from .element_specs import Bushing, Contact, Stop, TorsionSpring
+from .shapes import attach
+
+
+class ForceElementsMixin:
+    """add_torsion_spring, add_bushing, add_contact, add_stop (see issue 3)."""
+
+    def add_torsion_spring(self, name, joint, stiffness, damping=0.0, free_angle=0.0, preload=0.0) -> TorsionSpring:
+        """Rotational spring-damper on a revolute or cylindrical joint axis.
+
+        Torque on body_j about the axis = -(stiffness (theta - free_angle) + damping theta_dot + preload),
+        on body_i the opposite; theta [rad] is the joint angle (0 in the initial configuration).
+        stiffness [N m/rad] >= 0, damping [N m s/rad] >= 0, free_angle [rad], preload [N m].
+        `res.spring_length/velocity/force` give theta, theta_dot and that spring torque."""
+        entity = f"torsion spring '{name}'"
+        jt = self._element_joint(entity, joint)
+        self._rotational_joint(entity, jt, "rotation")
+        spec = TorsionSpring(name, jt, scalar(entity, "stiffness", stiffness, minimum=0.0),
+                             scalar(entity, "damping", damping, minimum=0.0),
+                             scalar(entity, "free_angle", free_angle), scalar(entity, "preload", preload))
+        return self.add_element(spec)
+
+    def add_bushing(self, name, marker_i, marker_j, stiffness=(0.0,) * 6, damping=(0.0,) * 6,
+                    preload=(0.0,) * 6) -> Bushing:
+        """Bushing between two markers (a Marker or (body, point in ground at t=0)), Adams BUSHING semantics.
+
+        stiffness (kx, ky, kz [N/m], ktx, kty, ktz [N m/rad]), damping (cx, cy, cz [N s/m], ctx, cty, ctz
+        [N m s/rad]) and preload (Fx, Fy, Fz [N], Tx, Ty, Tz [N m]) in marker_i axes; see mbdsim Bushing."""
+        entity = f"bushing '{name}'"
+        mi, mj = self._location(entity, "marker_i", marker_i), self._location(entity, "marker_j", marker_j)
+        if mi.body is mj.body:
+            raise ModelError(entity, "marker_j", "the markers must be on two different bodies")
+        k = _six(entity, "stiffness", stiffness, minimum=0.0)
+        c = _six(entity, "damping", damping, minimum=0.0)
+        return self.add_element(Bushing(name, mi, mj, k, c, _six(entity, "preload", preload)))
+
+    def add_contact(self, name, shape_i, shape_j, stiffness, exponent, damping, penetration, mu=0.0,
+                    friction_velocity=1e-3) -> Contact:
+        """Compliant contact between an mb.Sphere and an mb.Plane or two spheres (Adams IMPACT law).
+
+        stiffness k [N/m^e] >= 0, exponent e > 0, damping c_max [N s/m] >= 0 reached at `penetration`
+        d [m] > 0, Coulomb coefficient mu >= 0 regularised below `friction_velocity` [m/s] > 0."""
+        entity = f"contact '{name}'"
+        si = self._shape(entity, "shape_i", shape_i)
+        sj = self._shape(entity, "shape_j", shape_j)
+        if si.body is sj.body:
+            raise ModelError(entity, "shape_j", "the two shapes are on the same body")
+        if si.kind == "plane" and sj.kind == "plane":
+            raise ModelError(entity, "shape_j", "plane-plane contact is not supported (use a sphere)")
+        spec = Contact(name, si, sj, scalar(entity, "stiffness", stiffness, minimum=0.0),
+                       scalar(entity, "exponent", exponent, minimum=0.0, strict=True),
+                       scalar(entity, "damping", damping, minimum=0.0),
+                       scalar(entity, "penetration", penetration, minimum=0.0, strict=True),
+                       scalar(entity, "mu", mu, minimum=0.0),
+                       scalar(entity, "friction_velocity", friction_velocity, minimum=0.0, strict=True))
+        return self.add_element(spec)
+
+    def add_stop(self, name, joint, lower=None, upper=None, stiffness=None, exponent=1.5, damping=0.0,
+                 penetration=1e-3, dof=None) -> Stop:
+        """One- or two-sided stop on a translational, revolute or cylindrical joint coordinate.
+
+        lower/upper [m or rad] (None: open), in the coordinates of Result.joint_coordinate (0 at the
+        initial configuration); stiffness [N/m^e or N m/rad^e] > 0 (required), exponent e > 0,
+        damping c_max [N s/m or N m s/rad] >= 0 reached at `penetration` [m or rad] > 0.
+        `dof` picks "rotation" or "translation" on a cylindrical joint (default "translation")."""
+        entity = f"stop '{name}'"
+        jt = self._element_joint(entity, joint)
+        dof = self._stop_dof(entity, jt, dof)
+        if lower is None and upper is None:
+            raise ModelError(entity, "lower", "give lower and/or upper")
+        lo = None if lower is None else scalar(entity, "lower", lower)
+        hi = None if upper is None else scalar(entity, "upper", upper)
+        if lo is not None and hi is not None and not lo < hi:
+            raise ModelError(entity, "upper", f"must be > lower ({lo!r}), got {hi!r}")
+        if stiffness is None:
+            raise ModelError(entity, "stiffness", "is required")
+        spec = Stop(name, jt, dof, lo, hi, scalar(entity, "stiffness", stiffness, minimum=0.0, strict=True),
+                    scalar(entity, "exponent", exponent, minimum=0.0, strict=True),
+                    scalar(entity, "damping", damping, minimum=0.0),
+                    scalar(entity, "penetration", penetration, minimum=0.0, strict=True))
+        return self.add_element(spec)
+
+    # ----------------------------------------------------------------- helpers
+    def _element_joint(self, entity, joint):
+        return self._lookup(joint, self.joints, entity, "joint")
+
+    @staticmethod
+    def _rotational_joint(entity, jt, what):
+        if jt.kind not in ("revolute", "cylindrical"):
+            raise ModelError(entity, "joint", f"needs a revolute or cylindrical joint for a {what}, "
+                             f"{jt.name!r} is {jt.kind}")
+        if jt.body_j.is_particle:
+            raise ModelError(entity, "joint", f"body_j of {jt.name!r} is a particle: it has no rotation")
+
+    def _stop_dof(self, entity, jt, dof):
+        allowed = {"revolute": ("rotation",), "translational": ("translation",),
+                   "cylindrical": ("translation", "rotation")}
+        if jt.kind not in allowed:
+            raise ModelError(entity, "joint", f"needs a translational, revolute or cylindrical joint, "
+                             f"{jt.name!r} is {jt.kind}")
+        dof = allowed[jt.kind][0] if dof is None else dof
+        if dof not in allowed[jt.kind]:
+            raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {jt.kind} joint {jt.name!r}")
+        if dof == "rotation":
+            self._rotational_joint(entity, jt, "rotational stop")
+        return dof
+
+    def _shape(self, entity, field, shape):
+        body = self._lookup(getattr(shape, "body", None), self.bodies, entity, field) \
+            if hasattr(shape, "body") else None
+        if body is None:
+            raise ModelError(entity, field, f"expected mb.Sphere or mb.Plane, got {shape!r}")
+        return attach(entity, field, shape, body)
+
+
+def _six(entity, field, values, minimum=None) -> np.ndarray:
+    try:
+        a = np.asarray(values, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise ModelError(entity, field, f"expected 6 numbers, got {values!r}") from None
+    if a.shape != (6,):
+        raise ModelError(entity, field, f"expected 6 numbers (x, y, z, rx, ry, rz), got {values!r}")
+    return np.array([scalar(entity, f"{field}[{k}]", x, minimum=minimum) for k, x in enumerate(a)])
