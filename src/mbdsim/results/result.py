@@ -33,6 +33,7 @@ class Result:
         self.stats = stats or {}
         self._fr = None
         self._parent = None
+        self.error = None   # the MbdsimError that stopped a failed run (time, joints, last good state)
 
     # ------------------------------------------------------------ basics
     def __len__(self):
@@ -45,6 +46,7 @@ class Result:
     def frames(self):
         if self._fr is None:
             self._fr = body_frames(self.system, self.q, self.v, self.vd)
+            self._fr.t = self.time   # sample times, for time-dependent element measures
         return self._fr
 
     def at(self, t) -> "Result":
@@ -213,6 +215,11 @@ class Result:
             if hasattr(ev, "potential"):
                 V = V + ev.potential(self.system, self.frames, el)
         return V
+
+    def dissipated_energy(self):
+        """Energy dissipated by damping, friction and contact since the first sample [J], (N,)."""
+        from .energy import dissipated_energy
+        return dissipated_energy(self)
 
     # ------------------------------------------------------------ events and extrema
     def crossings(self, signal, value, direction=0):

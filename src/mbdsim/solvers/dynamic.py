@@ -93,7 +93,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
     y0 = np.concatenate([rep.q, rep.v])
     t0, t_end = times[0], times[-1]
     out = [consistent_state(sys, y0, t0, rows, sf)]
-    nxt, nsteps, success, message = 1, 0, True, "ok"
+    nxt, nsteps, success, message, error = 1, 0, True, "ok", None
     opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
     try:
         solver = solver_cls(rhs, t0, y0, t_end, **opts)
@@ -127,10 +127,11 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
             if hasattr(solver, "f"):
                 solver.f = rhs(solver.t, y)
     except MbdsimError as exc:
-        success, message = False, str(exc)
+        success, message, error = False, f"{exc}; last good output at t = {times[len(out) - 1]:.9g} s", exc
     n = len(out)
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
                  evaluate=traj.evaluate if traj.dense else None, success=success,
                  status=0 if success else -1, message=message,
                  stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
+    res.error = error
     return res

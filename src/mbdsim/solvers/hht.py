@@ -48,7 +48,7 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
     h = min(max_step or np.inf, (t_end - t0) / 100, _initial_step(sys, cur, rtol, atol))
     steps = [cur]
     out = [consistent_state(sys, np.concatenate([rep.q, rep.v]), t0, rows, sf)]
-    nxt, success, message, nrej = 1, True, "ok", 0
+    nxt, success, message, nrej, error = 1, True, "ok", 0, None
     itmat = None
     try:
         while cur.t < t_end - 1e-14 * max(1.0, abs(t_end)):
@@ -74,7 +74,7 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
             cur = new
             h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
     except MbdsimError as exc:
-        success, message = False, str(exc)
+        success, message, error = False, f"{exc}; last good step at t = {cur.t:.9g} s", exc
     n = len(out)
 
     def evaluate(ts):
@@ -85,10 +85,12 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
             states.append(_dense(sys, steps[k], steps[min(k + 1, len(steps) - 1)], t, rows, sf))
         return tuple(np.array([s[i] for s in states]) for i in range(4))
 
-    return Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)], evaluate=evaluate,
-                  success=success, status=0 if success else -1, message=message,
-                  stats={"steps": len(steps) - 1, "rejected": nrej, "method": "HHT", "alpha": alpha,
-                         "assembly": rep})
+    res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)], evaluate=evaluate,
+                 success=success, status=0 if success else -1, message=message,
+                 stats={"steps": len(steps) - 1, "rejected": nrej, "method": "HHT", "alpha": alpha,
+                        "assembly": rep})
+    res.error = error
+    return res
 
 
 def _force_term(sys, q, v, t, lam, rows, sf):
@@ -130,7 +132,7 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, itmat):
         norm = np.max(np.abs(d[:nv])) * beta * h * h
         if not np.all(np.isfinite(d)):
             return None, None, False
-        if norm < 1e-12 * (1 + np.max(np.abs(base_dq))) and np.max(np.abs(phi)) < 1e-10:
+        if norm < 1e-12 * (1 + np.max(np.abs(base_dq))) and (len(phi) == 0 or np.max(np.abs(phi)) < 1e-10):
             q1 = increment(sys, cur.q, base_dq + h * h * beta * a)
             v1 = base_v + h * gamma * a
             q1, _, _ = project_positions(sys, q1, t1, rows, tol=1e-12, maxit=3)

@@ -29,18 +29,21 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
     sf = state_factory(sys)
     out, q = [], rep.q
     prev = None
-    message, success = "ok", True
+    message, success, error = "ok", True, None
     for t in times:
         try:
             q = _predict(sys, prev, t) if prev is not None else q
             state = solve_at(sys, q, t, sf)
         except AssemblyError as exc:
-            success, message = False, f"{exc}; last good state at t = {prev[0] if prev else start_time:.9g} s"
+            success, error = False, exc
+            message = f"{exc}; last good state at t = {prev[0] if prev else start_time:.9g} s"
             break
         out.append(state)
         prev = state
     ev = lambda ts: _evaluate(sys, out, ts, sf)  # noqa: E731
-    return _result(sys, out, ev, success, message)
+    res = _result(sys, out, ev, success, message)
+    res.error = error
+    return res
 
 
 def time_grid(t0, t1, step):

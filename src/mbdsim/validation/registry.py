@@ -19,6 +19,7 @@ import math
 import pkgutil
 import re
 import time
+import warnings
 import traceback
 from dataclasses import dataclass
 from types import ModuleType, SimpleNamespace
@@ -186,8 +187,11 @@ def run_case(module: Any) -> CaseOutcome:
     """
     info = case_info(module)
     t0 = time.perf_counter()
+    caught: list = []
     try:
-        outcome = module.run()
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            outcome = module.run()
         if not isinstance(outcome, CaseOutcome):
             raise TypeError(f"run() returned {type(outcome).__name__}, expected CaseOutcome")
         for q in outcome.quantities:
@@ -197,6 +201,13 @@ def run_case(module: Any) -> CaseOutcome:
     except SystemExit as exc:  # a case calling sys.exit() must not end the run
         outcome = failed_outcome(info, f"SystemExit: {exc.code}")
     elapsed = time.perf_counter() - t0
+    seen = []
+    for w in caught:  # solver warnings (e.g. redundant constraints) go into the report, once each
+        text = f"Solver warning ({w.category.__name__}): {w.message}"
+        if text not in seen:
+            seen.append(text)
+    if seen and isinstance(outcome, CaseOutcome):
+        outcome.variants = list(outcome.variants) + seen
     try:
         outcome.elapsed_s = elapsed  # type: ignore[attr-defined]
     except Exception:  # pragma: no cover - frozen/slotted outcome

@@ -25,3 +25,6 @@ def evaluator(elem):
     if hasattr(elem, "generalized"):
         return elem
     raise TypeError(f"no evaluator for force element {elem!r}")
+
+
+from . import bushing, contact, stop, torsion  # noqa: E402,F401  (issue-3 evaluators register themselves)
