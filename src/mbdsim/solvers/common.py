@@ -1,8 +1,6 @@
 """Shared numerical kernels of the solvers: manifold increments, projections, accelerations."""
 from __future__ import annotations
 
-import warnings
-
 import numpy as np
 import scipy.linalg as sla
 
@@ -17,6 +15,7 @@ def increment(sys, q, dx):
     """q (+) dx: translate CMs by dx [m], rotate bodies by the body-axes rotation vector dx [rad]."""
     q = q.copy()
     q[sys.r_idx] += dx[sys.rd_idx]
+    q[sys.aux_q_idx] += dx[sys.aux_v_idx]   # auxiliary coordinates (curve parameters): plain sums
     if len(sys.p_idx):
         p = quat_mul(q[sys.p_idx], quat_exp(dx[sys.w_idx]))
         q[sys.p_idx] = p / np.linalg.norm(p, axis=-1, keepdims=True)
@@ -36,6 +35,7 @@ def qdot(sys, q, v):
     """dq/dt from velocity variables: rd for positions, 1/2 p (x) (0, w_B) for Euler parameters."""
     qd = np.zeros(sys.nq)
     qd[sys.r_idx] = v[sys.rd_idx]
+    qd[sys.aux_q_idx] = v[sys.aux_v_idx]
     if len(sys.p_idx):
         qd[sys.p_idx] = quat_rate(q[sys.p_idx], v[sys.w_idx])
     return qd
@@ -65,8 +65,18 @@ def dependent_owners(sys, J, rows):
     return names
 
 
+def active_rows(sys, rows, t):
+    """rows plus the switched rows in force at t (stick locks of joint friction, force_elements.friction)."""
+    if not len(sys.lock_rows):
+        return rows
+    from ..system.force_elements.friction import locks_at
+    locks = locks_at(sys, t)
+    return np.union1d(rows, locks).astype(int) if locks else rows
+
+
 def project_positions(sys, q, t, rows, tol=1e-12, maxit=25):
     """Newton (minimum-norm steps) onto phi(q, t) = 0 for the given rows; returns (q, residual, iterations)."""
+    rows = active_rows(sys, rows, t)
     zero = np.zeros(sys.nv)
     res = np.inf
     for it in range(maxit):
@@ -84,6 +94,7 @@ def project_positions(sys, q, t, rows, tol=1e-12, maxit=25):
 
 def project_velocities(sys, q, v, t, rows):
     """Minimum-norm correction of v so that phi_q v = nu on the given rows."""
+    rows = active_rows(sys, rows, t)
     _, J, nu, _ = constraint_terms(sys, q, v, t)
     J, nu = J[rows], nu[rows]
     if len(nu) == 0:
@@ -93,17 +104,19 @@ def project_velocities(sys, q, v, t, rows):
 
 def accelerations(sys, q, v, t, rows, state_factory=None):
     """vd and lambda_ (full nc, minimum-norm where redundant) from the equations of motion at (q, v, t)."""
+    rows = active_rows(sys, rows, t)
     fr = body_frames(sys, q, v)
     state = state_factory(t, q, v) if state_factory else None
     Q = applied_forces(sys, fr, t, state)
     _, J, _, gamma = constraint_terms(sys, q, v, t)
-    with warnings.catch_warnings():
-        warnings.simplefilter("error", sla.LinAlgWarning)
-        try:
-            vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
-        except (sla.LinAlgError, sla.LinAlgWarning, ValueError) as exc:
-            raise SolverError(f"singular equations of motion (lock-up or singular configuration): {exc}",
-                              time=t, joints=_worst_joints(sys, J, rows)) from None
+    try:
+        if len(sys.lock_rows):   # joint friction: slip loads depend on lambda_ (coupled KKT solve)
+            from ..system.force_elements.friction import friction_kkt
+            return friction_kkt(sys, fr, J, gamma, Q, rows, t)
+        vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise SolverError(f"singular equations of motion (lock-up or singular configuration): {exc}",
+                          time=t, joints=_worst_joints(sys, J, rows)) from None
     lam = np.zeros(sys.nc)
     if len(rows) == sys.nc:
         lam = lam_i

@@ -3,6 +3,9 @@
 Coordinates q per rigid body: CM position r [m] then Euler parameters p (4); per particle: r.
 Velocities v per rigid body: CM velocity [m/s] then angular velocity in body axes w_B [rad/s];
 per particle: CM velocity.  Frame index 0 is ground, k+1 is system body k.
+Auxiliary coordinates (the curve parameter s of each point-on-curve constraint) follow the bodies in
+q and v (s and s_dot, zero mass).  Rows: joints, motions, path constraints, then one lock row per
+joint friction element (active only while it sticks, see force_elements.friction).
 """
 from __future__ import annotations
 
@@ -15,7 +18,9 @@ from ..errors import ModelError
 from ..math.rotation import matrix_to_quat, perpendicular_frame
 from .constraints.base import JointGeom, RowSpec
 from .constraints.driver import driver_rows
+from .constraints.path import path_specs
 from .constraints.registry import JOINT_TYPES
+from .force_elements.friction import lock_specs
 
 
 @dataclass
@@ -56,10 +61,21 @@ class System:
     geoms: dict                # joint name -> JointGeom
     q0: np.ndarray
     v0: np.ndarray
+    # issue 3: auxiliary coordinates (curve parameters of path constraints) after the bodies' blocks,
+    # massless, ignored by Frames; run-time switched rows (stick locks of joint friction), last rows
+    aux_q_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    aux_v_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    lock_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
+    switched: dict = field(default_factory=dict)   # friction name -> StickSlip (mode history)
 
     @property
     def nbody(self) -> int:
         return len(self.bodies)
+
+    @property
+    def fixed_rows(self) -> np.ndarray:
+        """Rows always in force (all but the switched lock rows)."""
+        return np.arange(self.nc - len(self.lock_rows))
 
 
 def assemble_system(model) -> System:
@@ -75,6 +91,8 @@ def assemble_system(model) -> System:
             p_idx.append(range(len(q0), len(q0) + 4)); q0 += list(matrix_to_quat(b.orientation))
             w_idx.append(range(len(v0), len(v0) + 3)); v0 += list(b.orientation.T @ b.angular_velocity)
             rigid.append(k + 1)
+    pspecs, s0, sd0, aux_q, aux_v, pgeoms = path_specs(model, fid, len(q0), len(v0))
+    q0, v0 = q0 + s0, v0 + sd0
     nv = len(v0)
     mass = np.array([0.0] + [b.mass for b in bodies])
     J = np.zeros((len(bodies) + 1, 3, 3))
@@ -86,12 +104,16 @@ def assemble_system(model) -> System:
             J[k + 1] = b.inertia
             M[a + 3:a + 6, a + 3:a + 6] = b.inertia
     specs, geoms = _row_specs(model, fid)
+    geoms.update(pgeoms)
+    locks = lock_specs(model, geoms)
+    specs += pspecs + locks
     groups, owners, owner_rows = _groups(specs, fid)
     as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
     return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                   as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
                   np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
-                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float))
+                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
+                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks})
 
 
 def joint_geometry(joint, fid) -> JointGeom:

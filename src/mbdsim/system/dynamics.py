@@ -6,8 +6,8 @@ with Q = gravity + applied loads + force elements - w_B x (J w_B) (gyroscopic, b
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
+from .constraints.primitives import cross
 from .force_elements import evaluator
 from .force_elements import loads  # noqa: F401  (registers the built-in evaluators)
 from .frames import Frames
@@ -22,7 +22,7 @@ def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
     rig = sys.rigid_fid
     if len(rig):
         w_B = np.einsum("nji,nj->ni", fr.A[rig], fr.w[rig])
-        Q[sys.w_idx] -= np.cross(w_B, np.einsum("nij,nj->ni", sys.inertia_B[rig], w_B))
+        Q[sys.w_idx] -= cross(w_B, np.einsum("nij,nj->ni", sys.inertia_B[rig], w_B))
     for elem in sys.model.forces.values():
         Q += evaluator(elem).generalized(sys, fr, elem, t, state)
     return Q
@@ -31,11 +31,12 @@ def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
 def solve_kkt(M, J, Q, gamma):
     """Solve [[M, J^T], [J, 0]] [vd, lambda_] = [Q, gamma]; returns (vd, lambda_)."""
     nv, nc = M.shape[0], J.shape[0]
-    if nc == 0:
-        return sla.solve(M, Q, assume_a="pos"), np.zeros(0)
     K = np.zeros((nv + nc, nv + nc))
     K[:nv, :nv] = M
     K[:nv, nv:] = J.T
     K[nv:, :nv] = J
-    x = sla.solve(K, np.concatenate([Q, gamma]))
+    rhs = np.concatenate([Q, gamma])
+    x = np.linalg.solve(K, rhs)  # raises LinAlgError when exactly singular
+    if not np.all(np.isfinite(x)) or np.max(np.abs(x), initial=0.0) > 1e13 * (1.0 + np.max(np.abs(rhs), initial=0.0)):
+        raise np.linalg.LinAlgError("augmented matrix is numerically singular")
     return x[:nv], x[nv:]

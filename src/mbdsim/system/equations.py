@@ -8,12 +8,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import kernels
 from .constraints import primitives as pr
 from .frames import Frames, body_frames
 
 
 def _rows_of(group):
-    if group.kind == "sph":
+    if group.kind in ("sph", "curve"):
         return (group.row_adr[:, None] + np.arange(3)).reshape(-1)
     return group.row_adr
 
@@ -28,6 +29,9 @@ def group_rows(sys, fr: Frames, group):
         rows = pr.dot1(fr, group.bi, group.bj, v[0], v[1])
     elif group.kind == "dot2":
         rows = pr.dot2(fr, group.bi, group.bj, v[0], v[1], v[2])
+    elif group.kind == "curve":   # point on a curve, with the curve parameter as extra coordinate
+        from .constraints.path import curve_rows
+        rows = curve_rows(sys, fr, group)
     elif group.kind in ("angle", "slide"):
         if group.kind == "angle":
             _, rows, _ = pr.angle(fr, group.bi, group.bj, v[0], v[1], v[2])
@@ -57,12 +61,42 @@ def scatter_jacobian(sys, fr: Frames, idx, rows, out):
         if np.any(rig):
             Jb = np.einsum("ni,nij->nj", J_p[rig], fr.A[b[rig]])
             out[idx[rig][:, None], sys.frame_v_adr[b[rig]][:, None] + 3 + np.arange(3)] += Jb
+    aux = getattr(rows, "aux", None)   # auxiliary-coordinate columns (path constraints): (columns, entries)
+    if aux is not None:
+        np.add.at(out, (idx, aux[0]), aux[1])
+
+
+USE_KERNEL = kernels.HAVE_NUMBA
 
 
 def constraint_terms(sys, q, v, t, jacobian=True):
     """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False."""
+    if USE_KERNEL and sys.nc and not len(sys.aux_q_idx):   # path constraints: numpy path
+        return _terms_compiled(sys, q, v, t, jacobian)
+    return constraint_terms_numpy(sys, q, v, t, jacobian)
+
+
+def _terms_compiled(sys, q, v, t, jacobian):
+    packed = getattr(sys, "_packed", None)
+    if packed is None:
+        packed = sys._packed = kernels.pack_rows(sys)
+    kind, bi, bj, v1, v2, v3, drv, fns = packed
+    fr = body_frames(sys, q, v)
+    f = np.array([fn.value(t) for fn in fns], dtype=float)
+    fd = np.array([fn.d1(t) for fn in fns], dtype=float)
+    fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
+    phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
+    J = np.zeros((sys.nc, sys.nv))
+    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, v1, v2, v3, drv, f, fd, fdd,
+                              sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
+    return phi_, (J if jacobian else None), nu, gamma
+
+
+def constraint_terms_numpy(sys, q, v, t, jacobian=True):
+    """Reference numpy implementation of constraint_terms (vectorised primitives)."""
     fr = body_frames(sys, q, v)
     fr.t = t
+    fr.aux_q, fr.aux_v = np.asarray(q)[sys.aux_q_idx], np.asarray(v)[sys.aux_v_idx]
     phi_ = np.zeros(sys.nc)
     nu = np.zeros(sys.nc)
     gamma = np.zeros(sys.nc)

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..math.rotation import quat_to_matrix
+from . import kernels
 
 
 @dataclass
@@ -28,6 +29,10 @@ class Frames:
 def body_frames(sys, q, v=None, vd=None) -> Frames:
     """Frames of all bodies from q (..., nq), v (..., nv) and optionally vd (..., nv)."""
     q = np.asarray(q, dtype=float)
+    if q.ndim == 1 and vd is None and kernels.HAVE_NUMBA:
+        vv = np.zeros(sys.nv) if v is None else np.asarray(v, dtype=float)
+        return Frames(*kernels.frames_kernel(q, vv, sys.r_idx, sys.p_idx, sys.rd_idx, sys.w_idx,
+                                             sys.rigid_fid, sys.nbody + 1))
     lead = q.shape[:-1]
     n = sys.nbody + 1
     r = np.zeros(lead + (n, 3))

@@ -1,0 +1,302 @@
+"""Coulomb joint friction with event-driven stick/slip switching (translational and revolute joints).
+
+Model
+-----
+x is the joint coordinate (slide [m] of body_j along the axis h, or angle [rad] of body_j about it)
+and xd its rate.  Friction is a generalized force F_f on x (force [N] along h / torque [N m] about h
+on body_j, the opposite on body_i), written as the multiplier lambda_f of the element's LOCK ROW
+L(q) = x - x_stick, which is always present in the System's row layout (last rows,
+System.lock_rows): its load on the bodies is -dx/dv^T lambda_f, so F_f = -lambda_f and
+`res.friction_force(name)` = -lambda_f in both modes.
+
+Friction capacity mu N, with N from the joint's reaction (multipliers of the joint's rows) on body_j
+at the joint point: force F, moment T, split along / perpendicular to h:
+    translational [N]:  N = preload + |F_perp| + |T_perp| / effective_length + |T.h| / reaction_arm
+    revolute [N m]:     N = preload + pin_radius |F_perp| + friction_arm |F.h| + pin_radius |T_perp| / bending_arm
+(a term whose parameter is None is left out).
+
+Modes (history of (t, mode, direction s, x_stick) per element, kept on the System, so the state at
+any time - dense output, Result.at - uses the mode in force then):
+- slip, direction s = +-1: lambda_f = mu_dynamic N(lambda_) s, the lock row is inactive.  N depends on
+  lambda_, which depends on the friction load: `friction_kkt` solves the coupled KKT system by
+  iterating on the direction of the reaction (N is homogeneous of degree one in lambda_, so each
+  iterate is an exact linear solve; 1-3 iterations).  Switching function s xd: its zero (the joint
+  stops) is located as an event.
+- stick: the lock row is active (position level, so the joint cannot creep: coordinate projection
+  holds x = x_stick to the Newton tolerance); the friction force is its multiplier.  Switching
+  function mu_static N - |lambda_f| + eps, eps = STICK_TOL (1 + mu_static N): its zero releases the
+  joint in the direction sign(lambda_f) of the impending motion (dynamic friction from then on).
+- at every event (and at the start) a joint at rest (|xd| <= V_TOL) is tried in stick: it sticks if
+  |lambda_f| <= mu_static N + eps / 2, else it slips towards sign(lambda_f).  Several elements are
+  decided one after the other (not a complementarity solve).
+Only the "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic; equilibrium and
+kinematics ignore friction.  Energy: `dissipation` = lambda_f xd >= 0 [W] (needs the multipliers).
+"""
+from __future__ import annotations
+
+import bisect
+
+import numpy as np
+import scipy.linalg as sla
+
+from ...math.rotation import skew
+from ...model.friction_path import JointFriction
+from ..constraints.base import RowSpec
+from . import register
+
+V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
+STICK_TOL = 1e-9    # relative tolerance on the static friction limit
+MAXIT = 50          # iterations of the coupled friction KKT solve
+
+
+class StickSlip:
+    """Mode history of one friction element; also the target function of its lock row (x_stick)."""
+
+    def __init__(self, name):
+        self.name = name
+        self.times, self.modes = [], []     # modes: (mode, direction, x_stick)
+
+    def at(self, t):
+        """(mode, direction, x_stick) in force at time t, or None before the first decision."""
+        k = bisect.bisect_right(self.times, t) - 1
+        return self.modes[k] if k >= 0 else (self.modes[0] if self.modes else None)
+
+    def record(self, t, mode, direction=0.0, target=0.0):
+        if self.times and self.times[-1] >= t:
+            del self.times[-1], self.modes[-1]
+        self.times.append(float(t))
+        self.modes.append((mode, float(direction), float(target)))
+
+    # TimeFunction interface of the lock row: x_stick, constant within a stick period
+    def value(self, t):
+        m = self.at(t)
+        return m[2] if m else 0.0
+
+    @staticmethod
+    def d1(t):
+        return 0.0
+
+    @staticmethod
+    def d2(t):
+        return 0.0
+
+
+def lock_specs(model, geoms):
+    """Lock RowSpecs (one per friction element; rows go last in the layout) and their StickSlip states."""
+    specs = []
+    for el in model.forces.values():
+        if isinstance(el, JointFriction):
+            g = geoms[el.joint.name]
+            st = StickSlip(el.name)
+            if el.joint.kind == "revolute":
+                s = RowSpec("angle", (g.f_i, g.g_i, g.f_j), el.name, st)
+            else:
+                s = RowSpec("slide", (g.h_i, g.s_i, g.s_j), el.name, st)
+            s.frames = (g.bi, g.bj)
+            specs.append(s)
+    return specs
+
+
+def locks_at(sys, t):
+    """Row indices of the lock rows active (stick) at time t."""
+    out = []
+    for name, st in sys.switched.items():
+        m = st.at(t)
+        if m is not None and m[0] == "stick":
+            out.append(int(sys.owner_rows[name][0]))
+    return out
+
+
+# ----------------------------------------------------------------------------- normal load
+def _load_maps(sys, fr, J, elem):
+    """[(weight, L)]: N = preload + sum weight |L lambda_joint|, L linear maps of the joint's multipliers."""
+    g = sys.geoms[elem.joint.name]
+    jr = sys.owner_rows[elem.joint.name]
+    b, s_b = (g.bj, g.s_j) if g.bj != 0 else (g.bi, g.s_i)
+    a = sys.frame_v_adr[b]
+    LF = -J[jr, a:a + 3].T
+    h = fr.A[g.bi] @ g.h_i
+    P = np.eye(3) - np.outer(h, h)
+    LT = None
+    if sys.frame_rigid[b]:
+        A = fr.A[b]
+        LT = A @ (-J[jr, a + 3:a + 6].T) - skew(A @ s_b) @ LF
+    e = elem
+    if e.joint.kind == "revolute":
+        terms = [(e.pin_radius, P @ LF), (e.friction_arm, h[None] @ LF),
+                 (e.pin_radius / e.bending_arm if e.bending_arm else None, None if LT is None else P @ LT)]
+    else:
+        terms = [(1.0, P @ LF), (1 / e.effective_length if e.effective_length else None, None if LT is None else P @ LT),
+                 (1 / e.reaction_arm if e.reaction_arm else None, None if LT is None else h[None] @ LT)]
+    return jr, [(w, L) for w, L in terms if w and L is not None]
+
+
+def normal_load(elem, maps, lam_j):
+    """N (see module docstring) from the joint's multipliers lam_j."""
+    return elem.preload + sum(w * float(np.linalg.norm(L @ lam_j)) for w, L in maps)
+
+
+def _gradient(maps, lam_j):
+    g = np.zeros(len(lam_j))
+    for w, L in maps:
+        y = L @ lam_j
+        n = np.linalg.norm(y)
+        if n > 0:
+            g += w * (L.T @ y) / n
+    return g
+
+
+# ----------------------------------------------------------------------------- coupled KKT solve
+def friction_kkt(sys, fr, J, gamma, Q, rows, t):
+    """vd and full lambda_ (lock entries = friction multipliers) with slip friction loads coupled to lambda_.
+
+    rows: the active rows (independent joint rows + active lock rows)."""
+    nv, nr = sys.nv, len(rows)
+    K = np.zeros((nv + nr, nv + nr))
+    K[:nv, :nv] = sys.M
+    K[:nv, nv:] = J[rows].T
+    K[nv:, :nv] = J[rows]
+    b = np.concatenate([Q, gamma[rows]])
+    pos = np.full(sys.nc, -1)
+    pos[rows] = np.arange(nr)
+    slips = []
+    for name, st in sys.switched.items():
+        m = st.at(t)
+        if m is None or m[0] != "slip":
+            continue
+        elem = sys.model.forces[name]
+        jr, maps = _load_maps(sys, fr, J, elem)
+        keep = pos[jr] >= 0
+        maps = [(w, L[:, keep]) for w, L in maps]
+        slips.append((elem, elem.mu_dynamic * m[1], J[sys.owner_rows[name][0]], maps, pos[jr][keep],
+                      sys.owner_rows[name][0]))
+    x = sla.solve(K, b)
+    for _ in range(MAXIT if slips else 0):
+        K2, b2 = K.copy(), b.copy()
+        lam = x[nv:]
+        for elem, c, Jl, maps, idx, _ in slips:
+            g = np.zeros(nr)
+            g[idx] = _gradient(maps, lam[idx])
+            K2[:nv, nv:] += c * np.outer(Jl, g)
+            b2[:nv] -= c * elem.preload * Jl
+        x_new = sla.solve(K2, b2)
+        done = np.linalg.norm(x_new - x) <= 1e-14 * (1.0 + np.linalg.norm(x))
+        x = x_new
+        if done:
+            break
+    vd, lam = x[:nv], np.zeros(sys.nc)
+    lam[rows] = x[nv:]
+    Qf = np.zeros(nv)
+    for elem, c, Jl, maps, idx, lock in slips:
+        lam[lock] = c * normal_load(elem, maps, x[nv:][idx])
+        Qf -= Jl * lam[lock]
+    cand = np.union1d(sys.fixed_rows, [r for r in rows if r in set(sys.lock_rows)]).astype(int)
+    if len(cand) > nr:   # redundant rows dropped: minimum-norm distribution like the frictionless path
+        lam[cand] = np.linalg.lstsq(J[cand].T, Q + Qf - sys.M @ vd, rcond=None)[0]
+    return vd, lam
+
+
+# ----------------------------------------------------------------------------- evaluator
+def _rate(sys, fr, elem):
+    """Joint coordinate rate xd (N,) of time-axis frames."""
+    from ..measures import joint_coordinate
+    _, angd, _, sld = joint_coordinate(sys, fr, elem.joint)
+    return angd if elem.joint.kind == "revolute" else sld
+
+
+def _coordinate(sys, fr, elem):
+    from ..measures import joint_coordinate
+    ang, _, sl, _ = joint_coordinate(sys, fr, elem.joint)
+    return ang if elem.joint.kind == "revolute" else sl
+
+
+def _timed(fr):
+    from ..frames import Frames
+    if fr.r.ndim == 3:
+        return fr
+    return Frames(fr.r[None], fr.A[None], fr.rd[None], fr.w[None])
+
+
+def _stick_margin(sys, fr, J, lam, elem):
+    """mu_static N - |lambda_f| + eps and lambda_f at one state (full J and lambda_)."""
+    jr, maps = _load_maps(sys, fr, J, elem)
+    N = normal_load(elem, maps, lam[jr])
+    lf = lam[sys.owner_rows[elem.name][0]]
+    return elem.mu_static * N - abs(lf) + STICK_TOL * (1 + elem.mu_static * N), lf, STICK_TOL * (1 + elem.mu_static * N)
+
+
+def _decide(sys, elem, t, q, v):
+    """Mode decision at an event or at the start (see module docstring)."""
+    from ...solvers.common import accelerations, independent_rows
+    from ...solvers.state import state_factory
+    from ..equations import constraint_terms
+    from ..frames import body_frames
+    st = sys.switched[elem.name]
+    m = st.at(t)
+    fr = body_frames(sys, q, v)
+    xd = float(_rate(sys, _timed(fr), elem)[0])
+    if m is not None and m[0] == "slip" and m[1] * xd > V_TOL:
+        return
+    if m is None and abs(xd) > V_TOL:
+        st.record(t, "slip", np.sign(xd))
+        return
+    J = constraint_terms(sys, q, v, t)[1]
+    base = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]
+    if m is None or m[0] == "slip":
+        st.record(t, "stick", 0.0, float(_coordinate(sys, _timed(fr), elem)[0]))
+    lam = accelerations(sys, q, v, t, base, state_factory(sys))[1]
+    margin, lf, eps = _stick_margin(sys, fr, J, lam, elem)
+    if margin <= eps / 2:
+        st.record(t, "slip", 1.0 if lf >= 0 else -1.0)
+
+
+@register(JointFriction)
+class FrictionEval:
+    """Evaluator of JointFriction (its load enters through `friction_kkt`, not `generalized`)."""
+
+    needs_lambda = True       # switching functions use the multipliers (EventTracker attaches them)
+    restart_positive = True   # after an event every switching function starts positive
+
+    @staticmethod
+    def generalized(sys, fr, elem, t, state):
+        return np.zeros(sys.nv)
+
+    @staticmethod
+    def switch(sys, fr, elem, t):
+        """slip: s xd [m/s, rad/s]; stick: mu_static N - |lambda_f| + eps [N, N m]."""
+        m = sys.switched[elem.name].at(t)
+        if m is None:
+            return np.ones(1)
+        if m[0] == "slip":
+            return np.array([m[1] * float(_rate(sys, _timed(fr), elem)[0])])
+        from ..equations import constraint_terms
+        J = constraint_terms(sys, fr.q, fr.v, t)[1]
+        return np.array([_stick_margin(sys, fr, J, fr.lambda_, elem)[0]])
+
+    @staticmethod
+    def on_start(sys, elem, t, q, v):
+        _decide(sys, elem, t, q, v)
+
+    @staticmethod
+    def on_event(sys, elem, t, q, v):
+        _decide(sys, elem, t, q, v)
+
+    @staticmethod
+    def dissipation(sys, fr, elem, t=None):
+        """Friction power lambda_f xd >= 0 [W] (N,), from time-axis frames carrying `lambda_` (N, nc)."""
+        lam = getattr(fr, "lambda_", None)
+        if lam is None:
+            raise ValueError(f"friction '{elem.name}': dissipation needs the multipliers (a dynamic Result)")
+        lam = np.atleast_2d(lam)
+        return lam[:, sys.owner_rows[elem.name][0]] * _rate(sys, _timed(fr), elem)
+
+
+def friction_force(res, name):
+    """Friction force [N] / torque [N m] on body_j along / about the joint axis, (N,): -lambda_f."""
+    from ...errors import ModelError
+    el = res.system.model.forces.get(name if isinstance(name, str) else getattr(name, "name", None))
+    if not isinstance(el, JointFriction):
+        raise ModelError(f"friction {name!r}", "name", "is not a joint friction element of the analysed model")
+    if res.lambda_ is None:
+        raise ValueError("friction forces are not available: this result holds no multipliers")
+    return -res.lambda_[:, res.system.owner_rows[el.name][0]]

@@ -1,0 +1,194 @@
+"""Compiled (numba) kernel of the constraint equations: the same maths as `constraints.primitives`,
+evaluated row by row in one pass with scalar arithmetic, scattered straight into phi, phi_q, nu, gamma.
+
+`primitives` stays the reference implementation (and the path used without numba); the tests check
+that both agree to round-off.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
+(driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `pack_rows`).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+try:  # numba is optional at run time: without it the numpy path is used
+    from numba import njit
+    HAVE_NUMBA = True
+except ImportError:  # pragma: no cover
+    HAVE_NUMBA = False
+
+KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6}
+
+
+def pack_rows(sys):
+    """Flat per-row arrays (kind, bi, bj, v1, v2, v3, driver index) from the system's groups."""
+    nc = sys.nc
+    kind = np.zeros(nc, np.int64)
+    bi = np.zeros(nc, np.int64)
+    bj = np.zeros(nc, np.int64)
+    v = np.zeros((3, nc, 3))
+    drv = -np.ones(nc, np.int64)
+    fns = []
+    for g in sys.groups:
+        for k in range(len(g.bi)):
+            r0 = g.row_adr[k]
+            rows = [r0, r0 + 1, r0 + 2] if g.kind == "sph" else [r0]
+            for c, r in enumerate(rows):
+                kind[r] = c if g.kind == "sph" else KIND[g.kind]
+                bi[r], bj[r] = g.bi[k], g.bj[k]
+                for m, vec in enumerate(g.vecs):
+                    v[m, r] = vec[k]
+                if g.kind in ("angle", "slide"):
+                    drv[r] = len(fns)
+                    fns.append(g.fns[k])
+    return kind, bi, bj, v[0], v[1], v[2], drv, fns
+
+
+if HAVE_NUMBA:
+    @njit(cache=True)
+    def _mv(A, b, x):
+        return (A[b, 0, 0] * x[0] + A[b, 0, 1] * x[1] + A[b, 0, 2] * x[2],
+                A[b, 1, 0] * x[0] + A[b, 1, 1] * x[1] + A[b, 1, 2] * x[2],
+                A[b, 2, 0] * x[0] + A[b, 2, 1] * x[1] + A[b, 2, 2] * x[2])
+
+    @njit(cache=True)
+    def _cr(a, b):
+        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+    @njit(cache=True)
+    def _dt(a, b):
+        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+    @njit(cache=True)
+    def _add(a, b):
+        return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+    @njit(cache=True)
+    def _sub(a, b):
+        return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+    @njit(cache=True)
+    def _sc(s, a):
+        return (s * a[0], s * a[1], s * a[2])
+
+    @njit(cache=True)
+    def _scatter(J, row, b, Jr, Jp, A, vadr, rigid):
+        if b == 0:
+            return
+        c = vadr[b]
+        J[row, c] += Jr[0]
+        J[row, c + 1] += Jr[1]
+        J[row, c + 2] += Jr[2]
+        if rigid[b]:
+            for k in range(3):  # body axes: Jp A
+                J[row, c + 3 + k] += Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
+
+    @njit(cache=True)
+    def _dot1(A, w, bi, bj, ai_B, aj_B):
+        ai = _mv(A, bi, ai_B)
+        aj = _mv(A, bj, aj_B)
+        wi = (w[bi, 0], w[bi, 1], w[bi, 2])
+        wj = (w[bj, 0], w[bj, 1], w[bj, 2])
+        c = _cr(ai, aj)
+        wai, waj = _cr(wi, ai), _cr(wj, aj)
+        quad = _dt(_cr(wi, wai), aj) + 2.0 * _dt(wai, waj) + _dt(ai, _cr(wj, waj))
+        rate = _dt(c, wi) - _dt(c, wj)
+        return _dt(ai, aj), c, quad, rate
+
+    @njit(cache=True)
+    def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
+                          phi, J, nu, gamma):
+        """Fill phi, J (zeroed by the caller), nu, gamma for every row."""
+        zero = (0.0, 0.0, 0.0)
+        for row in range(kind.shape[0]):
+            k = kind[row]
+            bi, bj = bi_[row], bj_[row]
+            wi = (w[bi, 0], w[bi, 1], w[bi, 2])
+            wj = (w[bj, 0], w[bj, 1], w[bj, 2])
+            if k <= 2:
+                si = _mv(A, bi, v1[row])
+                sj = _mv(A, bj, v2[row])
+                ph = (r[bj, k] + sj[k] - r[bi, k] - si[k])
+                qd = _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k]
+                e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
+                # row k of skew(s): (s~)_k. = e_k x ... ; J_pi = s~_i row k, J_pj = -s~_j row k
+                ski = _cr(si, e)
+                skj = _cr(sj, e)
+                ski = (-ski[0], -ski[1], -ski[2])
+                _scatter(J, row, bi, (-e[0], -e[1], -e[2]), ski, A, vadr, rigid)
+                _scatter(J, row, bj, e, skj, A, vadr, rigid)
+                phi[row] = ph
+                gamma[row] = -qd
+            elif k == 3:
+                val, c, quad, _ = _dot1(A, w, bi, bj, v1[row], v2[row])
+                _scatter(J, row, bi, zero, c, A, vadr, rigid)
+                _scatter(J, row, bj, zero, _sc(-1.0, c), A, vadr, rigid)
+                phi[row] = val
+                gamma[row] = -quad
+            elif k == 4 or k == 6:
+                ai = _mv(A, bi, v1[row])
+                si = _mv(A, bi, v2[row])
+                sj = _mv(A, bj, v3[row])
+                d = _sub(_add((r[bj, 0], r[bj, 1], r[bj, 2]), sj), _add((r[bi, 0], r[bi, 1], r[bi, 2]), si))
+                dd = _sub(_add((rd[bj, 0], rd[bj, 1], rd[bj, 2]), _cr(wj, sj)),
+                          _add((rd[bi, 0], rd[bi, 1], rd[bi, 2]), _cr(wi, si)))
+                wai = _cr(wi, ai)
+                quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
+                        + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
+                _scatter(J, row, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, vadr, rigid)
+                _scatter(J, row, bj, ai, _cr(sj, ai), A, vadr, rigid)
+                phi[row] = _dt(ai, d)
+                gamma[row] = -quad
+                if k == 6:
+                    n = drv[row]
+                    phi[row] -= f[n]
+                    nu[row] = fd[n]
+                    gamma[row] += fdd[n]
+            else:  # angle driver
+                S, cS, qS, Sd = _dot1(A, w, bi, bj, v2[row], v3[row])
+                C, cC, qC, Cd = _dot1(A, w, bi, bj, v1[row], v3[row])
+                rho2 = S * S + C * C
+                N = C * Sd - S * Cd
+                Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
+                _scatter(J, row, bi, zero, Jp, A, vadr, rigid)
+                _scatter(J, row, bj, zero, _sc(-1.0, Jp), A, vadr, rigid)
+                quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
+                n = drv[row]
+                dth = np.arctan2(S, C) - f[n]
+                phi[row] = (dth + np.pi) % (2.0 * np.pi) - np.pi
+                nu[row] = fd[n]
+                gamma[row] = -quad + fdd[n]
+
+
+if HAVE_NUMBA:
+    @njit(cache=True)
+    def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
+        """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
+        r = np.zeros((nf, 3))
+        A = np.zeros((nf, 3, 3))
+        rd = np.zeros((nf, 3))
+        w = np.zeros((nf, 3))
+        for f in range(nf):
+            A[f, 0, 0] = 1.0
+            A[f, 1, 1] = 1.0
+            A[f, 2, 2] = 1.0
+        for k in range(r_idx.shape[0]):
+            for c in range(3):
+                r[k + 1, c] = q[r_idx[k, c]]
+                rd[k + 1, c] = v[rd_idx[k, c]]
+        for k in range(rigid_fid.shape[0]):
+            f = rigid_fid[k]
+            e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+            n = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3)
+            e0, e1, e2, e3 = e0 / n, e1 / n, e2 / n, e3 / n
+            A[f, 0, 0] = e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3
+            A[f, 0, 1] = 2 * (e1 * e2 - e0 * e3)
+            A[f, 0, 2] = 2 * (e1 * e3 + e0 * e2)
+            A[f, 1, 0] = 2 * (e1 * e2 + e0 * e3)
+            A[f, 1, 1] = e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3
+            A[f, 1, 2] = 2 * (e2 * e3 - e0 * e1)
+            A[f, 2, 0] = 2 * (e1 * e3 - e0 * e2)
+            A[f, 2, 1] = 2 * (e2 * e3 + e0 * e1)
+            A[f, 2, 2] = e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3
+            for c in range(3):
+                w[f, c] = (A[f, c, 0] * v[w_idx[k, 0]] + A[f, c, 1] * v[w_idx[k, 1]]
+                           + A[f, c, 2] * v[w_idx[k, 2]])
+        return r, A, rd, w
