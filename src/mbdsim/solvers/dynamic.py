@@ -92,12 +92,12 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
     events = EventTracker(sys, rows, sf)
     y0 = np.concatenate([rep.q, rep.v])
     t0, t_end = times[0], times[-1]
+    events.start(t0, y0)   # first: initial modes of switching elements (stick/slip) enter every solve
     out = [consistent_state(sys, y0, t0, rows, sf)]
     nxt, nsteps, success, message, error = 1, 0, True, "ok", None
     opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
     try:
         solver = solver_cls(rhs, t0, y0, t_end, **opts)
-        events.start(t0, y0)
         while solver.status == "running":
             t_old = solver.t
             msg = solver.step()

@@ -2,6 +2,11 @@
 
 A force-element evaluator may define `switch(sys, fr, elem, t) -> array` (the signed switching
 functions) and `on_event(sys, elem, t, q, v)` (called after the state at the event is accepted).
+Optional: `on_start(sys, elem, t, q, v)` (called once before the first step: initial modes),
+`needs_lambda = True` (the frames handed to `switch` then carry `q`, `v` and the multipliers
+`lambda_` (nc,) at that state: stick/slip friction) and `restart_positive = True` (a switching
+function that is zero right after an event is taken as positive, i.e. its new mode persists,
+instead of the default 'opposite sign of before').
 A step whose end changes the sign of a switching function is cut at the root, located with brentq
 on the dense output to 1e-13 s, and the integrator restarts there, so no discontinuity is stepped over.
 """
@@ -12,7 +17,7 @@ import scipy.optimize as so
 
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
-from .common import normalize
+from .common import accelerations, normalize
 
 
 class EventTracker:
@@ -23,15 +28,28 @@ class EventTracker:
         self.items = [(e, evaluator(e)) for e in sys.model.forces.values()
                       if hasattr(evaluator(e), "switch")]
         self.prev = None
+        self.rows, self.sf = rows, sf
+        self.need_lam = any(getattr(ev, "needs_lambda", False) for _, ev in self.items)
+        self.positive = np.zeros(0, dtype=bool)
 
     def values(self, t, y):
         if not self.items:
             return np.zeros(0)
         q, v = normalize(self.sys, y[:self.sys.nq]), y[self.sys.nq:]
         fr = body_frames(self.sys, q, v)
-        return np.concatenate([np.atleast_1d(ev.switch(self.sys, fr, e, t)) for e, ev in self.items])
+        if self.need_lam:
+            fr.q, fr.v = q, v
+            fr.lambda_ = accelerations(self.sys, q, v, t, self.rows, self.sf)[1]
+        gs = [np.atleast_1d(ev.switch(self.sys, fr, e, t)) for e, ev in self.items]
+        self.positive = np.concatenate([np.full(len(g), bool(getattr(ev, "restart_positive", False)))
+                                        for g, (_, ev) in zip(gs, self.items)])
+        return np.concatenate(gs)
 
     def start(self, t, y):
+        q, v = normalize(self.sys, y[:self.sys.nq]), y[self.sys.nq:]
+        for e, ev in self.items:
+            if hasattr(ev, "on_start"):
+                ev.on_start(self.sys, e, t, q, v)
         self.prev = self.values(t, y)
 
     def check(self, t_old, t_new, dense):
@@ -60,4 +78,5 @@ class EventTracker:
                 ev.on_event(self.sys, e, t, q, v)
         g = self.values(t, y)
         # values exactly at the root: take the sign just after the event
-        self.prev = np.where(np.abs(g) < 1e-12, -self.prev if self.prev is not None else g, g)
+        flip = np.where(self.positive, 1.0, -self.prev if self.prev is not None else g)
+        self.prev = np.where(np.abs(g) < 1e-12, flip, g)

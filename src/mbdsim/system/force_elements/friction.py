@@ -37,7 +37,6 @@ from __future__ import annotations
 import bisect
 
 import numpy as np
-import scipy.linalg as sla
 
 from ...math.rotation import skew
 from ...model.friction_path import JointFriction
@@ -170,7 +169,7 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
         maps = [(w, L[:, keep]) for w, L in maps]
         slips.append((elem, elem.mu_dynamic * m[1], J[sys.owner_rows[name][0]], maps, pos[jr][keep],
                       sys.owner_rows[name][0]))
-    x = sla.solve(K, b)
+    x = _solve(K, b)
     for _ in range(MAXIT if slips else 0):
         K2, b2 = K.copy(), b.copy()
         lam = x[nv:]
@@ -179,7 +178,7 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
             g[idx] = _gradient(maps, lam[idx])
             K2[:nv, nv:] += c * np.outer(Jl, g)
             b2[:nv] -= c * elem.preload * Jl
-        x_new = sla.solve(K2, b2)
+        x_new = _solve(K2, b2)
         done = np.linalg.norm(x_new - x) <= 1e-14 * (1.0 + np.linalg.norm(x))
         x = x_new
         if done:
@@ -194,6 +193,13 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
     if len(cand) > nr:   # redundant rows dropped: minimum-norm distribution like the frictionless path
         lam[cand] = np.linalg.lstsq(J[cand].T, Q + Qf - sys.M @ vd, rcond=None)[0]
     return vd, lam
+
+
+def _solve(K, b):
+    x = np.linalg.solve(K, b)   # LinAlgError when exactly singular (reported by solvers.common)
+    if not np.all(np.isfinite(x)) or np.max(np.abs(x), initial=0.0) > 1e13 * (1.0 + np.max(np.abs(b), initial=0.0)):
+        raise np.linalg.LinAlgError("augmented matrix with friction is numerically singular")
+    return x
 
 
 # ----------------------------------------------------------------------------- evaluator
