@@ -8,9 +8,11 @@ import warnings
 
 import numpy as np
 import pytest
+from scipy.linalg import null_space
 from scipy.spatial.transform import Rotation
 
 import mbdsim as mb
+from mbdsim.system import constraint_terms
 
 G = 9.81
 A_, B_, C_, D_ = 0.1, 0.3, 0.25, 0.3          # crank, coupler, rocker, ground link [m] (Grashof crank-rocker)
@@ -142,5 +144,15 @@ def test_in_plane_reactions_match_planar_hand_solution(run):
         for name, ref in (("O", FO), ("A", FA), ("B", FB), ("C", FC)):
             assert np.allclose(F[name][0][n, :2], ref, rtol=0, atol=1e-7 * scale), (name, n)
             assert abs(F[name][1][n, 2]) < 1e-7 * scale * A_    # a revolute carries no torque about its axis
-    # the minimum-norm solution of the indeterminate out-of-plane components is returned as finite numbers
-    assert all(np.all(np.isfinite(f)) for pair in F.values() for f in pair)
+    # relative joint rates: coupler w.r.t. crank at A
+    assert np.allclose(res.joint_velocity("A"), w[:, 1] - w[:, 0], atol=1e-9)
+    al = np.stack([res.angular_acceleration(b)[:, 2] for b in bodies], -1)
+    assert np.allclose(res.joint_acceleration("A"), al[:, 1] - al[:, 0], atol=1e-9)
+    # indeterminate (out-of-plane) components: the minimum-norm multipliers, i.e. orthogonal to the null
+    # space of phi_q^T (any multiple of a null vector would balance the same loads)
+    sys = res.system
+    for n in (0, len(res.time) // 2, len(res.time) - 1):
+        J = constraint_terms(sys, res.q[n], res.v[n], res.time[n])[1]
+        ns = null_space(J.T)
+        assert ns.shape[1] == 3
+        assert np.abs(ns.T @ res.lambda_[n]).max() < 1e-9 * np.abs(res.lambda_[n]).max()

@@ -15,7 +15,12 @@ from scipy.spatial.transform import Rotation
 
 import mbdsim as mb
 from mbdsim.solvers.common import increment
-from mbdsim.system import assemble_system, constraint_terms
+from mbdsim.system import assemble_system, equations
+
+# the dispatching entry point (compiled kernel when numba is present) and the numpy reference
+IMPLS = {"dispatch": equations.constraint_terms,
+         "numpy": getattr(equations, "constraint_terms_numpy", equations.constraint_terms)}
+constraint_terms = equations.constraint_terms
 
 KINDS = ["revolute", "translational", "cylindrical", "spherical", "universal", "planar", "fixed"]
 ROWS_RIGID = {"revolute": 5, "translational": 5, "cylindrical": 4, "spherical": 3, "universal": 4,
@@ -68,8 +73,9 @@ def fd(f, h, order):
     return (-fm2 + 16 * fm1 - 30 * f0 + 16 * f1 - f2) / (12 * h * h)
 
 
-def check_equations(model, t0=0.7, seed=1):
+def check_equations(model, t0=0.7, seed=1, impl="dispatch"):
     """phi_q, nu and gamma of the whole model against finite differences at a perturbed state."""
+    constraint_terms = IMPLS[impl]
     sys = assemble_system(model)
     rng = np.random.default_rng(seed)
     q = increment(sys, sys.q0, 0.2 * rng.normal(size=sys.nv))          # off the manifold, generic
@@ -102,10 +108,11 @@ PAIRS = ([(k, "rigid-rigid") for k in KINDS] + [(k, "ground-rigid") for k in KIN
          + [("spherical", "particle-particle"), ("spherical", "particle-rigid"), ("revolute", "ground-particle")])
 
 
+@pytest.mark.parametrize("impl", sorted(IMPLS))
 @pytest.mark.parametrize("kind,pair", PAIRS)
-def test_joint_jacobian_nu_gamma_against_finite_differences(kind, pair):
+def test_joint_jacobian_nu_gamma_against_finite_differences(kind, pair, impl):
     model, jt = build(kind, pair)
-    sys = check_equations(model)
+    sys = check_equations(model, impl=impl)
     if pair.endswith("-particle"):
         assert sys.nc == ROWS_PARTICLE_J[kind]
     else:
@@ -122,7 +129,8 @@ DRIVEN = [("revolute", "rotation"), ("translational", "translation"), ("cylindri
 @pytest.mark.parametrize("kind,dof", DRIVEN)
 @pytest.mark.parametrize("pair", ["rigid-rigid", "ground-rigid", "rigid-ground"])
 @pytest.mark.parametrize("how", ["displacement", "velocity", "acceleration"])
-def test_driver_rows_against_finite_differences(kind, dof, pair, how):
+@pytest.mark.parametrize("impl", sorted(IMPLS))
+def test_driver_rows_against_finite_differences(kind, dof, pair, how, impl):
     model, jt = build(kind, pair)
     spec = {"displacement": "0.3*sin(2*t) + 0.1*t**2", "velocity": lambda t: 0.6 * np.cos(2 * t) + 0.2 * t,
             "acceleration": "-1.2*sin(2*t) + 0.2"}[how]
@@ -134,13 +142,14 @@ def test_driver_rows_against_finite_differences(kind, dof, pair, how):
         assert fn.value(t) == pytest.approx(f, abs=1e-9)
         assert fn.d1(t) == pytest.approx(0.6 * np.cos(2 * t) + 0.2 * t, abs=1e-8)
         assert fn.d2(t) == pytest.approx(-1.2 * np.sin(2 * t) + 0.2, abs=1e-6)
-    check_equations(model)
+    check_equations(model, impl=impl)
 
 
-def test_translational_driver_on_particle():
+@pytest.mark.parametrize("impl", sorted(IMPLS))
+def test_translational_driver_on_particle(impl):
     model, jt = build("translational", "rigid-particle")
     model.add_motion("m", jt, displacement="0.5*t**3")
-    check_equations(model)
+    check_equations(model, impl=impl)
 
 
 # ----------------------------------------------------------------------------- allowed motions

@@ -18,3 +18,9 @@ __all__ = [
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "MbdsimError", "ModelError", "AssemblyError", "SolverError", "RedundantConstraintWarning",
 ]
+
+from .model.curves import Curve, Spline  # noqa: E402  (issue 3: path constraint curves)
+__all__ += ["Curve", "Spline"]
+
+from .model.shapes import Plane, Sphere  # noqa: E402  (issue 3: contact shapes)
+__all__ += ["Sphere", "Plane"]

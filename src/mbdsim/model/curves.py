@@ -17,6 +17,8 @@ s_range = (a, b): the parameter interval; on an open curve the constrained point
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 from scipy.interpolate import CubicSpline
 
@@ -88,7 +90,17 @@ class Curve:
         lo, hi = ss[max(k - 1, 0)], ss[min(k + 1, len(ss) - 1)]
         r = so.minimize_scalar(lambda s: float(np.sum((self.point(s) - p) ** 2)), bounds=(lo, hi),
                                method="bounded", options={"xatol": 1e-12 * max(1.0, b - a)})
-        return float(r.x) if r.fun <= d2[k] else float(ss[k])
+        s = float(r.x) if r.fun <= d2[k] else float(ss[k])
+        for _ in range(4):   # Newton on C'.(C - p) = 0: the distance alone fixes s to sqrt(eps) only
+            C, C1, C2 = self.derivatives(s)
+            den = float(C1 @ C1 + C2 @ (C - p))
+            if den <= 0:
+                break
+            s_new = s - float(C1 @ (C - p)) / den
+            if not (lo <= s_new <= hi):
+                break
+            s = s_new
+        return s
 
     # ------------------------------------------------------------------ derivatives
     def _numeric_d1(self, probe):
@@ -99,8 +111,10 @@ class Curve:
             return np.asarray(f(s + 1j * eps), dtype=complex).reshape(3).imag / eps
 
         try:
-            ok = all(np.allclose(complex_step(s), _richardson(f, s, h), rtol=1e-6, atol=1e-6 * self._scale(s))
-                     for s in probe)
+            with warnings.catch_warnings():   # a callable that drops the imaginary part fails the check
+                warnings.simplefilter("error", np.exceptions.ComplexWarning)
+                ok = all(np.allclose(complex_step(s), _richardson(f, s, h), rtol=1e-6, atol=1e-6 * self._scale(s))
+                         for s in probe)
         except Exception:  # noqa: BLE001 - any failure of the callable on complex input
             ok = False
         return complex_step if ok else (lambda s: _richardson(f, s, h))

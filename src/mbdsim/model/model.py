@@ -33,14 +33,22 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         """Add a rigid body: mass [kg], inertia about the CM in body axes [kg m^2] (3 values or 3x3),
         CM position [m], orientation (body->ground), CM velocity [m/s] and angular velocity [rad/s] in ground."""
         self._claim(name, "body")
-        b = make_body(name, mass, inertia, position, orientation, velocity, angular_velocity)
+        try:
+            b = make_body(name, mass, inertia, position, orientation, velocity, angular_velocity)
+        except ModelError:
+            self._names.discard(name)   # a failed add must not claim the name
+            raise
         self.bodies[name] = b
         return b
 
     def add_particle(self, name, mass, position=(0, 0, 0), velocity=(0, 0, 0)) -> Body:
         """Add a point mass [kg] at position [m] with velocity [m/s], both in ground; it has no rotation."""
         self._claim(name, "particle")
-        b = make_body(name, mass, None, position, None, velocity, None, particle=True)
+        try:
+            b = make_body(name, mass, None, position, None, velocity, None, particle=True)
+        except ModelError:
+            self._names.discard(name)
+            raise
         self.bodies[name] = b
         return b
 

@@ -46,6 +46,7 @@ def _dense_sampler(res):
         q, v = Y[:, :sys.nq], Y[:, sys.nq:]
         fr = body_frames(sys, q, v)
         fr.t = ts
+        fr.q, fr.v = q, v   # raw states, for elements whose power needs the multipliers (joint friction)
         return dissipation_power(sys, fr, ts)
 
     return power, np.union1d(starts, t_end)

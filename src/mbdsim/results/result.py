@@ -47,6 +47,7 @@ class Result:
         if self._fr is None:
             self._fr = body_frames(self.system, self.q, self.v, self.vd)
             self._fr.t = self.time   # sample times, for time-dependent element measures
+            self._fr.lambda_ = self.lambda_   # multipliers, for friction measures (force_elements.friction)
         return self._fr
 
     def at(self, t) -> "Result":
@@ -220,6 +221,17 @@ class Result:
         """Energy dissipated by damping, friction and contact since the first sample [J], (N,)."""
         from .energy import dissipated_energy
         return dissipated_energy(self)
+
+    def friction_force(self, friction):
+        """Joint friction force [N] (translational) or torque [N m] (revolute) on body_j along / about the
+        joint axis, (N,); it opposes the joint's motion (or the impending motion while sticking)."""
+        from ..system.force_elements.friction import friction_force
+        return friction_force(self, friction)
+
+    def friction_events(self, friction):
+        """Stick/slip history of a joint friction element: [(time [s], "stick" or "slip", direction)]."""
+        from ..system.force_elements.friction import friction_events
+        return friction_events(self, friction)
 
     # ------------------------------------------------------------ events and extrema
     def crossings(self, signal, value, direction=0):

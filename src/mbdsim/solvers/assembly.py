@@ -51,13 +51,13 @@ def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
 def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     """Assembly from a given state of an assembled System."""
     _, J0, _, _ = constraint_terms(sys, q0, v0, t)
-    q, res, _ = project_positions(sys, q0, t, np.arange(sys.nc), tol=tol, maxit=50)
+    q, res, _ = project_positions(sys, q0, t, sys.fixed_rows, tol=tol, maxit=50)  # friction locks: run time
     if res > 1e-9:
-        phi = constraint_terms(sys, q, v0, t, jacobian=False)[0]
+        phi = constraint_terms(sys, q, v0, t, jacobian=False)[0][sys.fixed_rows]
         worst = [sys.row_owner[k] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9]
         raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
                             time=t, joints=dict.fromkeys(worst), state=q)
-    _, J, _, _ = constraint_terms(sys, q, v0, t)
+    J = constraint_terms(sys, q, v0, t)[1][sys.fixed_rows]
     rows = independent_rows(J)
     redundant = dependent_owners(sys, J, rows)
     if redundant:
@@ -67,8 +67,8 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
                       RedundantConstraintWarning, stacklevel=3)
     v = project_velocities(sys, q, v0, t, rows)
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
-                          _vchanged(sys, v0, v), float(np.max(np.abs(constraint_terms(sys, q, v, t, False)[0])))
-                          if sys.nc else 0.0)
+                          _vchanged(sys, v0, v), float(np.max(np.abs(constraint_terms(sys, q, v, t, False)[0][sys.fixed_rows]),
+                                                              initial=0.0)))
 
 
 def _moved(sys, q0, q):

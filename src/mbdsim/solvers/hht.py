@@ -195,6 +195,7 @@ def _log_increment(sys, q0, q1, guess):
     from scipy.spatial.transform import Rotation
     dx = np.zeros(sys.nv)
     dx[sys.rd_idx] = q1[sys.r_idx] - q0[sys.r_idx]
+    dx[sys.aux_v_idx] = q1[sys.aux_q_idx] - q0[sys.aux_q_idx]   # auxiliary coordinates (path constraints)
     if len(sys.p_idx):
         p0, p1 = q0[sys.p_idx], q1[sys.p_idx]
         conj = p0 * np.array([1, -1, -1, -1])

@@ -60,7 +60,7 @@ def time_grid(t0, t1, step):
 
 def solve_at(sys, q_guess, t, sf=None):
     """(t, q, v, vd, lambda_) of the driven mechanism at time t [s]."""
-    q, res, _ = project_positions(sys, q_guess, t, np.arange(sys.nc), tol=1e-13, maxit=30)
+    q, res, _ = project_positions(sys, q_guess, t, sys.fixed_rows, tol=1e-13, maxit=30)
     if res > 1e-9:
         phi = constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0]
         worst = list(dict.fromkeys(sys.row_owner[k] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9))

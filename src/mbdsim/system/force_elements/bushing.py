@@ -6,6 +6,7 @@ from scipy.spatial.transform import Rotation
 
 from ...model.element_specs import Bushing
 from ..frames import point_state
+from ..constraints.primitives import cross
 from . import register
 from ._common import batched
 from .loads import add_point_force, add_torque
@@ -26,7 +27,7 @@ def bushing_state(sys, fr, elem):
     d = p_j - p_i
     to_i = lambda vec: np.einsum("nji,nj->ni", Ai, vec)  # noqa: E731
     x = to_i(d)
-    xd = to_i(v_j - v_i - np.cross(w_i, d))
+    xd = to_i(v_j - v_i - cross(w_i, d))
     a = Rotation.from_matrix(np.einsum("nji,njk->nik", Ai, Aj)).as_rotvec().reshape(-1, 3)
     w = to_i(w_j - w_i)
     return x, xd, a, w, Ai, p_i, p_j

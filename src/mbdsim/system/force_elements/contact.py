@@ -10,13 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from ...model.element_specs import Contact
+from ..constraints.primitives import cross
 from . import register
 from ._common import batched, element_state
 from .loads import add_point_force
 
 
 def _material_velocity(fr, fid, P):
-    return fr.rd[:, fid] + np.cross(fr.w[:, fid], P - fr.r[:, fid])
+    return fr.rd[:, fid] + cross(fr.w[:, fid], P - fr.r[:, fid])
 
 
 def _sphere_center(fr, shape, fid):

@@ -44,7 +44,7 @@ from ..constraints.base import RowSpec
 from . import register
 
 V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
-STICK_TOL = 1e-9    # relative tolerance on the static friction limit
+STICK_TOL = 1e-10   # relative tolerance on the static friction limit
 MAXIT = 50          # iterations of the coupled friction KKT solve
 
 
@@ -231,14 +231,43 @@ def _stick_margin(sys, fr, J, lam, elem):
     return elem.mu_static * N - abs(lf) + STICK_TOL * (1 + elem.mu_static * N), lf, STICK_TOL * (1 + elem.mu_static * N)
 
 
+def _multipliers(sys, fr, elem, t):
+    """lambda_ (N, nc) at the states fr.q, fr.v (N, ...) and times t, in the modes then in force."""
+    from ...solvers.common import accelerations
+    from ...solvers.state import state_factory
+    q, v = getattr(fr, "q", None), getattr(fr, "v", None)
+    t = getattr(fr, "t", None) if t is None else t
+    if q is None or v is None or t is None:
+        raise ValueError(f"friction '{elem.name}': dissipation needs the multipliers or the states (q, v, t)")
+    q, v, t = np.atleast_2d(q), np.atleast_2d(v), np.broadcast_to(np.asarray(t, dtype=float), (len(q),))
+    rows, sf = _base_rows(sys, q[0], v[0], t[0]), state_factory(sys)
+    return np.array([accelerations(sys, q[n], v[n], t[n], rows, sf)[1] for n in range(len(q))])
+
+
+def _base_rows(sys, q, v, t):
+    """Independent rows among the always-active ones (as assembly picks them), cached on the System."""
+    rows = sys.__dict__.get("_friction_base_rows")
+    if rows is None:
+        from ...solvers.common import independent_rows
+        from ..equations import constraint_terms
+        J = constraint_terms(sys, q, v, t)[1]
+        rows = sys._friction_base_rows = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]
+    return rows
+
+
 def _decide(sys, elem, t, q, v):
     """Mode decision at an event or at the start (see module docstring)."""
-    from ...solvers.common import accelerations, independent_rows
+    from ...solvers.common import accelerations
     from ...solvers.state import state_factory
     from ..equations import constraint_terms
     from ..frames import body_frames
+    for other in sys.switched.values():   # elements not decided yet act as frictionless meanwhile
+        if not other.times:
+            other.record(t, "free")
     st = sys.switched[elem.name]
     m = st.at(t)
+    if m is not None and m[0] == "free":
+        m = None
     fr = body_frames(sys, q, v)
     xd = float(_rate(sys, _timed(fr), elem)[0])
     if m is not None and m[0] == "slip" and m[1] * xd > V_TOL:
@@ -247,7 +276,7 @@ def _decide(sys, elem, t, q, v):
         st.record(t, "slip", np.sign(xd))
         return
     J = constraint_terms(sys, q, v, t)[1]
-    base = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]
+    base = _base_rows(sys, q, v, t)
     if m is None or m[0] == "slip":
         st.record(t, "stick", 0.0, float(_coordinate(sys, _timed(fr), elem)[0]))
     lam = accelerations(sys, q, v, t, base, state_factory(sys))[1]
@@ -265,6 +294,11 @@ class FrictionEval:
 
     @staticmethod
     def generalized(sys, fr, elem, t, state):
+        if not sys.switched[elem.name].times:   # no stick/slip logic runs in this analysis
+            from ...errors import ModelError
+            raise ModelError(f"friction '{elem.name}'", "method", "joint friction is modelled by the "
+                             "event-driven index-1 methods of mb.simulate (method='dop853', 'rk45', 'radau' "
+                             "or 'bdf'); this analysis cannot include it")
         return np.zeros(sys.nv)
 
     @staticmethod
@@ -289,20 +323,33 @@ class FrictionEval:
 
     @staticmethod
     def dissipation(sys, fr, elem, t=None):
-        """Friction power lambda_f xd >= 0 [W] (N,), from time-axis frames carrying `lambda_` (N, nc)."""
+        """Friction power lambda_f xd >= 0 [W] (N,) of time-axis frames carrying the multipliers
+        `lambda_` (N, nc), or the states `q`, `v` (N, nq/nv) and times `t` to solve for them."""
         lam = getattr(fr, "lambda_", None)
         if lam is None:
-            raise ValueError(f"friction '{elem.name}': dissipation needs the multipliers (a dynamic Result)")
+            lam = _multipliers(sys, fr, elem, t)
         lam = np.atleast_2d(lam)
         return lam[:, sys.owner_rows[elem.name][0]] * _rate(sys, _timed(fr), elem)
 
 
-def friction_force(res, name):
-    """Friction force [N] / torque [N m] on body_j along / about the joint axis, (N,): -lambda_f."""
+def _element(res, name):
     from ...errors import ModelError
     el = res.system.model.forces.get(name if isinstance(name, str) else getattr(name, "name", None))
-    if not isinstance(el, JointFriction):
+    if not isinstance(el, JointFriction) or el.name not in res.system.switched:
         raise ModelError(f"friction {name!r}", "name", "is not a joint friction element of the analysed model")
+    return el
+
+
+def friction_events(res, name):
+    """[(time [s], mode, direction)] of the element's stick/slip history within the result's span."""
+    st = res.system.switched[_element(res, name).name]
+    t1 = res.time[-1] if len(res.time) else -np.inf
+    return [(t, m, d) for t, (m, d, _) in zip(st.times, st.modes) if t <= t1 and m != "free"]
+
+
+def friction_force(res, name):
+    """Friction force [N] / torque [N m] on body_j along / about the joint axis, (N,): -lambda_f."""
+    el = _element(res, name)
     if res.lambda_ is None:
         raise ValueError("friction forces are not available: this result holds no multipliers")
     return -res.lambda_[:, res.system.owner_rows[el.name][0]]

@@ -27,7 +27,7 @@ CASE = CaseInfo(
     number=6,
     slug="sliders_link",
     title="Two sliders connected by a light rigid bar: accelerations and bar force",
-    reference="Meriam & Kraige, Dynamics 7th ed., ch.3 (the manual prints 'pp.129, P.3.2', copied from case 5)",
+    reference="Meriam & Kraige, Dynamics 7th ed., p.129, P3.2 (as printed; copied from case 5, see discrepancies)",
     analysis="dynamics (two particles with a massless link, instantaneous)",
     statement=(
         "Sliders A (2 kg) and B (3 kg) move without friction in perpendicular slots of a horizontal plane "
@@ -49,11 +49,13 @@ CASE = CaseInfo(
     ),
     discrepancies=[
         "Given-data units are wrong: x_A, x_B = 0.4, 0.3 'mm' are metres, v_A, v_B = 0.9, 1.2 'mm/s' are m/s, "
-        "omega_AB = 3 'deg/s' is rad/s; the accelerations are printed with the unit m/s (m/s^2).",
+        "omega_AB = 3 'deg/s' is rad/s; the 'decreasing rate' v_A belongs to an increasing x_A; "
+        "the accelerations are printed with the unit m/s (m/s^2).",
         "The first time derivative of the constraint is printed 2 x_A x_A'' + 2 x_B x_B'' = 0; it is "
         "2 x_A x_A' + 2 x_B x_B' = 0 (velocities).",
         "v_B is printed +1.2 m/s; with x_B decreasing it is -1.2 m/s (only its square enters).",
-        "The reference 'pp.129, P.3.2' is copied from case 5 (the crate on an incline).",
+        "The reference 'pp.129, P.3.2' is copied from case 5 (the crate on an incline); this is a "
+        "different chapter-3 problem.",
         "Table a_A = 1.36 is truncated from 15/11 = 1.363636 m/s^2: RecurDyn's 1.361 is 0.193 % off the "
         "exact value (printed 0.074 %); a_B: 0.0341 % (printed 0.032 %); T = 46.590909 N: 0.0023 % "
         "(printed 0.004 %).",

@@ -27,7 +27,8 @@ CASE = CaseInfo(
     reference="Meriam & Kraige, Dynamics 7th ed., p.182, P3.139",
     analysis="dynamics (particle, work-energy)",
     statement=(
-        "The 0.9 kg collar is released from rest at A and slides up the smooth fixed rod under the action "
+        "The collar (0.9 kg, reconstructed) is "
+        "released from rest at A and slides up the smooth fixed rod under the action "
         "of the spring (k = 24 N/m, unstretched length 375 mm) attached to the fixed point C. "
         "Find the speed v_B of the collar as it passes B, 0.25 m above A."
     ),

@@ -95,7 +95,7 @@ def run() -> CaseOutcome:
 
     model = build_model()
     rev = model.joints["rev_O"]
-    res = mb.simulate(model, 85.0, output_step=0.25, method="dop853", rtol=1e-10, atol=1e-12)
+    res = mb.simulate(model, 85.0, output_step=0.5, method="dop853", rtol=1e-10, atol=1e-12)
     angle = lambda r: r.joint_coordinate(rev)
     t90, th_max = res.maximum(angle)
     th = theory()

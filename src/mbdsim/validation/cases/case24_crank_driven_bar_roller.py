@@ -104,7 +104,7 @@ def run() -> CaseOutcome:
 
     model = build_model()
     roller, floor = model.bodies["roller_B"], model.joints["floor"]
-    res = mb.kinematics(model, 0.2, 0.002)
+    res = mb.kinematics(model, 0.4, 0.004)
     N_B = float(res.at(0.0).reaction_force(floor, on=roller)[0, 1])
     th = theory()
     q = [Quantity("N_B", "N", th["N_B"], *MANUAL["N_B"], N_B,

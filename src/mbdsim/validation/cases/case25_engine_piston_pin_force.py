@@ -122,7 +122,7 @@ def _measure(model):
 
     rev_O, rev_A, rod = model.joints["rev_O"], model.joints["rev_A"], model.bodies["rod"]
     period = 2 * np.pi / OMEGA
-    res = mb.kinematics(model, period, period / 400)
+    res = mb.kinematics(model, period, period / 180)
     t90 = res.crossings(lambda r: r.joint_coordinate(rev_O), np.pi / 2)[0]
     F = res.at(t90).reaction_force(rev_A, on=rod)[0]
     return res, float(t90), float(np.hypot(F[0], F[1]))

@@ -97,7 +97,7 @@ def run() -> CaseOutcome:
 
     model = build_model()
     rev_O, slider = model.joints["rev_O"], model.bodies["slider_B"]
-    res = mb.simulate(model, 0.6, output_step=0.002, method="dop853", rtol=1e-10, atol=1e-12)
+    res = mb.simulate(model, 0.45, output_step=0.002, method="dop853", rtol=1e-10, atol=1e-12)
     t90 = res.crossings(lambda r: r.joint_coordinate(rev_O), np.pi / 2, direction=1)[0]
     v_Bx = float(res.at(t90).velocity(slider)[0, 0])
     th = theory()

@@ -103,7 +103,7 @@ def run() -> CaseOutcome:
 
     model = build_model()
     bar, rev = model.bodies["bar"], model.joints["rev_O"]
-    res = mb.simulate(model, 0.8, output_step=0.002, method="dop853", rtol=1e-10, atol=1e-12)
+    res = mb.simulate(model, 0.6, output_step=0.002, method="dop853", rtol=1e-10, atol=1e-12)
     w_cw = lambda r: -r.angular_velocity(bar)[:, 2]           # clockwise angular velocity
     t_w, w_max = res.maximum(w_cw)
     th_w = float(np.degrees(res.at(t_w).joint_coordinate(rev)[0]))

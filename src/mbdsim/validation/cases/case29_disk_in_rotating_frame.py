@@ -95,7 +95,7 @@ def run() -> CaseOutcome:
     model = build_model()
     disk = model.bodies["disk"]
     A = disk.markers["A"]
-    res = mb.kinematics(model, 1.1, 0.002)
+    res = mb.kinematics(model, 1.1, 0.005)
     at = res.at(T_MEAS)
     a_A = at.acceleration(A)[0]
     alpha = at.angular_acceleration(disk)[0]
