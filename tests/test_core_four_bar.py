@@ -43,7 +43,8 @@ def four_bar():
     p3 = lambda v: (v[0], v[1], 0.0)  # noqa: E731
     rz = lambda a: Rotation.from_rotvec([0, 0, a])  # noqa: E731
     bodies = []
-    for name, m, izz, cm, th in (("crank", MASS[0], IZZ[0], A / 2, TH1_0), ("coupler", MASS[1], IZZ[1], (A + B) / 2, th2),
+    for name, m, izz, cm, th in (("crank", MASS[0], IZZ[0], A / 2, TH1_0),
+                                 ("coupler", MASS[1], IZZ[1], (A + B) / 2, th2),
                                  ("rocker", MASS[2], IZZ[2], (B + C) / 2, th3)):
         bodies.append(model.add_body(name, m, inertia=(izz / 20, izz, izz), position=p3(cm), orientation=rz(th)))
     crank, coupler, rocker = bodies

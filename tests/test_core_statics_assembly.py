@@ -96,3 +96,11 @@ def test_assembly_report_moves_bodies_to_satisfy_drivers_and_velocities():
         warnings.simplefilter("error")
         rep = mb.assemble(model)
     assert rep.dof == 1 and not rep.moved and not rep.velocity_changed
+
+
+def test_equilibrium_that_does_not_exist_raises_solver_error():
+    model = mb.Model("fall", gravity=(0.0, 0.0, -G))
+    model.add_particle("p", 1.0)
+    with pytest.raises(mb.SolverError, match=r"static equilibrium not found in \d+ iterations \(residual 9.81\) "
+                                             r"at t = 0 s"):
+        mb.equilibrium(model)

@@ -208,3 +208,29 @@ def test_methods_without_stick_slip_logic_refuse_friction():
     with pytest.raises(mb.ModelError) as err:
         mb.equilibrium(model)
     assert err.value.field == "method" and "dop853" in str(err.value)
+
+
+def test_one_friction_per_joint_and_none_on_driven_joints():
+    m = mb.Model("driven")
+    a = m.add_body("a", 1.0, (1, 1, 1))
+    rev = m.add_revolute("rev", m.ground, a, (0, 0, 0), (0, 0, 1))
+    m.add_friction("f1", rev, 0.3, 0.2, pin_radius=0.01)
+    with pytest.raises(mb.ModelError) as err:
+        m.add_friction("f2", rev, 0.3, 0.2, pin_radius=0.01)
+    assert err.value.field == "joint" and "f1" in str(err.value)
+    m.add_motion("spin", rev, velocity=1.0)
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, 1.0, method="dop853")
+    assert err.value.field == "joint" and "spin" in str(err.value)
+
+
+@pytest.mark.parametrize("method", ["rk45", "radau", "bdf"])
+def test_other_index1_methods_locate_the_stop(method):
+    mu, v0 = 0.4, 7.0
+    a = G * (np.sin(np.radians(15)) - mu * np.cos(np.radians(15)))
+    model, joint = incline(15, v0, mu, mu)
+    res = mb.simulate(model, 8.0, output_step=0.05, method=method)
+    ev = res.friction_events("friction")
+    assert [e[1] for e in ev] == ["slip", "stick"]
+    assert ev[1][0] == pytest.approx(-v0 / a, rel=1e-6)
+    assert res.joint_coordinate(joint)[-1] == pytest.approx(-v0**2 / (2 * a), rel=1e-6)

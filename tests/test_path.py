@@ -150,13 +150,18 @@ def test_bead_on_vertical_circle_reaction_force():
     assert np.allclose(np.cross(F, res.position(bead))[:, 2], 0, atol=1e-8)   # radial
 
 
-def test_leaving_an_open_curve_stops_the_analysis():
-    m = mb.Model("short", gravity=(0, 0, -G))
-    bead = m.add_particle("bead", 1.0, position=(0, 0, 0))
-    m.add_point_on_curve("ramp", bead.add_marker("c"), m.ground,
-                         mb.Curve(lambda s: np.array([s, 0.0, -0.5 * s]), (0, 1)))
-    res = mb.simulate(m, 2.0, output_step=0.01, method="dop853")
-    assert not res.success and "ramp" in res.message and "left the open curve" in res.message
+def test_bead_laps_a_closed_spline_ring():
+    """No gravity: the speed stays constant and s runs over several periods of the closed spline."""
+    ring = mb.Spline([(np.cos(a), 0.6 * np.sin(a), 0.1 * np.sin(3 * a))
+                      for a in np.linspace(0, 2 * np.pi, 24, endpoint=False)], closed=True)
+    P, C1 = ring.point(0.0), ring.derivatives(0.0)[1]
+    m = mb.Model("ring")
+    bead = m.add_particle("bead", 0.2, position=P, velocity=3.0 * C1 / np.linalg.norm(C1))
+    m.add_point_on_curve("ring", bead.add_marker("c"), m.ground, ring)
+    res = mb.simulate(m, 5.0, output_step=0.05, method="dop853")
+    assert res.success, res.message
+    assert res.q[-1, res.system.aux_q_idx[0]] > 2.5 * ring.s_range[1]
+    assert np.allclose(np.linalg.norm(res.velocity(bead), axis=1), 3.0, rtol=1e-8)
 
 
 # ----------------------------------------------------------------------------- bad input

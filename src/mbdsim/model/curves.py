@@ -12,8 +12,10 @@ carried by the body it is fixed on).  `derivatives(s)` returns (C, dC/ds, d2C/ds
   closed) through the points, parametrised by cumulative chord length [m] (s ~ arc length), with
   exact derivatives.
 
-s_range = (a, b): the parameter interval; on an open curve the constrained point may not leave it
-(the analysis stops with a SolverError), a closed curve is periodic with period b - a.
+s_range = (a, b): the parameter interval (used to find the initial parameter and the difference
+steps); a closed curve is periodic with period b - a.  Beyond the interval of an open curve the
+callable is evaluated as given and a spline is extrapolated by its end cubics: keep the motion of
+the constrained point within the curve (the integrator's trial stages may probe beyond it).
 """
 from __future__ import annotations
 

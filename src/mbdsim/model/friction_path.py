@@ -80,6 +80,9 @@ class FrictionPathMixin:
             if jt.kind not in FRICTION_PARAMETERS:
                 raise ModelError(entity, "joint", f"friction needs a translational or revolute joint, "
                                  f"{jt.name!r} is {jt.kind}")
+            taken = [f.name for f in self.forces.values() if isinstance(f, JointFriction) and f.joint is jt]
+            if taken:
+                raise ModelError(entity, "joint", f"joint {jt.name!r} already has friction {taken[0]!r}")
             if jt.kind == "revolute" and (jt.body_j.is_particle or jt.body_i.is_particle):
                 raise ModelError(entity, "joint", "revolute friction needs rigid bodies (a particle has no rotation)")
             ms = scalar(entity, "mu_static", mu_static, minimum=0.0)

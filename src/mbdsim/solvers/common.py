@@ -111,7 +111,7 @@ def accelerations(sys, q, v, t, rows, state_factory=None):
     _, J, _, gamma = constraint_terms(sys, q, v, t)
     try:
         if len(sys.lock_rows):   # joint friction: slip loads depend on lambda_ (coupled KKT solve)
-            from ..system.force_elements.friction import friction_kkt
+            from ..system.force_elements.friction_kkt import friction_kkt
             return friction_kkt(sys, fr, J, gamma, Q, rows, t)
         vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
     except (np.linalg.LinAlgError, ValueError) as exc:

@@ -13,11 +13,11 @@ import bisect
 import numpy as np
 from scipy import integrate
 
-from ..errors import MbdsimError, ModelError
+from ..errors import MbdsimError, ModelError, SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
 from .assembly import assemble_state
-from .common import accelerations, normalize, project_positions, project_velocities, qdot
+from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
 from .events import EventTracker
 from .kinematic import time_grid
 from .state import state_factory
@@ -94,16 +94,23 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
     t0, t_end = times[0], times[-1]
     events.start(t0, y0)   # first: initial modes of switching elements (stick/slip) enter every solve
     out = [consistent_state(sys, y0, t0, rows, sf)]
-    nxt, nsteps, success, message, error = 1, 0, True, "ok", None
+    nxt, nsteps, success, message, error, nsmall = 1, 0, True, "ok", None, 0
     opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
     try:
         solver = solver_cls(rhs, t0, y0, t_end, **opts)
         while solver.status == "running":
             t_old = solver.t
             msg = solver.step()
-            if solver.status == "failed":
-                success, message = False, f"integrator failed at t = {solver.t:.9g} s: {msg}"
-                break
+            tiny = 1e-10 * max(1.0, abs(solver.t))
+            if solver.status == "failed" or (solver.t - t_old < tiny and solver.status == "running"):
+                nsmall = nsmall + 1 if solver.status == "running" else 99
+                if nsmall > 20:
+                    y = solver.y
+                    raise SolverError(f"step size collapsed ({msg or 'steps below 1e-10 s'}): lock-up or "
+                                      "singular configuration", time=solver.t,
+                                      joints=_weak_joints(sys, y[:nq], y[nq:], solver.t, rows), state=y[:nq])
+            else:
+                nsmall = 0
             nsteps += 1
             dense = solver.dense_output()
             t_new, y_new = solver.t, solver.y
@@ -135,3 +142,10 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
                  stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
     res.error = error
     return res
+
+
+def _weak_joints(sys, q, v, t, rows):
+    """Joints whose constraint rows are closest to dependent at (q, t)."""
+    from ..system.equations import constraint_terms
+    _, J, _, _ = constraint_terms(sys, normalize(sys, q), v, t)
+    return _worst_joints(sys, J, rows)

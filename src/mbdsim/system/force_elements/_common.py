@@ -52,7 +52,7 @@ WRAP_LIMIT = 0.75 * np.pi   # re-anchor the angle reference when |theta - ref| e
 
 
 def _ref(sys, name, ts):
-    """Angle reference [rad] in force at times ts (history of re-anchoring events)."""
+    """Angle reference [rad] in force at times ts: the last anchor at or before each time (0 before any)."""
     hist = element_state(sys, name).get("angle_ref", [])
     if not hist:
         return np.zeros(len(ts))
@@ -64,11 +64,13 @@ def _ref(sys, name, ts):
     return out
 
 
-def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
+def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None, anchor=False):
     """Coordinate x (N,), rate xd (N,) and Jacobian Rows of a joint's rotation [rad] or slide [m].
 
-    The angle is continued beyond +-pi: theta = ref + wrap(theta_raw - ref), with `ref` re-anchored by
-    the event switch `angle_switch` (stored per element `owner` on the System)."""
+    The angle is continued beyond +-pi: theta = ref(t) + wrap(theta_raw - ref(t)), exact as long as the
+    true angle stays within pi of ref(t).  With anchor=True (force evaluation of one state at time t)
+    a new anchor (t, theta) is recorded, per element `owner` on the System, whenever |theta - ref|
+    exceeds WRAP_LIMIT; measures at any later time then use the anchors recorded before that time."""
     fb, _ = batched(fr)
     g = sys.geoms[joint.name]
     N = fb.r.shape[0]
@@ -76,23 +78,12 @@ def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
     rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
     if dof == "rotation":
         raw, rows, rate = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
-        ref = _ref(sys, owner, times_of(fb, t, N))
+        ts = times_of(fb, t, N)
+        ref = _ref(sys, owner, ts)
         x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi
+        if anchor and N == 1 and np.isfinite(ts[0]) and abs(x[0] - ref[0]) > WRAP_LIMIT:
+            hist = element_state(sys, owner).setdefault("angle_ref", [])
+            bisect.insort(hist, (float(ts[0]), float(x[0])))
         return x, rate, rows
     rows = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
     return rows.phi, pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)), rows
-
-
-def angle_switch(sys, fr, joint, owner, t) -> np.ndarray:
-    """Switching function > 0 while the continued angle stays within WRAP_LIMIT of its reference."""
-    x = joint_coordinate(sys, fr, joint, "rotation", owner, t)[0]
-    ref = _ref(sys, owner, times_of(batched(fr)[0], t, len(x)))
-    return np.cos(x - ref) - np.cos(WRAP_LIMIT)
-
-
-def angle_reanchor(sys, fr, joint, owner, t):
-    """After an event at t: re-anchor the angle reference at the current continued angle."""
-    x = float(joint_coordinate(sys, fr, joint, "rotation", owner, t)[0][0])
-    hist = element_state(sys, owner).setdefault("angle_ref", [])
-    if abs(x - (hist[-1][1] if hist else 0.0)) > 0.5 * WRAP_LIMIT:
-        hist.append((float(t), x))

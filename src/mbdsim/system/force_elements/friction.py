@@ -18,10 +18,10 @@ at the joint point: force F, moment T, split along / perpendicular to h:
 Modes (history of (t, mode, direction s, x_stick) per element, kept on the System, so the state at
 any time - dense output, Result.at - uses the mode in force then):
 - slip, direction s = +-1: lambda_f = mu_dynamic N(lambda_) s, the lock row is inactive.  N depends on
-  lambda_, which depends on the friction load: `friction_kkt` solves the coupled KKT system by
-  iterating on the direction of the reaction (N is homogeneous of degree one in lambda_, so each
-  iterate is an exact linear solve; 1-3 iterations).  Switching function s xd: its zero (the joint
-  stops) is located as an event.
+  lambda_, which depends on the friction load: `friction_kkt.friction_kkt` (called by
+  solvers.common.accelerations) solves the coupled KKT system by iterating on the direction of the
+  reaction (N is homogeneous of degree one in lambda_, so each iterate is an exact linear solve).
+  Switching function s xd: its zero (the joint stops) is located as an event.
 - stick: the lock row is active (position level, so the joint cannot creep: coordinate projection
   holds x = x_stick to the Newton tolerance); the friction force is its multiplier.  Switching
   function mu_static N - |lambda_f| + eps, eps = STICK_TOL (1 + mu_static N): its zero releases the
@@ -29,8 +29,11 @@ any time - dense output, Result.at - uses the mode in force then):
 - at every event (and at the start) a joint at rest (|xd| <= V_TOL) is tried in stick: it sticks if
   |lambda_f| <= mu_static N + eps / 2, else it slips towards sign(lambda_f).  Several elements are
   decided one after the other (not a complementarity solve).
-Only the "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic; equilibrium and
-kinematics ignore friction.  Energy: `dissipation` = lambda_f xd >= 0 [W] (needs the multipliers).
+Only the "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic (through the
+EventTracker hooks on_start / on_event / switch); other analyses raise a ModelError naming the
+element.  One friction element per joint; a joint driven by a motion cannot have friction.  The
+joint's `reaction_force` does not include the friction force (`res.friction_force(name)` gives it;
+`res.friction_events(name)` the stick/slip history).  Energy: `dissipation` = lambda_f xd >= 0 [W].
 """
 from __future__ import annotations
 
@@ -38,14 +41,13 @@ import bisect
 
 import numpy as np
 
-from ...math.rotation import skew
 from ...model.friction_path import JointFriction
 from ..constraints.base import RowSpec
 from . import register
+from .friction_kkt import load_maps, normal_load
 
 V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
 STICK_TOL = 1e-10   # relative tolerance on the static friction limit
-MAXIT = 50          # iterations of the coupled friction KKT solve
 
 
 class StickSlip:
@@ -85,6 +87,11 @@ def lock_specs(model, geoms):
     specs = []
     for el in model.forces.values():
         if isinstance(el, JointFriction):
+            driven = [m.name for m in model.motions.values() if m.joint is el.joint]
+            if driven:
+                from ...errors import ModelError
+                raise ModelError(f"friction '{el.name}'", "joint", f"joint {el.joint.name!r} is driven by motion "
+                                 f"{driven[0]!r}: friction on a driven joint is not supported")
             g = geoms[el.joint.name]
             st = StickSlip(el.name)
             if el.joint.kind == "revolute":
@@ -104,102 +111,6 @@ def locks_at(sys, t):
         if m is not None and m[0] == "stick":
             out.append(int(sys.owner_rows[name][0]))
     return out
-
-
-# ----------------------------------------------------------------------------- normal load
-def _load_maps(sys, fr, J, elem):
-    """[(weight, L)]: N = preload + sum weight |L lambda_joint|, L linear maps of the joint's multipliers."""
-    g = sys.geoms[elem.joint.name]
-    jr = sys.owner_rows[elem.joint.name]
-    b, s_b = (g.bj, g.s_j) if g.bj != 0 else (g.bi, g.s_i)
-    a = sys.frame_v_adr[b]
-    LF = -J[jr, a:a + 3].T
-    h = fr.A[g.bi] @ g.h_i
-    P = np.eye(3) - np.outer(h, h)
-    LT = None
-    if sys.frame_rigid[b]:
-        A = fr.A[b]
-        LT = A @ (-J[jr, a + 3:a + 6].T) - skew(A @ s_b) @ LF
-    e = elem
-    if e.joint.kind == "revolute":
-        terms = [(e.pin_radius, P @ LF), (e.friction_arm, h[None] @ LF),
-                 (e.pin_radius / e.bending_arm if e.bending_arm else None, None if LT is None else P @ LT)]
-    else:
-        terms = [(1.0, P @ LF), (1 / e.effective_length if e.effective_length else None, None if LT is None else P @ LT),
-                 (1 / e.reaction_arm if e.reaction_arm else None, None if LT is None else h[None] @ LT)]
-    return jr, [(w, L) for w, L in terms if w and L is not None]
-
-
-def normal_load(elem, maps, lam_j):
-    """N (see module docstring) from the joint's multipliers lam_j."""
-    return elem.preload + sum(w * float(np.linalg.norm(L @ lam_j)) for w, L in maps)
-
-
-def _gradient(maps, lam_j):
-    g = np.zeros(len(lam_j))
-    for w, L in maps:
-        y = L @ lam_j
-        n = np.linalg.norm(y)
-        if n > 0:
-            g += w * (L.T @ y) / n
-    return g
-
-
-# ----------------------------------------------------------------------------- coupled KKT solve
-def friction_kkt(sys, fr, J, gamma, Q, rows, t):
-    """vd and full lambda_ (lock entries = friction multipliers) with slip friction loads coupled to lambda_.
-
-    rows: the active rows (independent joint rows + active lock rows)."""
-    nv, nr = sys.nv, len(rows)
-    K = np.zeros((nv + nr, nv + nr))
-    K[:nv, :nv] = sys.M
-    K[:nv, nv:] = J[rows].T
-    K[nv:, :nv] = J[rows]
-    b = np.concatenate([Q, gamma[rows]])
-    pos = np.full(sys.nc, -1)
-    pos[rows] = np.arange(nr)
-    slips = []
-    for name, st in sys.switched.items():
-        m = st.at(t)
-        if m is None or m[0] != "slip":
-            continue
-        elem = sys.model.forces[name]
-        jr, maps = _load_maps(sys, fr, J, elem)
-        keep = pos[jr] >= 0
-        maps = [(w, L[:, keep]) for w, L in maps]
-        slips.append((elem, elem.mu_dynamic * m[1], J[sys.owner_rows[name][0]], maps, pos[jr][keep],
-                      sys.owner_rows[name][0]))
-    x = _solve(K, b)
-    for _ in range(MAXIT if slips else 0):
-        K2, b2 = K.copy(), b.copy()
-        lam = x[nv:]
-        for elem, c, Jl, maps, idx, _ in slips:
-            g = np.zeros(nr)
-            g[idx] = _gradient(maps, lam[idx])
-            K2[:nv, nv:] += c * np.outer(Jl, g)
-            b2[:nv] -= c * elem.preload * Jl
-        x_new = _solve(K2, b2)
-        done = np.linalg.norm(x_new - x) <= 1e-14 * (1.0 + np.linalg.norm(x))
-        x = x_new
-        if done:
-            break
-    vd, lam = x[:nv], np.zeros(sys.nc)
-    lam[rows] = x[nv:]
-    Qf = np.zeros(nv)
-    for elem, c, Jl, maps, idx, lock in slips:
-        lam[lock] = c * normal_load(elem, maps, x[nv:][idx])
-        Qf -= Jl * lam[lock]
-    cand = np.union1d(sys.fixed_rows, [r for r in rows if r in set(sys.lock_rows)]).astype(int)
-    if len(cand) > nr:   # redundant rows dropped: minimum-norm distribution like the frictionless path
-        lam[cand] = np.linalg.lstsq(J[cand].T, Q + Qf - sys.M @ vd, rcond=None)[0]
-    return vd, lam
-
-
-def _solve(K, b):
-    x = np.linalg.solve(K, b)   # LinAlgError when exactly singular (reported by solvers.common)
-    if not np.all(np.isfinite(x)) or np.max(np.abs(x), initial=0.0) > 1e13 * (1.0 + np.max(np.abs(b), initial=0.0)):
-        raise np.linalg.LinAlgError("augmented matrix with friction is numerically singular")
-    return x
 
 
 # ----------------------------------------------------------------------------- evaluator
@@ -225,7 +136,7 @@ def _timed(fr):
 
 def _stick_margin(sys, fr, J, lam, elem):
     """mu_static N - |lambda_f| + eps and lambda_f at one state (full J and lambda_)."""
-    jr, maps = _load_maps(sys, fr, J, elem)
+    jr, maps = load_maps(sys, fr, J, elem)
     N = normal_load(elem, maps, lam[jr])
     lf = lam[sys.owner_rows[elem.name][0]]
     return elem.mu_static * N - abs(lf) + STICK_TOL * (1 + elem.mu_static * N), lf, STICK_TOL * (1 + elem.mu_static * N)
