@@ -234,3 +234,13 @@ def test_other_index1_methods_locate_the_stop(method):
     assert [e[1] for e in ev] == ["slip", "stick"]
     assert ev[1][0] == pytest.approx(-v0 / a, rel=1e-6)
     assert res.joint_coordinate(joint)[-1] == pytest.approx(-v0**2 / (2 * a), rel=1e-6)
+
+
+def test_default_method_with_friction_is_the_event_driven_dop853():
+    """mb.simulate without a method picks dop853 for stick/slip friction; an explicit 'hht' is refused."""
+    model, _ = incline(15, 0.0)
+    res = mb.simulate(model, 0.5, 0.1)
+    assert res.success and res.stats["method"] == "DOP853"
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(model, 0.5, 0.1, method="hht")
+    assert err.value.field == "method" and "dop853" in str(err.value)

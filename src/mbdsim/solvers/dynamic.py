@@ -33,8 +33,9 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "hht" (default, implicit, error-controlled), "dop853" (high accuracy, index-1 with
-    projection), "rk45", "radau", "bdf".  rtol/atol: integrator tolerances (relative, absolute in SI)."""
-    method = (method or "hht").lower()
+    projection), "rk45", "radau", "bdf".  A model with stick/slip joint friction defaults to "dop853",
+    whose event-driven mode switching the friction model needs.  rtol/atol: integrator tolerances (relative, absolute in SI)."""
+    method = (method or _default_method(model)).lower()
     if method not in SCIPY_METHODS and method != "hht":
         raise ModelError("simulate", "method", f"unknown method {method!r}; choose from "
                          f"{sorted(list(SCIPY_METHODS) + ['hht'])}")
@@ -47,6 +48,14 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
         from .hht import integrate_hht
         return integrate_hht(sys, rep, times, rtol, atol, max_step)
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
+
+
+def _default_method(model) -> str:
+    """'hht', or 'dop853' when a force element needs event-driven mode switching (joint friction)."""
+    from ..system.force_elements import evaluator
+    if any(getattr(evaluator(e), "needs_lambda", False) for e in model.forces.values()):
+        return "dop853"
+    return "hht"
 
 
 class _Trajectory:

@@ -178,18 +178,16 @@ def _dense(sys, s0, s1, t, rows, sf):
     if h <= 0 or t <= s0.t:
         return consistent_state(sys, np.concatenate([s0.q, s0.v]), t, rows, sf)
     tau = (t - s0.t) / h
-    dq = h * s0.v + h * h * (0.5 * s0.a)  # increment direction estimate; refined by the Hermite form below
-    delta = _log_increment(sys, s0.q, s1.q, dq)
-    h00, h10, h01, h11 = 2 * tau**3 - 3 * tau**2 + 1, tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2
+    delta = _log_increment(sys, s0.q, s1.q)
+    h10, h01, h11 = tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2
     dpos = h10 * h * s0.v + h01 * delta + h11 * h * s1.v
-    vel = ((6 * tau**2 - 6 * tau) * 0 + (3 * tau**2 - 4 * tau + 1) * h * s0.v + (-6 * tau**2 + 6 * tau) * delta
+    vel = ((3 * tau**2 - 4 * tau + 1) * h * s0.v + (-6 * tau**2 + 6 * tau) * delta
            + (3 * tau**2 - 2 * tau) * h * s1.v) / h
-    del h00
     q = increment(sys, s0.q, dpos)
     return consistent_state(sys, np.concatenate([q, vel]), t, rows, sf)
 
 
-def _log_increment(sys, q0, q1, guess):
+def _log_increment(sys, q0, q1):
     """Increment dx with q0 (+) dx = q1 (translation difference; body-axes rotation vector)."""
     from ..math.rotation import quat_mul
     from scipy.spatial.transform import Rotation
