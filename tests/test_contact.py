@@ -145,6 +145,31 @@ def test_energy_balance_damped_frictional_contacting_model():
     assert np.max(np.abs(E + D - E[0] - W)) < 1e-6 * scale
 
 
+def test_energy_balance_joint_friction_stop_and_contact_on_moving_body():
+    """Block sliding down an incline with Coulomb joint friction into a damped Hertzian end stop, while a
+    spinning ball bounces on its top face (contact between two moving bodies, with friction)."""
+    a = np.radians(20.0)
+    down = np.array([np.cos(a), 0.0, -np.sin(a)])
+    m = mb.Model(gravity=(0, 0, -G))
+    block = m.add_body("block", 2.0, (0.02, 0.03, 0.04), velocity=tuple(0.5 * down))
+    sl = m.add_translational("slide", m.ground, block, (0, 0, 0), tuple(down))
+    m.add_friction("fr", sl, 0.25, 0.2, preload=0.5)
+    m.add_stop("end", sl, upper=0.3, stiffness=1e6, exponent=1.5, damping=300.0, penetration=1e-3)
+    ball = m.add_body("ball", 0.2, (2e-4,) * 3, position=(0.0, 0, 0.25), velocity=(0.1, 0, 0),
+                      angular_velocity=(0, 4, 0))
+    m.add_contact("hit", mb.Plane(block, (0, 0, 0.05), (0, 0, 1)), mb.Sphere(ball, 0.03), 1e5, 1.5, 10.0, 1e-3,
+                  mu=0.3, friction_velocity=1e-2)
+    res = mb.simulate(m, 0.8, 0.002, method="dop853", rtol=1e-10, atol=1e-12)
+    assert res.success
+    assert len(element_state(res.system, "end")["events"]) >= 2
+    assert len(element_state(res.system, "hit")["events"]) >= 4
+    E = res.kinetic_energy() + res.potential_energy()
+    D = res.dissipated_energy()
+    assert D[-1] > E[0]                                       # gravity work was dissipated too
+    assert np.max(np.abs(E + D - E[0])) < 1e-6 * np.max(np.abs(E))
+    assert abs(res.joint_velocity(sl)[-1]) < 1e-9             # stuck against the stop at the end
+
+
 # --------------------------------------------------------------------------- bad input
 @pytest.mark.parametrize("make, field", [
     (lambda m, a, b: (mb.Plane(a, (0, 0, 0), (0, 0, 1)), mb.Plane(b, (0, 0, 0), (0, 0, 1))), "shape_j"),

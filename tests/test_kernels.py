@@ -48,3 +48,17 @@ def test_frames_kernel_matches_numpy():
     a, b = body_frames(sys, q, v), body_frames(sys, q[None], v[None])
     for k in ("r", "A", "rd", "w"):
         np.testing.assert_allclose(getattr(a, k), getattr(b, k)[0], atol=1e-14)
+
+
+@pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
+def test_increment_kernel_matches_quaternion_algebra(monkeypatch):
+    from mbdsim.solvers.common import increment
+    sys = assemble_system(mixed_model())
+    rng = np.random.default_rng(3)
+    for scale in (1.0, 1e-9):
+        dx = scale * rng.normal(size=sys.nv)
+        a = increment(sys, sys.q0, dx)
+        monkeypatch.setattr(kernels, "HAVE_NUMBA", False)
+        b = increment(sys, sys.q0, dx)
+        monkeypatch.setattr(kernels, "HAVE_NUMBA", True)
+        np.testing.assert_allclose(a, b, atol=1e-15)

@@ -7,12 +7,18 @@ import scipy.linalg as sla
 from ..errors import SolverError
 from ..math.rotation import quat_exp, quat_mul, quat_rate
 from ..system.dynamics import applied_forces, solve_kkt
+from ..system import kernels
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 
 
 def increment(sys, q, dx):
     """q (+) dx: translate CMs by dx [m], rotate bodies by the body-axes rotation vector dx [rad]."""
+    if kernels.HAVE_NUMBA:
+        q = kernels.increment_kernel(np.asarray(q, dtype=float), np.asarray(dx, dtype=float), sys.r_idx,
+                                     sys.rd_idx, sys.p_idx, sys.w_idx)
+        q[sys.aux_q_idx] += dx[sys.aux_v_idx]
+        return q
     q = q.copy()
     q[sys.r_idx] += dx[sys.rd_idx]
     q[sys.aux_q_idx] += dx[sys.aux_v_idx]   # auxiliary coordinates (curve parameters): plain sums

@@ -25,7 +25,7 @@ from .state import state_factory
 SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, "rk45": integrate.RK45,
                  "radau": integrate.Radau, "bdf": integrate.BDF}
 DEFAULT_TOL = {"dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
-               "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-6, 1e-8)}
+               "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-5, 1e-7)}
 
 
 def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,

@@ -49,14 +49,17 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
     steps = [cur]
     out = [consistent_state(sys, np.concatenate([rep.q, rep.v]), t0, rows, sf)]
     nxt, success, message, nrej, error = 1, True, "ok", 0, None
-    itmat = None
+    tan = _Tangent()
     try:
         while cur.t < t_end - 1e-14 * max(1.0, abs(t_end)):
             h = min(h, t_end - cur.t, max_step or np.inf)
-            new, itmat, ok = _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, itmat)
+            new, ok = _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan)
             if not ok:
                 nrej += 1
-                itmat = None
+                if not tan.fresh:       # first refresh the tangent, then cut the step
+                    tan.K = None
+                    continue
+                tan.K = None
                 h *= 0.25
                 if h < 1e-14 * max(1.0, abs(cur.t)):
                     raise SolverError("HHT step size underflow (Newton does not converge)", time=cur.t,
@@ -106,14 +109,24 @@ def _initial_step(sys, s, rtol, atol):
     return 0.1 * (1.0 / max(an, 1e-10)) ** 0.5 if an > 0 else 1e-2
 
 
-def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, itmat):
+class _Tangent:
+    """Cached stiffness K = d(phi_q^T lambda_ - Q)/dx and damping C = -dQ/dv (finite differences);
+    refreshed only when Newton stalls, as in a modified Newton method."""
+
+    def __init__(self):
+        self.K = self.C = None
+        self.fresh = False
+
+
+def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
+    """One HHT step of size h from `cur`; returns (new _Step or None, converged)."""
     t1 = cur.t + h
     a, lam = cur.a.copy(), cur.lam.copy()
-    nv, nr = sys.nv, len(rows)
+    nv = sys.nv
     base_dq = h * cur.v + h * h * (0.5 - beta) * cur.a
     base_v = cur.v + h * (1 - gamma) * cur.a
-    prev_norm = np.inf
-    for it in range(10):
+    prev_norm, lu = np.inf, None
+    for it in range(8):
         q1 = increment(sys, cur.q, base_dq + h * h * beta * a)
         v1 = base_v + h * gamma * a
         Q = applied_forces(sys, body_frames(sys, q1, v1), t1, sf(t1, q1, v1) if sf else None)
@@ -121,33 +134,37 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, itmat):
         J, phi = J[rows], phi[rows]
         r1 = sys.M @ a + (1 + alpha) * (J.T @ lam - Q) - alpha * cur.f
         r2 = phi / (beta * h * h)
-        if itmat is None or it == 3:
-            itmat = _iteration_matrix(sys, q1, v1, t1, lam, J, h, alpha, beta, gamma, rows, sf)
+        if tan.K is None:
+            tan.K, tan.C = _tangent(sys, q1, v1, t1, lam, rows, sf)
+            tan.fresh = True
+        if lu is None:
+            lu = _iteration_matrix(sys, tan, J, h, alpha, beta, gamma)
         try:
-            d = sla.lu_solve(itmat, -np.concatenate([r1, r2]))
+            d = sla.lu_solve(lu, -np.concatenate([r1, r2]))
         except (ValueError, sla.LinAlgError):
-            return None, None, False
+            return None, False
+        if not np.all(np.isfinite(d)):
+            return None, False
         a += d[:nv]
         lam += d[nv:]
-        norm = np.max(np.abs(d[:nv])) * beta * h * h
-        if not np.all(np.isfinite(d)):
-            return None, None, False
-        if norm < 1e-12 * (1 + np.max(np.abs(base_dq))) and (len(phi) == 0 or np.max(np.abs(phi)) < 1e-10):
+        norm = np.max(np.abs(d[:nv]), initial=0.0) * beta * h * h
+        if norm < 1e-12 * (1 + np.max(np.abs(base_dq), initial=0.0)) and \
+                (len(phi) == 0 or np.max(np.abs(phi)) < 1e-10):
             q1 = increment(sys, cur.q, base_dq + h * h * beta * a)
             v1 = base_v + h * gamma * a
             q1, _, _ = project_positions(sys, q1, t1, rows, tol=1e-12, maxit=3)
-            return _Step(t1, q1, v1, a, lam, _force_term(sys, q1, v1, t1, lam, rows, sf)), itmat, True
-        if it > 4 and norm > 0.9 * prev_norm:
-            return None, None, False
+            tan.fresh = False
+            return _Step(t1, q1, v1, a, lam, _force_term(sys, q1, v1, t1, lam, rows, sf)), True
+        if it > 2 and norm > 0.5 * prev_norm:   # slow convergence: stop and let the caller react
+            break
         prev_norm = norm
-    return None, None, False
+    return None, False
 
 
-def _iteration_matrix(sys, q, v, t, lam, J, h, alpha, beta, gamma, rows, sf):
-    nv, nr = sys.nv, len(rows)
-    K, C = _tangent(sys, q, v, t, lam, rows, sf)
+def _iteration_matrix(sys, tan, J, h, alpha, beta, gamma):
+    nv, nr = sys.nv, J.shape[0]
     A = np.zeros((nv + nr, nv + nr))
-    A[:nv, :nv] = sys.M + (1 + alpha) * (gamma * h * C + beta * h * h * K)
+    A[:nv, :nv] = sys.M + (1 + alpha) * (gamma * h * tan.C + beta * h * h * tan.K)
     A[:nv, nv:] = (1 + alpha) * J.T
     A[nv:, :nv] = J
     return sla.lu_factor(A, check_finite=False)

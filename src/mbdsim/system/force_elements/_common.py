@@ -64,13 +64,14 @@ def _ref(sys, name, ts):
     return out
 
 
-def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None, anchor=False):
+def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
     """Coordinate x (N,), rate xd (N,) and Jacobian Rows of a joint's rotation [rad] or slide [m].
 
     The angle is continued beyond +-pi: theta = ref(t) + wrap(theta_raw - ref(t)), exact as long as the
-    true angle stays within pi of ref(t).  With anchor=True (force evaluation of one state at time t)
-    a new anchor (t, theta) is recorded, per element `owner` on the System, whenever |theta - ref|
-    exceeds WRAP_LIMIT; measures at any later time then use the anchors recorded before that time."""
+    true angle stays within pi of ref(t).  The anchors (t, theta) of element `owner` are recorded on
+    the System from accepted states only, at the events of `angle_switch` (|theta - ref| = WRAP_LIMIT):
+    trial states of rejected steps never move them.  Without event support (solvers that do not
+    call switch/on_event) ref stays 0, i.e. theta is wrapped to (-pi, pi]."""
     fb, _ = batched(fr)
     g = sys.geoms[joint.name]
     N = fb.r.shape[0]
@@ -81,9 +82,20 @@ def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None, anchor=False):
         ts = times_of(fb, t, N)
         ref = _ref(sys, owner, ts)
         x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi
-        if anchor and N == 1 and np.isfinite(ts[0]) and abs(x[0] - ref[0]) > WRAP_LIMIT:
-            hist = element_state(sys, owner).setdefault("angle_ref", [])
-            bisect.insort(hist, (float(ts[0]), float(x[0])))
         return x, rate, rows
     rows = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
     return rows.phi, pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)), rows
+
+
+def angle_switch(sys, fr, joint, owner, t) -> np.ndarray:
+    """Switching function > 0 while the continued angle stays within WRAP_LIMIT of its reference."""
+    x = joint_coordinate(sys, fr, joint, "rotation", owner, t)[0]
+    ref = _ref(sys, owner, times_of(batched(fr)[0], t, len(x)))
+    return np.cos(x - ref) - np.cos(WRAP_LIMIT)
+
+
+def angle_reanchor(sys, fr, joint, owner, t):
+    """After an (accepted) event at t: anchor the reference at the current angle if it has moved away."""
+    x = float(joint_coordinate(sys, fr, joint, "rotation", owner, t)[0][0])
+    if abs(x - _ref(sys, owner, [t])[0]) > 0.5 * WRAP_LIMIT:
+        bisect.insort(element_state(sys, owner).setdefault("angle_ref", []), (float(t), x))

@@ -5,7 +5,7 @@ import numpy as np
 
 from ...model.element_specs import Stop
 from . import register
-from ._common import element_state, joint_coordinate, load_from_rows
+from ._common import angle_reanchor, angle_switch, element_state, joint_coordinate, load_from_rows
 
 
 def _walls(elem, x, xd):
@@ -43,7 +43,7 @@ class StopEval:
 
     @staticmethod
     def generalized(sys, fr, elem, t, state):
-        x, xd, rows = joint_coordinate(sys, fr, elem.joint, elem.dof, elem.name, t, anchor=True)
+        x, xd, rows = joint_coordinate(sys, fr, elem.joint, elem.dof, elem.name, t)
         F = float(StopEval.tension(elem, x, xd)[0])
         return load_from_rows(sys, fr, rows, F) if F != 0.0 else np.zeros(sys.nv)
 
@@ -63,14 +63,21 @@ class StopEval:
 
     @staticmethod
     def switch(sys, fr, elem, t):
-        """Signed clearances x - lower and upper - x [m or rad]: wall contacts are located as events."""
+        """Signed clearances x - lower, upper - x [m or rad] (wall contacts located as events), plus the
+        angle continuation switch for a rotation."""
         x = joint_coordinate(sys, fr, elem.joint, elem.dof, elem.name, t)[0]
-        out = ([x - elem.lower] if elem.lower is not None else []) + ([elem.upper - x] if elem.upper is not None else [])
+        out = [x - elem.lower] if elem.lower is not None else []
+        out += [elem.upper - x] if elem.upper is not None else []
+        if elem.dof == "rotation":
+            out.append(angle_switch(sys, fr, elem.joint, elem.name, t))
         return np.concatenate(out)
 
     @staticmethod
     def on_event(sys, elem, t, q, v):
         from ..frames import body_frames
-        x = joint_coordinate(sys, body_frames(sys, q, v), elem.joint, elem.dof, elem.name, t)[0][0]
+        fr = body_frames(sys, q, v)
+        if elem.dof == "rotation":
+            angle_reanchor(sys, fr, elem.joint, elem.name, t)
+        x = joint_coordinate(sys, fr, elem.joint, elem.dof, elem.name, t)[0][0]
         if any(w is not None and abs(x - w) < 1e-9 for w in (elem.lower, elem.upper)):
             element_state(sys, elem.name).setdefault("events", []).append(float(t))

@@ -1,11 +1,9 @@
 """Rotational spring-damper on a revolute or cylindrical joint axis (TorsionSpring)."""
 from __future__ import annotations
 
-import numpy as np
-
 from ...model.element_specs import TorsionSpring
 from . import register
-from ._common import joint_coordinate, load_from_rows
+from ._common import angle_reanchor, angle_switch, joint_coordinate, load_from_rows
 
 
 @register(TorsionSpring)
@@ -25,7 +23,7 @@ class TorsionEval:
 
     @staticmethod
     def generalized(sys, fr, elem, t, state):
-        x, xd, rows = joint_coordinate(sys, fr, elem.joint, "rotation", elem.name, t, anchor=True)
+        x, xd, rows = joint_coordinate(sys, fr, elem.joint, "rotation", elem.name, t)
         return load_from_rows(sys, fr, rows, -float(TorsionEval.tension(elem, x[0], xd[0])))
 
     @staticmethod
@@ -38,3 +36,13 @@ class TorsionEval:
     def dissipation(sys, fr, elem, t):
         """Damping power c theta_dot^2 [W]."""
         return elem.damping * TorsionEval.measure(sys, fr, elem, t)[1] ** 2
+
+    @staticmethod
+    def switch(sys, fr, elem, t):
+        """Angle continuation: an event each time the angle moves WRAP_LIMIT from its anchor."""
+        return angle_switch(sys, fr, elem.joint, elem.name, t)
+
+    @staticmethod
+    def on_event(sys, elem, t, q, v):
+        from ..frames import body_frames
+        angle_reanchor(sys, body_frames(sys, q, v), elem.joint, elem.name, t)
