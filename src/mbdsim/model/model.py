@@ -212,11 +212,15 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         if isinstance(at, Marker):
             self._lookup(at.body, self.bodies, entity, field)
             return at
+        if isinstance(at, Body):   # a body alone means its centre of mass
+            body = self._lookup(at, self.bodies, entity, field)
+            return Marker(f"{entity}.{field}", body, body.position.copy(), np.eye(3))
         if isinstance(at, (tuple, list)) and len(at) == 2:
             body = self._lookup(at[0], self.bodies, entity, field)
             pt = vec3(entity, field, at[1])
             return Marker(f"{entity}.{field}", body, pt, np.eye(3))
-        raise ModelError(entity, field, f"expected a Marker or (body, point), got {at!r}")
+        raise ModelError(entity, field, f"expected a Marker, a body (its centre of mass) or (body, point), "
+                         f"got {at!r}")
 
     def _check_frame(self, entity, frame):
         if frame is None:
