@@ -138,7 +138,7 @@ def test_joint_and_load_input_errors():
         (lambda: m.add_universal("j", m.ground, b, (0, 0, 0), (0, 0, 1), (0, 1, 1)), "joint 'j'", "axis_j",
          "perpendicular"),
         (lambda: m.add_force("f", (b, (0, 0, 0)), (1, 2)), "force 'f'", "force", "3 numbers"),
-        (lambda: m.add_force("f", b, (1, 2, 3)), "force 'f'", "at", "Marker or (body, point)"),
+        (lambda: m.add_force("f", 3.0, (1, 2, 3)), "force 'f'", "at", "Marker, a body (its centre of mass) or (body, point)"),
         (lambda: m.add_torque("tq", "nobody", (1, 2, 3)), "torque 'tq'", "body", "no body named"),
         (lambda: m.add_spring_damper("s", (b, (1, 0, 0)), (m.ground, (0, 0, 0)), -5.0), "spring 's'",
          "stiffness", ">= 0"),
