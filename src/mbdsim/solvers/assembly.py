@@ -16,7 +16,7 @@ class RedundantConstraintWarning(UserWarning):
     """Some constraint equations are linearly dependent (e.g. a planar loop of 3D revolutes)."""
 
 
-@dataclass
+@dataclass(repr=False)
 class AssemblyReport:
     """Consistent initial state and what assembly changed (SI units, ground axes)."""
 
@@ -30,6 +30,9 @@ class AssemblyReport:
     moved: dict = field(default_factory=dict)       # body -> (|dr| [m], rotation angle [rad])
     velocity_changed: dict = field(default_factory=dict)  # body -> |dv| (velocity variables)
     residual: float = 0.0            # max |phi| after assembly [m or rad]
+
+    def __repr__(self) -> str:
+        return f"AssemblyReport(t={self.t:g} s, dof={self.dof}, residual={self.residual:.3g}, moved={list(self.moved)})"
 
     def __str__(self) -> str:
         lines = [f"assembly at t = {self.t:g} s: {self.dof} DOF, residual {self.residual:.3g}"]

@@ -25,6 +25,7 @@ from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .common import accelerations, increment, project_positions, project_velocities
 from .dynamic import consistent_state
+from .events import EventTracker
 from .state import state_factory
 
 ALPHA = -0.05
@@ -42,6 +43,9 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
     rows, sf = rep.rows, state_factory(sys)
     beta, gamma = (1 - alpha) ** 2 / 4, 0.5 - alpha
     t0, t_end = float(times[0]), float(times[-1])
+    events = EventTracker(sys, rows, sf)
+    events.start(t0, np.concatenate([rep.q, rep.v]))
+    to_event = False
     a0, lam_full = accelerations(sys, rep.q, rep.v, t0, rows, sf)
     lam0 = lam_full[rows]
     cur = _Step(t0, rep.q, rep.v, a0, lam0, _force_term(sys, rep.q, rep.v, t0, lam0, rows, sf))
@@ -70,6 +74,15 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
                 nrej += 1
                 h *= max(0.2, 0.9 * err ** (-1 / 3))
                 continue
+            if not to_event and events.items:
+                hit = events.check(cur.t, new.t, lambda t, a=cur, b=new: _hermite_y(sys, a, b, t))
+                if hit is not None and hit < new.t - 1e-13 * max(1.0, abs(new.t)):
+                    h, to_event = hit - cur.t, True     # redo the step so that it ends at the event
+                    continue
+                to_event = hit is not None
+            if to_event:                                # the step ends at an event: switch modes
+                events.after(new.t, np.concatenate([new.q, new.v]))
+                to_event = False
             steps.append(new)
             while nxt < len(times) and times[nxt] <= new.t + 1e-12 * max(1.0, abs(new.t)):
                 out.append(_dense(sys, cur, new, times[nxt], rows, sf))
@@ -189,19 +202,23 @@ def _error(cur, new, h, beta, rtol, atol):
     return float(np.sqrt(np.mean((e / scale) ** 2))) if len(e) else 0.0
 
 
-def _dense(sys, s0, s1, t, rows, sf):
-    """Consistent state at t in [s0.t, s1.t] by cubic Hermite interpolation in the tangent space."""
+def _hermite_y(sys, s0, s1, t):
+    """[q, v] at t in [s0.t, s1.t]: cubic Hermite interpolation of (q, v) in the tangent space."""
     h = s1.t - s0.t
     if h <= 0 or t <= s0.t:
-        return consistent_state(sys, np.concatenate([s0.q, s0.v]), t, rows, sf)
+        return np.concatenate([s0.q, s0.v])
     tau = (t - s0.t) / h
     delta = _log_increment(sys, s0.q, s1.q)
     h10, h01, h11 = tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2
     dpos = h10 * h * s0.v + h01 * delta + h11 * h * s1.v
     vel = ((3 * tau**2 - 4 * tau + 1) * h * s0.v + (-6 * tau**2 + 6 * tau) * delta
            + (3 * tau**2 - 2 * tau) * h * s1.v) / h
-    q = increment(sys, s0.q, dpos)
-    return consistent_state(sys, np.concatenate([q, vel]), t, rows, sf)
+    return np.concatenate([increment(sys, s0.q, dpos), vel])
+
+
+def _dense(sys, s0, s1, t, rows, sf):
+    """Consistent state at t in [s0.t, s1.t] from the Hermite interpolant, projected and completed."""
+    return consistent_state(sys, _hermite_y(sys, s0, s1, t), t, rows, sf)
 
 
 def _log_increment(sys, q0, q1):

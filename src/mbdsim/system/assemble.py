@@ -35,7 +35,7 @@ class Group:
     fns: list = field(default_factory=list)
 
 
-@dataclass
+@dataclass(repr=False)
 class System:
     """Assembled equations of a Model; see module docstring for the coordinate layout."""
 
@@ -71,6 +71,9 @@ class System:
     @property
     def nbody(self) -> int:
         return len(self.bodies)
+
+    def __repr__(self) -> str:
+        return f"System({self.model.name!r}: nq={self.nq}, nv={self.nv}, nc={self.nc})"
 
     @property
     def fixed_rows(self) -> np.ndarray:
