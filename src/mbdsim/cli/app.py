@@ -36,16 +36,8 @@ app = typer.Typer(
 
 
 def _version() -> str:
-    mod = sys.modules.get("mbdsim")
-    v = getattr(mod, "__version__", None) if mod is not None else None
-    if v:
-        return str(v)
-    try:
-        from importlib.metadata import version
-
-        return version("mbdsim")
-    except Exception:  # noqa: BLE001
-        return "unknown"
+    from mbdsim import __version__
+    return __version__
 
 
 def _version_callback(value: bool) -> None:

@@ -29,7 +29,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Iterable, Sequence
 
+from mbdsim import __version__ as _mbdsim_version
 from mbdsim.validation.framework import FLOOR, REL_TOL, CaseOutcome, Plot, Quantity
+from mbdsim.validation.registry import outcome_error
 
 __all__ = [
     "write_report",
@@ -103,18 +105,9 @@ def _safe(fn, default=None):
         return default
 
 
-def _error_of(outcome: CaseOutcome) -> str | None:
-    err = getattr(outcome, "error", None)
-    if err:
-        return str(err)
-    if not outcome.quantities:
-        return "the case produced no compared quantities"
-    return None
-
-
 def case_status(outcome: CaseOutcome) -> str:
     """``"PASS"``, ``"FAIL"`` (some quantity fails) or ``"ERROR"`` (the case did not run)."""
-    if _error_of(outcome) is not None:
+    if outcome_error(outcome) is not None:
         return "ERROR"
     ok = _safe(lambda: all(q.passed for q in outcome.quantities), False)
     return "PASS" if ok else "FAIL"
@@ -679,23 +672,10 @@ def _max_or_none(values: Iterable[Any]) -> float | None:
     return max(vals) if vals else None
 
 
-def _mbdsim_version() -> str:
-    mod = sys.modules.get("mbdsim")
-    v = getattr(mod, "__version__", None) if mod is not None else None
-    if v:
-        return str(v)
-    try:
-        from importlib.metadata import version
-
-        return version("mbdsim")
-    except Exception:  # noqa: BLE001
-        return "unknown"
-
-
 def _environment() -> str:
     import numpy
 
-    parts = [f"mbdsim {_mbdsim_version()}", f"Python {platform.python_version()}",
+    parts = [f"mbdsim {_mbdsim_version}", f"Python {platform.python_version()}",
              f"NumPy {numpy.__version__}"]
     scipy = sys.modules.get("scipy")
     if scipy is not None:
@@ -813,7 +793,7 @@ def _md_case(d: _CaseDoc) -> str:
     if elapsed is not None:
         meta.append(f"**Run time:** {float(elapsed):.2f} s")
     out.append(" · ".join(m for m in meta if m) + "\n")
-    err = _error_of(o)
+    err = outcome_error(o)
     if err:
         out.append(f"> **ERROR:** {_md_cell(err)}\n")
         tb = getattr(o, "traceback", "")
@@ -1033,7 +1013,7 @@ def _html_case(d: _CaseDoc) -> str:
         meta.append(f"<b>Run time:</b> {float(elapsed):.2f} s")
     if meta:
         p.append(f'<p class="meta">{" · ".join(meta)}</p>')
-    err = _error_of(o)
+    err = outcome_error(o)
     if err:
         p.append(f'<div class="error"><b>ERROR:</b> {_e(err)}</div>')
         tb = getattr(o, "traceback", "")
