@@ -16,6 +16,7 @@ from scipy import integrate
 from ..errors import MbdsimError, ModelError, SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
+from ..system.force_elements import evaluator
 from .assembly import assemble_state
 from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
 from .events import EventTracker
@@ -46,13 +47,17 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
     if method == "hht":
         from .hht import integrate_hht
+        if _default_method(model) != "hht":
+            names = [e.name for e in model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
+            raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
+                             "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
+                             "'bdf'); the HHT method cannot include it")
         return integrate_hht(sys, rep, times, rtol, atol, max_step)
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
 
 
 def _default_method(model) -> str:
     """'hht', or 'dop853' when a force element needs event-driven mode switching (joint friction)."""
-    from ..system.force_elements import evaluator
     if any(getattr(evaluator(e), "needs_lambda", False) for e in model.forces.values()):
         return "dop853"
     return "hht"
