@@ -1,10 +1,17 @@
 """mbdsim: 3D multibody dynamics in Python (SI units throughout).
 
-Public API (a contract; everything else may change): Model, simulate, kinematics, assemble,
-equilibrium, Result, the error types and the expression/function library.
+Public API (a contract; everything else may change): Model and its add_* methods, the analyses
+(simulate, kinematics, assemble, equilibrium), Result, contact shapes and path curves, the error
+types, and the Adams-style function library (STEP, STEP5, HAVSIN, IMPACT, BISTOP, POLY, SHF, AKISPL)
+with the safe expression parser `parse`.
 """
+from . import expressions, functions
 from .errors import AssemblyError, MbdsimError, ModelError, SolverError
+from .expressions import ExpressionError, parse
+from .functions import AKISPL, BISTOP, HAVSIN, IMPACT, POLY, SHF, STEP, STEP5, Akima, CubicSplineTable
 from .model import Body, Force, Joint, Marker, Model, Motion, SpringDamper, Torque
+from .model.curves import Curve, Spline
+from .model.shapes import Plane, Sphere
 from .results import Result
 from .solvers.assembly import AssemblyReport, RedundantConstraintWarning, assemble
 from .solvers.dynamic import simulate
@@ -15,12 +22,9 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
+    "Curve", "Spline", "Sphere", "Plane",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
-    "MbdsimError", "ModelError", "AssemblyError", "SolverError", "RedundantConstraintWarning",
+    "MbdsimError", "ModelError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
+    "expressions", "functions", "parse",
+    "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]
-
-from .model.curves import Curve, Spline  # noqa: E402  (issue 3: path constraint curves)
-__all__ += ["Curve", "Spline"]
-
-from .model.shapes import Plane, Sphere  # noqa: E402  (issue 3: contact shapes)
-__all__ += ["Sphere", "Plane"]
