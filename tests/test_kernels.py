@@ -62,3 +62,25 @@ def test_increment_kernel_matches_quaternion_algebra(monkeypatch):
         b = increment(sys, sys.q0, dx)
         monkeypatch.setattr(kernels, "HAVE_NUMBA", True)
         np.testing.assert_allclose(a, b, atol=1e-15)
+
+
+@pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
+def test_qdot_kernel_matches_quaternion_rate(monkeypatch):
+    from mbdsim.solvers.common import qdot
+    sys = assemble_system(mixed_model())
+    v = np.random.default_rng(4).normal(size=sys.nv)
+    a = qdot(sys, sys.q0, v)
+    monkeypatch.setattr(kernels, "HAVE_NUMBA", False)
+    b = qdot(sys, sys.q0, v)
+    np.testing.assert_allclose(a, b, atol=1e-15)
+
+
+@pytest.mark.skipif(not kernels.HAVE_NUMBA, reason="numba not installed")
+def test_inertial_forces_kernel_matches_numpy(monkeypatch):
+    from mbdsim.system.dynamics import inertial_forces
+    sys = assemble_system(mixed_model())
+    fr = body_frames(sys, sys.q0, sys.v0 + 0.7)
+    a = inertial_forces(sys, fr)
+    monkeypatch.setattr(kernels, "HAVE_NUMBA", False)
+    b = inertial_forces(sys, fr)
+    np.testing.assert_allclose(a, b, atol=1e-13)

@@ -85,7 +85,8 @@ class Model(ForceElementsMixin, FrictionPathMixin):
 
     def add_fixed(self, name, body_i, body_j, point=None) -> Joint:
         """Fixed joint welding body_j to body_i (at `point`, default body_j's CM)."""
-        point = body_j.position if point is None and isinstance(body_j, Body) else point
+        bj = self.bodies.get(body_j) if isinstance(body_j, str) else body_j   # a body may be given by name
+        point = bj.position if point is None and isinstance(bj, Body) else point
         return self._joint(name, "fixed", body_i, body_j, point, (0.0, 0.0, 1.0))
 
     # ----------------------------------------------------------------- drivers
@@ -155,6 +156,8 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         self._claim(name, "torque")
         try:
             b = self._lookup(body, self.bodies, entity, "body")
+            if b.is_particle:
+                raise ModelError(entity, "body", f"{b.name!r} is a particle: it has no rotation for a torque to act on")
             val = torque if callable(torque) else vec3(entity, "torque", torque)
             self._check_frame(entity, frame)
         except ModelError:

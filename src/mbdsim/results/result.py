@@ -114,9 +114,17 @@ class Result:
         ang, angd, sl, sld = ms.joint_coordinate(self.system, self.frames, self._joint(joint))
         if ang is not None:
             if self._parent is None:
-                ang = np.unwrap(ang)
-            else:  # continue the parent's unwrapped history
-                ref = np.interp(self.time, self._parent.time, self._parent._coord(joint)[0])
+                ref = _angle_anchor(self.system, self._joint(joint), self.time)
+                if ref is not None:   # a torsion spring / stop on the joint continued the angle in the run
+                    ang = ref + (ang - ref + np.pi) % (2 * np.pi) - np.pi
+                ang = _unwrap_with_rate(self.time, ang, angd)
+            else:  # continue the parent's unwrapped history from its nearest sample
+                p = self._parent
+                p_ang, p_rate = p._coord(joint)[:2]
+                k = np.clip(np.searchsorted(p.time, self.time), 0, len(p.time) - 1)
+                prev = np.maximum(k - 1, 0)
+                k = np.where(np.abs(p.time[prev] - self.time) < np.abs(p.time[k] - self.time), prev, k)
+                ref = p_ang[k] + 0.5 * (p_rate[k] + angd) * (self.time - p.time[k])
                 ang = ref + (ang - ref + np.pi) % (2 * np.pi) - np.pi
         return ang, angd, sl, sld
 
@@ -260,20 +268,52 @@ class Result:
 
     def _extremum(self, signal, sign):
         y = sign * np.asarray(signal(self), dtype=float)
-        k = int(np.argmax(y))
+        # the first sample at the maximum up to rounding (a plateau - a joint stopped by friction - counts from
+        # its start, not from wherever the last bit of noise happens to peak)
+        tol = 1e-12 * np.max(np.abs(y))
+        k = int(np.argmax(y >= np.max(y) - tol))
         if k in (0, len(y) - 1) or self._evaluate is None:
             return float(self.time[k]), float(sign * y[k])
         f = lambda t: -sign * float(np.asarray(signal(self.at(t)))[0])  # noqa: E731
-        r = so.minimize_scalar(f, bracket=(self.time[k - 1], self.time[k], self.time[k + 1]),
-                               method="brent", tol=1e-12)
+        flat = False
+        try:
+            r = so.minimize_scalar(f, bracket=(self.time[k - 1], self.time[k], self.time[k + 1]),
+                                   method="brent", tol=1e-12)
+        except ValueError:   # flat top (a neighbour sample equals the maximum): bounded search instead
+            r = so.minimize_scalar(f, bounds=(self.time[k - 1], self.time[k + 1]), method="bounded",
+                                   options={"xatol": 1e-12})
+            flat = True
         t = float(r.x) if self.time[k - 1] <= r.x <= self.time[k + 1] else float(self.time[k])
-        return t, float(np.asarray(signal(self.at(t)))[0])
+        val = float(np.asarray(signal(self.at(t)))[0])
+        better = sign * val > y[k] + tol if flat else sign * val >= y[k]   # a plateau keeps its first sample
+        return (t, val) if better else (float(self.time[k]), float(sign * y[k]))
 
     # ------------------------------------------------------------ export
     def to_dataframe(self):
         """Tidy pandas DataFrame: time and each body's position/velocity, joint coordinates; units in names."""
         from .export import to_dataframe
         return to_dataframe(self)
+
+
+def _angle_anchor(system, joint, times):
+    """The angle references (N,) recorded during the analysis by a force element on `joint` (torsion
+    spring, rotational stop), or None."""
+    from ..system.force_elements._common import _ref, element_state
+    for e in system.model.forces.values():
+        if getattr(e, "joint", None) is joint and element_state(system, e.name).get("angle_ref"):
+            return _ref(system, e.name, times)
+    return None
+
+
+def _unwrap_with_rate(t, ang, rate):
+    """Continue wrapped angles (N,) beyond +-pi: each increment is the one closest to the trapezoidal
+    prediction from the rates, so more than pi per output step is followed (np.unwrap is not)."""
+    if len(ang) < 2:
+        return ang
+    pred = 0.5 * (rate[1:] + rate[:-1]) * np.diff(t)
+    inc = pred + (np.diff(ang) - pred + np.pi) % (2 * np.pi) - np.pi
+    cont = ang[0] + np.concatenate([[0.0], np.cumsum(inc)])
+    return ang + 2 * np.pi * np.round((cont - ang) / (2 * np.pi))   # the raw values, shifted by whole turns
 
 
 def _pick(ang, sl):

@@ -39,6 +39,11 @@ def normalize(sys, q):
 
 def qdot(sys, q, v):
     """dq/dt from velocity variables: rd for positions, 1/2 p (x) (0, w_B) for Euler parameters."""
+    if kernels.HAVE_NUMBA:
+        qd = kernels.qdot_kernel(np.asarray(q, dtype=float), np.asarray(v, dtype=float), sys.r_idx,
+                                 sys.rd_idx, sys.p_idx, sys.w_idx, sys.nq)
+        qd[sys.aux_q_idx] = v[sys.aux_v_idx]
+        return qd
     qd = np.zeros(sys.nq)
     qd[sys.r_idx] = v[sys.rd_idx]
     qd[sys.aux_q_idx] = v[sys.aux_v_idx]

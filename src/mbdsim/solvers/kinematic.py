@@ -40,6 +40,7 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
             break
         out.append(state)
         prev = state
+        _continue_angles(sys, state)
     ev = lambda ts: _evaluate(sys, out, ts, sf)  # noqa: E731
     res = _result(sys, out, ev, success, message)
     res.error = error
@@ -73,6 +74,17 @@ def solve_at(sys, q_guess, t, sf=None):
     Q = applied_forces(sys, body_frames(sys, q, v), t, sf(t, q, v) if sf else None)
     lam = np.linalg.lstsq(J.T, Q - sys.M @ vd, rcond=None)[0]
     return t, q, v, vd, lam
+
+
+def _continue_angles(sys, state):
+    """Re-anchor the joint angles of torsion springs and rotational stops after each solved time (what
+    the event tracker does in mb.simulate), so that they continue beyond +-pi instead of wrapping."""
+    from ..model.element_specs import Stop, TorsionSpring
+    from ..system.force_elements._common import angle_reanchor
+    t, q, v = state[:3]
+    for e in sys.model.forces.values():
+        if isinstance(e, TorsionSpring) or (isinstance(e, Stop) and e.dof == "rotation"):
+            angle_reanchor(sys, body_frames(sys, q, v), e.joint, e.name, t)
 
 
 def _predict(sys, prev, t):

@@ -1,6 +1,8 @@
 """The `state` handed to force/torque callables: Result measures at the current instant, one sample."""
 from __future__ import annotations
 
+import bisect
+
 import numpy as np
 
 
@@ -16,6 +18,16 @@ class State:
     def time(self) -> float:
         return self.t
 
+    def joint_coordinate(self, joint):
+        """Joint coordinate at this instant; an angle continues beyond +-pi along the analysis, as in a Result."""
+        res = self._res
+        x = np.array(res.joint_coordinate(joint)[0], dtype=float)
+        jt = res._joint(joint)
+        if jt.kind in ("revolute", "cylindrical") and not jt.body_j.is_particle:
+            ang = x.reshape(-1)
+            ang[0] = _continued(res.system, jt.name, self.t, float(ang[0]))
+        return x[()] if x.ndim == 0 else x
+
     def __getattr__(self, name):
         attr = getattr(self._res, name)
         if not callable(attr):
@@ -25,6 +37,19 @@ class State:
             out = attr(*args, **kwargs)
             return out[0] if isinstance(out, np.ndarray) and out.ndim >= 1 and len(out) == 1 else out
         return one
+
+
+def _continued(sys, name, t, raw):
+    """Angle [rad] closest to the reference in force at time t (the last anchor at or before t, 0 before
+    any); an anchor (t, angle) is recorded on the System whenever the angle moves pi/4 from it, so the
+    angle of a joint read by a load callable is continuous over the analysis (the System is per analysis)."""
+    hist = sys.__dict__.setdefault("_state_angles", {}).setdefault(name, [])
+    k = bisect.bisect_right(hist, (t, np.inf)) - 1
+    ref = hist[k][1] if k >= 0 else 0.0
+    x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi
+    if abs(x - ref) > 0.25 * np.pi:
+        bisect.insort(hist, (t, x))
+    return x
 
 
 def state_factory(sys):

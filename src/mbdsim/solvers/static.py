@@ -46,6 +46,7 @@ def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
         step = np.linalg.lstsq(A, -r, rcond=None)[0]
         alpha, r_norm = 1.0, np.linalg.norm(r)
         while alpha > 1e-4:
+            _follow_angles(sys, q, alpha * step[:n], t)
             q_try, lam_try = increment(sys, q, alpha * step[:n]), lam + alpha * step[n:]
             r_try, J_try = residual(q_try, lam_try)
             if np.linalg.norm(r_try) < r_norm * (1 - 1e-4 * alpha) or alpha <= 1.5e-4:
@@ -59,6 +60,20 @@ def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
     lam_full[rows] = lam
     return Result(sys, [t], q[None], zero[None], zero[None], lam_full[None], None, True, 0,
                   f"equilibrium in {it} iterations")
+
+
+def _follow_angles(sys, q, dx, t):
+    """Anchor the continued joint angles of torsion springs and rotational stops at their linear prediction
+    for the Newton update q (+) dx, so that equilibria beyond +-pi (a wound-up spring) are found."""
+    from ..model.element_specs import Stop, TorsionSpring
+    from ..system.force_elements._common import element_state, joint_coordinate, load_from_rows
+    fr = None
+    for e in sys.model.forces.values():
+        if isinstance(e, TorsionSpring) or (isinstance(e, Stop) and e.dof == "rotation"):
+            fr = body_frames(sys, q, np.zeros(sys.nv)) if fr is None else fr
+            x, _, rows = joint_coordinate(sys, fr, e.joint, "rotation", e.name, t)
+            pred = float(x[0] + load_from_rows(sys, fr, rows, 1.0) @ dx)
+            element_state(sys, e.name)["angle_ref"] = [(float(t), pred)]
 
 
 def _stiffness(sys, q, lam, t, residual, h=1e-7):

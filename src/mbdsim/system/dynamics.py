@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import kernels
 from .constraints.primitives import cross
 from .force_elements import evaluator
 from .force_elements import loads  # noqa: F401  (registers the built-in evaluators)
@@ -15,16 +16,23 @@ from .frames import Frames
 
 def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
     """Q (nv,): gravity, gyroscopic terms and every force element at one state (frames without time axis)."""
+    Q = inertial_forces(sys, fr)
+    for elem in sys.model.forces.values():
+        Q += evaluator(elem).generalized(sys, fr, elem, t, state)
+    return Q
+
+
+def inertial_forces(sys, fr: Frames) -> np.ndarray:
+    """Q (nv,) of gravity on every CM [N] and the gyroscopic torques -w_B x (J w_B) [N m, body axes]."""
+    if kernels.HAVE_NUMBA:
+        return kernels.inertial_forces_kernel(fr.A, fr.w, sys.mass, sys.inertia_B, sys.rd_idx, sys.w_idx,
+                                              sys.rigid_fid, sys.model.gravity, sys.nv)
     Q = np.zeros(sys.nv)
-    g = sys.model.gravity
-    a = sys.rd_idx
-    Q[a] += sys.mass[1:, None] * g
+    Q[sys.rd_idx] += sys.mass[1:, None] * sys.model.gravity
     rig = sys.rigid_fid
     if len(rig):
         w_B = np.einsum("nji,nj->ni", fr.A[rig], fr.w[rig])
         Q[sys.w_idx] -= cross(w_B, np.einsum("nij,nj->ni", sys.inertia_B[rig], w_B))
-    for elem in sys.model.forces.values():
-        Q += evaluator(elem).generalized(sys, fr, elem, t, state)
     return Q
 
 

@@ -216,3 +216,41 @@ if HAVE_NUMBA:
             n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
             out[p_idx[k, 0]], out[p_idx[k, 1]], out[p_idx[k, 2]], out[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
         return out
+
+
+if HAVE_NUMBA:
+    @njit(cache=True)
+    def qdot_kernel(q, v, r_idx, rd_idx, p_idx, w_idx, nq):
+        """dq/dt: rd for CM positions, pdot = 1/2 p (x) (0, w_B) for Euler parameters."""
+        qd = np.zeros(nq)
+        for k in range(r_idx.shape[0]):
+            for c in range(3):
+                qd[r_idx[k, c]] = v[rd_idx[k, c]]
+        for k in range(p_idx.shape[0]):
+            e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+            x, y, z = v[w_idx[k, 0]], v[w_idx[k, 1]], v[w_idx[k, 2]]
+            qd[p_idx[k, 0]] = 0.5 * (-e1 * x - e2 * y - e3 * z)
+            qd[p_idx[k, 1]] = 0.5 * (e0 * x + e2 * z - e3 * y)
+            qd[p_idx[k, 2]] = 0.5 * (e0 * y - e1 * z + e3 * x)
+            qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
+        return qd
+
+
+if HAVE_NUMBA:
+    @njit(cache=True)
+    def inertial_forces_kernel(A, w, mass, inertia_B, rd_idx, w_idx, rigid_fid, g, nv):
+        """Q (nv,) of gravity m g on every CM and the gyroscopic term -w_B x (J w_B) (body axes)."""
+        Q = np.zeros(nv)
+        for k in range(rd_idx.shape[0]):
+            for c in range(3):
+                Q[rd_idx[k, c]] += mass[k + 1] * g[c]
+        for k in range(rigid_fid.shape[0]):
+            f = rigid_fid[k]
+            wb = np.zeros(3)
+            for i in range(3):
+                wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
+            h = inertia_B[f] @ wb
+            Q[w_idx[k, 0]] -= wb[1] * h[2] - wb[2] * h[1]
+            Q[w_idx[k, 1]] -= wb[2] * h[0] - wb[0] * h[2]
+            Q[w_idx[k, 2]] -= wb[0] * h[1] - wb[1] * h[0]
+        return Q
