@@ -14,21 +14,19 @@ class ModelError(MbdsimError, ValueError):
         super().__init__(f"{entity}.{field}: {message}")
 
 
-class AssemblyError(MbdsimError):
+class _TimedError(MbdsimError):
+    """An analysis failure at a time, naming the joints involved and keeping the last state."""
+
+    def __init__(self, message: str, time: float | None = None, joints=(), state=None):
+        self.time, self.joints, self.state = time, tuple(joints), state
+        where = f" at t = {time:.9g} s" if time is not None else ""
+        names = f" (joints involved: {', '.join(self.joints)})" if self.joints else ""
+        super().__init__(f"{message}{where}{names}")
+
+
+class AssemblyError(_TimedError):
     """The constraints cannot be satisfied (assembly or kinematic position analysis)."""
 
-    def __init__(self, message: str, time: float | None = None, joints=(), state=None):
-        self.time, self.joints, self.state = time, tuple(joints), state
-        where = f" at t = {time:.9g} s" if time is not None else ""
-        names = f" (joints involved: {', '.join(self.joints)})" if self.joints else ""
-        super().__init__(f"{message}{where}{names}")
 
-
-class SolverError(MbdsimError):
+class SolverError(_TimedError):
     """A solver failed (lock-up, singular equations, step size underflow)."""
-
-    def __init__(self, message: str, time: float | None = None, joints=(), state=None):
-        self.time, self.joints, self.state = time, tuple(joints), state
-        where = f" at t = {time:.9g} s" if time is not None else ""
-        names = f" (joints involved: {', '.join(self.joints)})" if self.joints else ""
-        super().__init__(f"{message}{where}{names}")

@@ -31,7 +31,7 @@ from typing import Any, Iterable, Sequence
 
 from mbdsim import __version__ as _mbdsim_version
 from mbdsim.validation.framework import FLOOR, REL_TOL, CaseOutcome, Plot, Quantity
-from mbdsim.validation.registry import outcome_error
+from mbdsim.validation.registry import is_finite, outcome_error
 
 __all__ = [
     "write_report",
@@ -59,13 +59,6 @@ COLUMNS = (
 )
 
 # --------------------------------------------------------------------------- formatting
-
-
-def _finite(x: Any) -> bool:
-    try:
-        return math.isfinite(float(x))
-    except (TypeError, ValueError):
-        return False
 
 
 def fmt_value(x: Any) -> str:
@@ -668,7 +661,7 @@ def _counts(docs: Sequence[_CaseDoc]) -> dict[str, int]:
 
 
 def _max_or_none(values: Iterable[Any]) -> float | None:
-    vals = [float(v) for v in values if v is not None and _finite(v)]
+    vals = [float(v) for v in values if v is not None and is_finite(v)]
     return max(vals) if vals else None
 
 
