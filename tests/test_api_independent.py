@@ -818,3 +818,103 @@ def test_assembly_projects_an_inconsistent_velocity_onto_a_skew_slide():
     gu = np.array([0.0, -G, 0.0]) @ u
     t = res.time
     assert np.allclose(res.velocity(p), np.outer((v0 @ u) + gu * t, u), atol=1e-10)
+
+
+@pytest.mark.parametrize("method", ["dop853", "hht"])
+def test_solver_settings_are_checked_naming_the_field(method):
+    """Negative tolerances or step limits used to hang HHT (atol < 0) or run it backwards in time
+    (max_step < 0); each now raises a ModelError naming simulate.<field>."""
+    model = mb.Model("args", gravity=(0, -G, 0))
+    model.add_particle("p", 1.0)
+    cases = [(dict(rtol=-1e-6), "rtol"), (dict(rtol=0.0), "rtol"), (dict(atol=-1.0), "atol"), (dict(atol=0.0), "atol"),
+             (dict(max_step=-0.1), "max_step"), (dict(max_step=float("nan")), "max_step"),
+             (dict(rtol="tight"), "rtol")]
+    for kw, field in cases:
+        with pytest.raises(mb.ModelError) as ei:
+            mb.simulate(model, 1.0, 0.1, method=method, **kw)
+        assert (ei.value.entity, ei.value.field) == ("simulate", field), str(ei.value)
+    for kw, field in ((dict(output_step=float("nan")), "output_step"), (dict(output_step=float("inf")), "output_step"),
+                      (dict(output_step="fine"), "output_step"), (dict(end_time="end"), "end_time")):
+        kw = dict(dict(end_time=1.0, output_step=0.1), **kw)
+        with pytest.raises(mb.ModelError) as ei:
+            mb.simulate(model, method=method, **kw)
+        assert (ei.value.entity, ei.value.field) == ("analysis", field), str(ei.value)
+    with pytest.raises(mb.ModelError, match="simulate.method"):
+        mb.simulate(model, 1.0, 0.1, method=3)
+    res = mb.simulate(model, 0.2, 0.1, method=method, atol=1e-12, max_step=float("inf"))
+    assert res.success and np.allclose(res.position("p")[:, 1], -0.5 * G * res.time**2, atol=1e-8)
+    with pytest.raises(ValueError, match="outside"):
+        res.at(float("nan"))
+
+
+def test_cylindrical_joint_on_a_turning_arm_driven_in_both_coordinates():
+    """Arm turned about n by a(t); a sleeve on a cylindrical joint along u (fixed on the arm) driven in rotation
+    phi(t) and translation s(t): w_j = a' n + phi' u(t), alpha_j = a'' n + phi'' u(t) + a' phi' n x u(t),
+    and the sleeve CM follows the rotated, slid point."""
+    n, u = unit((0.0, 0.3, 1.0)), unit((1.0, -0.2, 0.4))
+    P, Q = np.array([0.0, 0.1, 0.0]), np.array([0.3, 0.2, -0.1])
+    C = Q + np.array([0.0, 0.05, 0.02])
+    model = mb.Model("sleeve", gravity=(0, 0, -G))
+    arm = model.add_body("arm", 1.0, inertia=(0.01, 0.05, 0.05), position=(Q + P) / 2)
+    sleeve = model.add_body("sleeve", 0.4, inertia=[[2e-3, 1e-4, 0], [1e-4, 3e-3, 0], [0, 0, 2.5e-3]], position=C,
+                            orientation=Rotation.from_rotvec([0.5, 0.0, 0.2]))
+    hub = model.add_revolute("hub", model.ground, arm, P, n)
+    cyl = model.add_cylindrical("cyl", arm, sleeve, Q, u)
+    model.add_motion("turn", hub, displacement="0.8*t")
+    model.add_motion("spin", cyl, displacement="3*t + 0.5*sin(2*t)", dof="rotation")
+    model.add_motion("lift", cyl, acceleration="-0.6*cos(t)", initial_displacement=0.0, initial_velocity=0.2,
+                     dof="translation")
+    res = mb.kinematics(model, 2.0, 0.1)
+    assert res.success, res.message
+    t = res.time
+    a, ad = 0.8 * t, 0.8 + 0 * t
+    ph, phd, phdd = 3 * t + 0.5 * np.sin(2 * t), 3 + np.cos(2 * t), -2 * np.sin(2 * t)
+    s, sd, sdd = 0.2 * t + 0.6 * (np.cos(t) - 1), 0.2 - 0.6 * np.sin(t), -0.6 * np.cos(t)
+    q = res.joint_coordinate(cyl)
+    assert np.allclose(q, np.stack([ph, s], -1), atol=1e-9)
+    assert np.allclose(res.joint_velocity(cyl), np.stack([phd, sd], -1), atol=1e-9)
+    assert np.allclose(res.joint_acceleration(cyl), np.stack([phdd, sdd], -1), atol=1e-8)
+    Ra = rot_about(n, a)
+    ut = apply(Ra, u)
+    assert np.allclose(res.angular_velocity(sleeve), np.outer(ad, n) + phd[:, None] * ut, atol=1e-9)
+    assert np.allclose(res.angular_acceleration(sleeve),
+                       phdd[:, None] * ut + (ad * phd)[:, None] * np.cross(n, ut), atol=1e-8)
+    # sleeve CM: rotate about the sleeve axis (through Q on the arm), slide along it, then turn with the arm
+    Rs = rot_about(u, ph)
+    local = Q - P + s[:, None] * u + apply(Rs, C - Q)
+    assert np.allclose(res.position(sleeve), P + apply(Ra, local), atol=1e-9)
+    assert np.allclose(res.orientation(sleeve), Ra @ Rs @ Rotation.from_rotvec([0.5, 0.0, 0.2]).as_matrix(),
+                       atol=1e-9)
+
+
+def test_spinning_puck_on_an_inclined_planar_joint_gyroscopic_reaction_torque():
+    """A rigid puck (full inertia tensor, principal axes not along the plane normal) spinning at w about the
+    normal n of an inclined planar joint: its CM follows the in-plane projectile, the spin stays, and the
+    joint supplies F = m g_par - m g and, about the CM, the gyroscopic torque w x (J_g w)."""
+    n = unit((0.3, 1.0, 0.2))
+    g = np.array([0.0, -G, 0.0])
+    gp = g - (g @ n) * n
+    C0, v0 = np.array([0.2, 0.1, -0.3]), np.array([1.0, 3.0, -0.5])
+    v0 = v0 - (v0 @ n) * n
+    w, m_ = 7.0, 0.8
+    J = np.array([[0.02, 0.003, -0.001], [0.003, 0.03, 0.002], [-0.001, 0.002, 0.025]])
+    A0 = Rotation.from_rotvec([0.4, -0.3, 0.2]).as_matrix()
+    P0 = C0 + np.array([0.05, -0.02, 0.04])
+    P0 = P0 - ((P0 - C0) @ n) * n
+    model = mb.Model("puck", gravity=g)
+    puck = model.add_body("puck", m_, inertia=J, position=C0, orientation=A0, velocity=v0, angular_velocity=w * n)
+    ice = model.add_planar("ice", model.ground, puck, P0, n)
+    res = mb.simulate(model, 1.0, 0.05, **TIGHT)
+    assert res.success, res.message
+    t = res.time
+    C = C0 + np.outer(t, v0) + 0.5 * np.outer(t**2, gp)
+    assert np.allclose(res.position(puck), C, atol=1e-10)
+    assert np.allclose(res.angular_velocity(puck), np.broadcast_to(w * n, (len(t), 3)), atol=1e-10)
+    R = rot_about(n, w * t)
+    A = R @ A0
+    Wv = np.broadcast_to(w * n, (len(t), 3))
+    T_cm = np.cross(Wv, np.einsum("nij,nj->ni", A @ J @ np.swapaxes(A, 1, 2), Wv))
+    F = np.broadcast_to(m_ * gp - m_ * g, (len(t), 3))
+    P_j = C + apply(R, P0 - C0)                    # the joint point moves with the puck
+    assert np.allclose(res.reaction_force(ice), F, atol=1e-9)
+    assert np.allclose(res.reaction_torque(ice), T_cm + np.cross(C - P_j, F), atol=1e-9)

@@ -36,12 +36,17 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     method: "hht" (default, implicit, error-controlled), "dop853" (high accuracy, index-1 with
     projection), "rk45", "radau", "bdf".  A model with stick/slip joint friction defaults to "dop853",
     whose event-driven mode switching the friction model needs.  rtol/atol: integrator tolerances (relative, absolute in SI)."""
-    method = (method or _default_method(model)).lower()
+    method = method or _default_method(model)
+    if not isinstance(method, str):
+        raise ModelError("simulate", "method", f"expected a method name, got {method!r}")
+    method = method.lower()
     if method not in SCIPY_METHODS and method != "hht":
         raise ModelError("simulate", "method", f"unknown method {method!r}; choose from "
                          f"{sorted(list(SCIPY_METHODS) + ['hht'])}")
     d_rtol, d_atol = DEFAULT_TOL[method]
-    rtol, atol = rtol or d_rtol, atol or d_atol
+    rtol = d_rtol if rtol is None else _positive("rtol", rtol)
+    atol = d_atol if atol is None else _positive("atol", atol)   # 0 divides by zero in the error norms
+    max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
@@ -54,6 +59,18 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
                              "'bdf'); the HHT method cannot include it")
         return integrate_hht(sys, rep, times, rtol, atol, max_step)
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
+
+
+def _positive(field, value, strict=True, finite=True) -> float:
+    """A solver setting > 0 (>= 0 when not strict), else ModelError naming simulate.<field>."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError("simulate", field, f"expected a number, got {value!r}") from None
+    if np.isnan(x) or x < 0 or (strict and x == 0) or (finite and np.isinf(x)):
+        raise ModelError("simulate", field, f"must be {'>' if strict else '>='} 0"
+                         f"{' and finite' if finite else ''}, got {value!r}")
+    return x
 
 
 def _default_method(model) -> str:

@@ -49,11 +49,18 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
 
 def time_grid(t0, t1, step):
     """Output times from t0 to t1 inclusive with spacing step (default (t1-t0)/500) [s]."""
+    try:
+        t1 = float(t1)
+    except (TypeError, ValueError):
+        raise ModelError("analysis", "end_time", f"expected a number, got {t1!r}") from None
     if not np.isfinite(t1) or t1 <= t0:
         raise ModelError("analysis", "end_time", f"must be greater than the start time {t0}, got {t1!r}")
-    step = (t1 - t0) / 500 if step is None else float(step)
-    if step <= 0:
-        raise ModelError("analysis", "output_step", f"must be positive, got {step!r}")
+    try:
+        step = (t1 - t0) / 500 if step is None else float(step)
+    except (TypeError, ValueError):
+        raise ModelError("analysis", "output_step", f"expected a number, got {step!r}") from None
+    if not (step > 0 and np.isfinite(step)):   # also NaN
+        raise ModelError("analysis", "output_step", f"must be positive and finite, got {step!r}")
     n = max(1, int(np.ceil((t1 - t0) / step - 1e-9)))
     return np.linspace(t0, t1, n + 1) if abs(n * step - (t1 - t0)) < 1e-9 * step else \
         np.append(t0 + step * np.arange(n), t1)
