@@ -54,7 +54,8 @@ class Result:
         """The same Result API at time(s) t [s], evaluated from the solver's dense output."""
         ts = np.atleast_1d(np.asarray(t, dtype=float))
         lo, hi = self.time[0], self.time[-1]
-        if not np.all(np.isfinite(ts)) or np.any(ts < lo - 1e-12 * max(1, abs(lo))) or np.any(ts > hi + 1e-12 * max(1, abs(hi))):
+        if not np.all(np.isfinite(ts)) or np.any(ts < lo - 1e-12 * max(1, abs(lo))) or \
+                np.any(ts > hi + 1e-12 * max(1, abs(hi))):
             raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
         if self._evaluate is None:
             idx = [int(np.argmin(np.abs(self.time - x))) for x in ts]
