@@ -131,19 +131,38 @@ class Result:
 
     def joint_coordinate(self, joint):
         """Relative angle [rad] or displacement [m] of body_j w.r.t. body_i, unwrapped; (N, 2) [angle, slide]
-        for a cylindrical joint."""
+        for a cylindrical joint; (N, 3) [u, v along the plane axes, angle] for a planar joint; for
+        spherical, universal and fixed joints the rotation vector [rad] (N, 3) of j relative to its initial
+        attitude, in body_i axes."""
+        jt = self._joint(joint)
+        if jt.kind in ROTATION_JOINTS:
+            return ms.relative_rotation_vector(self.system, self.frames, jt)
+        if jt.kind == "planar":
+            return ms.planar_coordinates(self.system, self.frames, jt)[0]
         ang, _, sl, _ = self._coord(joint)
         return _pick(ang, sl)
 
     def joint_velocity(self, joint):
-        """Rate of the joint coordinate [rad/s or m/s]."""
+        """Rate of the joint coordinate [rad/s or m/s]; for spherical, universal and fixed joints the
+        angular velocity of j relative to i [rad/s] in body_i axes."""
+        jt = self._joint(joint)
+        if jt.kind in ROTATION_JOINTS:
+            return ms.relative_angular_velocity(self.system, self.frames, jt)[0]
+        if jt.kind == "planar":
+            return ms.planar_coordinates(self.system, self.frames, jt)[1]
         _, angd, _, sld = self._coord(joint)
         return _pick(angd, sld)
 
     def joint_acceleration(self, joint):
-        """Second derivative of the joint coordinate [rad/s^2 or m/s^2]."""
+        """Second derivative of the joint coordinate [rad/s^2 or m/s^2]; for spherical, universal and fixed
+        joints the time derivative, in body_i axes, of the relative angular velocity [rad/s^2]."""
         self._need_acc("joint_acceleration")
         jt = self._joint(joint)
+        if jt.kind in ROTATION_JOINTS:
+            return ms.relative_angular_velocity(self.system, self.frames, jt)[1]
+        if jt.kind == "planar":
+            raise ModelError(f"joint '{jt.name}'", "joint", "joint_acceleration of a planar joint is not "
+                             "available; use acceleration()/angular_acceleration() of its bodies")
         g = self.system.geoms[jt.name]
         fr = self.frames
         rel_acc_rot = fr.alpha[:, g.bj] - fr.alpha[:, g.bi]
@@ -318,6 +337,9 @@ def _unwrap_with_rate(t, ang, rate):
     inc = pred + (np.diff(ang) - pred + np.pi) % (2 * np.pi) - np.pi
     cont = ang[0] + np.concatenate([[0.0], np.cumsum(inc)])
     return ang + 2 * np.pi * np.round((cont - ang) / (2 * np.pi))   # the raw values, shifted by whole turns
+
+
+ROTATION_JOINTS = ("spherical", "universal", "fixed")
 
 
 def _pick(ang, sl):

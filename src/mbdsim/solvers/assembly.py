@@ -47,6 +47,8 @@ class AssemblyReport:
 
 def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
     """Solve phi(q, t) = 0 and phi_q v = nu from the model's initial values (minimum-norm corrections)."""
+    from .kinematic import check_model
+    check_model(model)
     sys = assemble_system(model)
     return assemble_state(sys, sys.q0, sys.v0, t, tol)
 

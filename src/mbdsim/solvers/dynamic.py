@@ -20,7 +20,7 @@ from ..system.force_elements import evaluator
 from .assembly import assemble_state
 from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
 from .events import EventTracker
-from .kinematic import time_grid
+from .kinematic import check_model, time_grid
 from .state import state_factory
 
 SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, "rk45": integrate.RK45,
@@ -36,6 +36,7 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     method: "hht" (default, implicit, error-controlled), "dop853" (high accuracy, index-1 with
     projection), "rk45", "radau", "bdf".  A model with stick/slip joint friction defaults to "dop853",
     whose event-driven mode switching the friction model needs.  rtol/atol: integrator tolerances (relative, absolute in SI)."""
+    check_model(model)
     method = method or _default_method(model)
     if not isinstance(method, str):
         raise ModelError("simulate", "method", f"expected a method name, got {method!r}")
@@ -45,7 +46,9 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
                          f"{sorted(list(SCIPY_METHODS) + ['hht'])}")
     d_rtol, d_atol = DEFAULT_TOL[method]
     rtol = d_rtol if rtol is None else _positive("rtol", rtol)
-    atol = d_atol if atol is None else _positive("atol", atol)   # 0 divides by zero in the error norms
+    # atol follows a user's rtol in the default ratio, so that rtol alone tightens (or loosens) the run;
+    # atol = 0 would divide by zero in the error norms
+    atol = d_atol * rtol / d_rtol if atol is None else _positive("atol", atol)
     max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)

@@ -20,6 +20,7 @@ from .state import state_factory
 def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s]."""
     from ..system.assemble import assemble_system
+    check_model(model)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
     if rep.dof > 0:
@@ -45,6 +46,13 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
     res = _result(sys, out, ev, success, message)
     res.error = error
     return res
+
+
+def check_model(model):
+    """ModelError unless `model` is an mbdsim Model."""
+    from ..model.model import Model
+    if not isinstance(model, Model):
+        raise ModelError("analysis", "model", f"expected an mbdsim.Model, got {type(model).__name__}")
 
 
 def time_grid(t0, t1, step):

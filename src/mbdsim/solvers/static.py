@@ -21,6 +21,8 @@ from .state import state_factory
 
 def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
     """Static equilibrium at time t [s]: a single-time Result (velocities and accelerations zero)."""
+    from .kinematic import check_model
+    check_model(model)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), t)
     rows, sf = rep.rows, state_factory(sys)

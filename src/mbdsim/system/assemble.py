@@ -12,6 +12,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import warnings
+
 import numpy as np
 
 from ..errors import ModelError
@@ -139,6 +141,7 @@ def _row_specs(model, fid):
                              f"{jt.kind} joint (it has no orientation to carry the joint axes)")
         g = joint_geometry(jt, fid)
         geoms[jt.name] = g
+        _warn_particle_offset(jt, g)
         specs += _placed(JOINT_TYPES[jt.kind].rows(g), g)
     for m in model.motions.values():
         g = geoms[m.joint.name]
@@ -146,6 +149,18 @@ def _row_specs(model, fid):
             raise ModelError(f"motion '{m.name}'", "joint", "cannot drive a rotation of a particle")
         specs += _placed(driver_rows(g, m.dof, m.function, m.name), g)
     return specs, geoms
+
+
+def _warn_particle_offset(jt, g):
+    """A particle has no rotation: a point joint away from its position pins the particle itself."""
+    if jt.kind not in ("revolute", "spherical", "universal", "fixed"):
+        return
+    for particle, s in ((jt.body_i, g.s_i), (jt.body_j, g.s_j)):
+        if particle.is_particle and np.linalg.norm(s) > 1e-9:
+            warnings.warn(f"joint '{jt.name}': its point is {np.linalg.norm(s):.6g} m from particle "
+                          f"'{particle.name}', which has no rotation, so the particle is held at a fixed "
+                          "offset from the joint point (it cannot swing about it); use a rigid body (e.g. a "
+                          "massless link) to make a pendulum", UserWarning, stacklevel=4)
 
 
 def _placed(rows, g):

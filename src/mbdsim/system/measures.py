@@ -106,3 +106,44 @@ def kinetic_energy(sys, fr) -> np.ndarray:
 def gravity_potential(sys, fr) -> np.ndarray:
     """Gravity potential energy (N,) [J], zero at the ground origin."""
     return -np.einsum("f,nfi,i->n", sys.mass, fr.r, sys.model.gravity)
+
+
+def relative_rotation_vector(sys, fr, joint):
+    """Rotation vector [rad] (N, 3) of body_j relative to its initial attitude w.r.t. body_i, in body_i axes."""
+    from scipy.spatial.transform import Rotation
+    g = sys.geoms[joint.name]
+    R0 = joint.body_i.orientation.T @ joint.body_j.orientation
+    Ai, Aj = fr.A[:, g.bi], fr.A[:, g.bj]
+    R = np.einsum("nji,njk->nik", Ai, Aj) @ R0.T
+    return Rotation.from_matrix(R).as_rotvec()
+
+
+def relative_angular_velocity(sys, fr, joint):
+    """Angular velocity [rad/s] of j relative to i and its derivative [rad/s^2] (N, 3), body_i axes."""
+    g = sys.geoms[joint.name]
+    Ai = fr.A[:, g.bi]
+    dw = fr.w[:, g.bj] - fr.w[:, g.bi]
+    w_rel = np.einsum("nji,nj->ni", Ai, dw)
+    acc = None
+    if fr.alpha is not None:
+        w_iB = np.einsum("nji,nj->ni", Ai, fr.w[:, g.bi])
+        acc = np.einsum("nji,nj->ni", Ai, fr.alpha[:, g.bj] - fr.alpha[:, g.bi]) - np.cross(w_iB, w_rel)
+    return w_rel, acc
+
+
+def planar_coordinates(sys, fr, joint):
+    """[u, v, angle] (N, 3) of a planar joint (u, v along f_i, g_i [m]; angle about h_i [rad], wrapped)
+    and their rates (N, 3)."""
+    g = sys.geoms[joint.name]
+    N = fr.r.shape[0]
+    ff, bi, bj = flat(fr, g.bi, g.bj)
+    rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
+    u = pr.dot2(ff, bi, bj, rep(g.f_i), rep(g.s_i), rep(g.s_j)).phi
+    v = pr.dot2(ff, bi, bj, rep(g.g_i), rep(g.s_i), rep(g.s_j)).phi
+    ud = pr.dot2_rate(ff, bi, bj, rep(g.f_i), rep(g.s_i), rep(g.s_j))
+    vd = pr.dot2_rate(ff, bi, bj, rep(g.g_i), rep(g.s_i), rep(g.s_j))
+    if g.particle_j:
+        z = np.zeros(N)
+        return np.stack([u, v, z], -1), np.stack([ud, vd, z], -1)
+    ang, _, angd = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
+    return np.stack([u, v, np.unwrap(ang)], -1), np.stack([ud, vd, angd], -1)
