@@ -6,16 +6,22 @@ import numpy as np
 from ..errors import ModelError
 
 
-def vec3(entity: str, field: str, value, unit: bool = False) -> np.ndarray:
-    """A finite 3-vector (a unit vector when unit=True), else ModelError."""
+def vector(entity: str, field: str, value, n: int = 3, what: str = "") -> np.ndarray:
+    """A finite n-vector, else ModelError (`what` names the components in the message)."""
     try:
         v = np.asarray(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
-        raise ModelError(entity, field, f"expected 3 numbers, got {value!r}") from None
-    if v.shape != (3,):
-        raise ModelError(entity, field, f"expected 3 numbers, got {value!r}")
+        raise ModelError(entity, field, f"expected {n} numbers, got {value!r}") from None
+    if v.shape != (n,):
+        raise ModelError(entity, field, f"expected {n} numbers{what}, got {value!r}")
     if not np.all(np.isfinite(v)):
         raise ModelError(entity, field, f"values must be finite, got {value!r}")
+    return v
+
+
+def vec3(entity: str, field: str, value, unit: bool = False) -> np.ndarray:
+    """A finite 3-vector (a unit vector when unit=True), else ModelError."""
+    v = vector(entity, field, value, 3)
     if unit:
         n = np.linalg.norm(v)
         if n < 1e-12:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from ._check import scalar
+from ._check import scalar, vector
 from .element_specs import Bushing, Contact, Stop, TorsionSpring
 from .shapes import attach
 
@@ -125,10 +125,5 @@ class ForceElementsMixin:
 
 
 def _six(entity, field, values, minimum=None) -> np.ndarray:
-    try:
-        a = np.asarray(values, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
-        raise ModelError(entity, field, f"expected 6 numbers, got {values!r}") from None
-    if a.shape != (6,):
-        raise ModelError(entity, field, f"expected 6 numbers (x, y, z, rx, ry, rz), got {values!r}")
+    a = vector(entity, field, values, 6, " (x, y, z, rx, ry, rz)")
     return np.array([scalar(entity, f"{field}[{k}]", x, minimum=minimum) for k, x in enumerate(a)])
