@@ -13,7 +13,6 @@ import scipy.optimize as so
 from ..errors import ModelError
 from ..model.joints import Joint
 from ..system import measures as ms
-from ..system.equations import constraint_terms
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
 

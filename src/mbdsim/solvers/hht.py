@@ -23,7 +23,7 @@ from ..results.result import Result
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
-from .common import accelerations, increment, project_positions, project_velocities
+from .common import accelerations, increment, project_positions
 from .dynamic import consistent_state
 from .events import EventTracker
 from .state import state_factory
