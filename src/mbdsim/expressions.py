@@ -54,6 +54,9 @@ class Expr:
         return self._source if self._source is not None else _text(self.node)
 
     def evaluate(self, *args, **kwargs):
+        if not kwargs and len(args) == 1 == len(self.variables) and type(args[0]) in (float, int, np.float64):
+            with np.errstate(all="ignore"):   # fast path: one real scalar (the solvers' hot path)
+                return float(_eval(self.node, {self.variables[0]: float(args[0])}))
         if len(args) > len(self.variables):
             raise TypeError(f"expression of {self.variables} got {len(args)} positional values")
         values = dict(zip(self.variables, args), **kwargs)
