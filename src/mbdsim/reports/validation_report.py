@@ -379,6 +379,11 @@ def _draw_mechanism(outcome: CaseOutcome) -> bytes:
     allpts += [p for _, p in ground_pts]
     for _, a, b in spring_geo:
         allpts += [a, b]
+    curve_geo, shape_geo = _curves_and_shapes(model, forces)
+    for _, pts in curve_geo:
+        allpts += list(pts)
+    for _, kind, c, _ in shape_geo:
+        allpts.append(c)
     if not allpts:
         raise ValueError("the model has no drawable points (bodies, markers or joints)")
     P = np.array(allpts)
@@ -497,6 +502,20 @@ def _draw_mechanism(outcome: CaseOutcome) -> bytes:
     for (x, y), labels in joint_labels.values():  # joints sharing a point share one label
         ax.annotate(", ".join(labels), (x, y), xytext=(5, -7), textcoords="offset points",
                     fontsize=7, color="black", va="top")
+    for cname, pts in curve_geo:   # path constraints: the curve at t = 0
+        ax.plot(pts[:, ix], pts[:, iy], color="0.35", lw=1.2, ls="-", zorder=2)
+        ax.annotate(cname, xy(pts[len(pts) // 2]), xytext=(4, 4), textcoords="offset points", fontsize=7,
+                    color="0.3")
+    for sname, kind, c, extra in shape_geo:   # contact shapes
+        x, y = xy(c)
+        if kind == "sphere":
+            from matplotlib.patches import Circle
+            ax.add_patch(Circle((x, y), extra, facecolor="none", edgecolor="#8c564b", lw=1.2, zorder=4))
+        else:   # plane: its trace, perpendicular to the projected normal
+            n2 = np.array([extra[ix], extra[iy]])
+            t2 = np.array([-n2[1], n2[0]]) / max(np.linalg.norm(n2), 1e-12) * 0.6 * scale
+            ax.plot([x - t2[0], x + t2[0]], [y - t2[1], y + t2[1]], color="#8c564b", lw=1.6, zorder=2)
+        ax.annotate(sname, (x, y), xytext=(4, -10), textcoords="offset points", fontsize=7, color="#8c564b")
     legend = []
     if joint_legend:
         legend.append("joints: " + "; ".join(joint_legend))
@@ -522,6 +541,32 @@ def _draw_mechanism(outcome: CaseOutcome) -> bytes:
     plane = axis_names[ix] + "-" + axis_names[iy]
     ax.set_title(f"Case {outcome.info.number:02d}: model at t = 0 ({plane} projection)", fontsize=10)
     return _to_png(fig)
+
+
+def _curves_and_shapes(model, forces):
+    """Path curves [(name, (K, 3) points)] and contact shapes [(name, kind, centre, radius | normal)] at t = 0,
+    all in ground; anything missing or malformed is skipped."""
+    import numpy as np
+    curves, shapes = [], []
+    for name, pc in _items(getattr(model, "path_constraints", None)):
+        try:
+            a, b = pc.curve.s_range
+            pts = np.array([pc.curve.point(x) for x in np.linspace(a, b, 200)], dtype=float)
+            if pts.shape[1:] == (3,) and np.all(np.isfinite(pts)):
+                curves.append((getattr(pc, "name", name), pts))
+        except Exception:  # noqa: BLE001 - a figure never stops the report
+            continue
+    for name, f in forces:
+        for side in ("shape_i", "shape_j"):
+            sh = getattr(f, side, None)
+            body = getattr(sh, "body", None)
+            try:
+                c = np.asarray(body.position, float) + np.asarray(body.orientation, float) @ np.asarray(sh.s_B, float)
+                extra = sh.radius if sh.kind == "sphere" else np.asarray(body.orientation, float) @ sh.n_B
+                shapes.append((f"{name}.{side[-1]}", sh.kind, c, extra))
+            except Exception:  # noqa: BLE001
+                continue
+    return curves, shapes
 
 
 def _draw_plot(plot: Plot) -> bytes:
