@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbdsim.validation.cases._slider_crank import build_slider_crank
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -66,16 +67,6 @@ CASE = CaseInfo(
 )
 
 
-def geometry(theta: float = THETA):
-    """Positions [m] of O, B, A, G in ground for the crank angle theta (angle AOB) [rad]."""
-    beta = np.arcsin(R / L * np.sin(theta))
-    O = np.zeros(3)
-    B = np.array([-R * np.cos(theta), R * np.sin(theta), 0.0])
-    A = np.array([-(R * np.cos(theta) + L * np.cos(beta)), 0.0, 0.0])
-    G = A + L1 * np.array([np.cos(beta), np.sin(beta), 0.0])
-    return O, B, A, G
-
-
 def theory() -> dict:
     """Relative-velocity solution of the manual (law of sines), in full precision."""
     beta = np.arcsin(R / L * np.sin(THETA))                 # rod angle to the piston line
@@ -89,25 +80,9 @@ def theory() -> dict:
 
 
 def build_model(theta0: float = THETA):
-    """Slider-crank at crank angle theta0, crank driven clockwise at OMEGA."""
-    import mbdsim as mb
-
-    O, B, A, G = geometry(theta0)
-    beta = np.arcsin(R / L * np.sin(theta0))
-    model = mb.Model("case11_engine", gravity=(0.0, 0.0, 0.0))
-    rz = lambda a: np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1.0]])
-    m_c, m_r, m_p = 1.0, 2.0, 1.5                      # nominal masses [kg]
-    crank = model.add_body("crank", mass=m_c, inertia=(1e-4, m_c * R**2 / 12, m_c * R**2 / 12),
-                           position=(O + B) / 2, orientation=rz(np.pi - theta0))
-    rod = model.add_body("rod", mass=m_r, inertia=(1e-4, m_r * L**2 / 12, m_r * L**2 / 12),
-                         position=G, orientation=rz(beta))
-    piston = model.add_body("piston", mass=m_p, inertia=(1e-3, 1e-3, 1e-3), position=A)
-    model.add_revolute("rev_O", model.ground, crank, point=O, axis=(0, 0, -1))
-    model.add_revolute("rev_B", crank, rod, point=B, axis=(0, 0, 1))
-    model.add_revolute("rev_A", rod, piston, point=A, axis=(0, 0, 1))
-    model.add_translational("slider_A", model.ground, piston, point=A, axis=(1, 0, 0))
-    model.add_motion("crank_drive", "rev_O", displacement="50*pi*t")
-    return model
+    """Engine at crank angle theta0 [rad]; rod CM G at L1 from A; crank driven clockwise at 1500 rev/min."""
+    return build_slider_crank("case11_engine", R, L, theta0, "50*pi*t", masses=(1.0, 2.0, 1.5),
+                              rod_cm_from_A=L1)
 
 
 def run() -> CaseOutcome:

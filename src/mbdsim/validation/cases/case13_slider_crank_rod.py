@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbdsim.validation.cases._slider_crank import build_slider_crank
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -49,14 +50,6 @@ CASE = CaseInfo(
 )
 
 
-def geometry(theta: float = THETA):
-    """O, B, A [m] in ground and rod angle beta [rad] for crank angle theta."""
-    beta = np.arcsin(R / L * np.sin(theta))
-    B = np.array([-R * np.cos(theta), R * np.sin(theta), 0.0])
-    A = np.array([-(R * np.cos(theta) + L * np.cos(beta)), 0.0, 0.0])
-    return np.zeros(3), B, A, beta
-
-
 def theory() -> dict:
     """The manual's closed forms for beta_dot and beta_ddot (theta_ddot = 0), full precision."""
     k = R / L
@@ -68,22 +61,8 @@ def theory() -> dict:
 
 def build_model(theta0: float = THETA):
     """Slider-crank at crank angle theta0 [rad], crank driven clockwise at OMEGA0."""
-    import mbdsim as mb
-
-    O, B, A, beta = geometry(theta0)
-    rz = lambda a: np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1.0]])
-    model = mb.Model("case13_slider_crank", gravity=(0.0, 0.0, 0.0))
-    crank = model.add_body("crank", mass=0.5, inertia=(1e-5, 0.5 * R**2 / 12, 0.5 * R**2 / 12),
-                           position=(O + B) / 2, orientation=rz(np.pi - theta0))
-    rod = model.add_body("rod", mass=1.0, inertia=(1e-5, L**2 / 12, L**2 / 12),
-                         position=(A + B) / 2, orientation=rz(beta))
-    slider = model.add_body("slider", mass=0.5, inertia=(1e-4, 1e-4, 1e-4), position=A)
-    model.add_revolute("rev_O", model.ground, crank, point=O, axis=(0, 0, -1))
-    model.add_revolute("rev_B", crank, rod, point=B, axis=(0, 0, 1))
-    model.add_revolute("rev_A", rod, slider, point=A, axis=(0, 0, 1))
-    model.add_translational("slider_A", model.ground, slider, point=A, axis=(1, 0, 0))
-    model.add_motion("crank_drive", "rev_O", displacement="3*t")
-    return model
+    return build_slider_crank("case13_slider_crank", R, L, theta0, "3*t", masses=(0.5, 1.0, 0.5),
+                              slider="slider", axial_inertia=1e-5)
 
 
 def run() -> CaseOutcome:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import brentq
 
+from mbdsim.validation.cases._slider_crank import build_slider_crank
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -79,24 +80,8 @@ def theory() -> dict:
 
 
 def build_model():
-    """Slider-crank at dead centre (theta = 0), crank driven clockwise at OMEGA."""
-    import mbdsim as mb
-
-    B = np.array([-R, 0.0, 0.0])
-    A = np.array([-(R + L), 0.0, 0.0])
-    flip = np.diag([-1.0, -1.0, 1.0])                     # body x axis along -x (O -> B)
-    model = mb.Model("case19_piston", gravity=(0.0, 0.0, 0.0))
-    crank = model.add_body("crank", mass=1.0, inertia=(1e-4, R**2 / 12, R**2 / 12), position=B / 2,
-                           orientation=flip)
-    rod = model.add_body("rod", mass=2.0, inertia=(1e-4, 2 * L**2 / 12, 2 * L**2 / 12),
-                         position=(A + B) / 2)
-    piston = model.add_body("piston", mass=1.5, inertia=(1e-3, 1e-3, 1e-3), position=A)
-    model.add_revolute("rev_O", model.ground, crank, point=(0, 0, 0), axis=(0, 0, -1))
-    model.add_revolute("rev_B", crank, rod, point=B, axis=(0, 0, 1))
-    model.add_revolute("rev_A", rod, piston, point=A, axis=(0, 0, 1))
-    model.add_translational("slider_A", model.ground, piston, point=A, axis=(1, 0, 0))
-    model.add_motion("crank_drive", "rev_O", displacement="50*pi*t")
-    return model
+    """Engine at top dead centre (theta = 0), crank driven clockwise at 1500 rev/min."""
+    return build_slider_crank("case19_piston", R, L, 0.0, "50*pi*t", masses=(1.0, 2.0, 1.5))
 
 
 def run() -> CaseOutcome:
