@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbdsim.validation.cases._common import one_revolution
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -96,13 +97,9 @@ def build_model(theta0: float = THETA):
 
 
 def run() -> CaseOutcome:
-    import mbdsim as mb
-
     model = build_model()
     arm, crank_joint = model.bodies["arm"], model.joints["rev_O"]
-    period = 2 * np.pi / OMEGA
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
-    t45 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
+    res, t45 = one_revolution(model, crank_joint, OMEGA)
     w = float(res.at(t45).angular_velocity(arm)[0, 2])
     th = theory()
     q = [Quantity("omega_AB", "rad/s", th["omega_AB"], *MANUAL["omega_AB"], w,

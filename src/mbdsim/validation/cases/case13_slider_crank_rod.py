@@ -8,6 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from mbdsim.validation.cases._slider_crank import build_slider_crank
+from mbdsim.validation.cases._common import one_revolution
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -66,13 +67,9 @@ def build_model(theta0: float = THETA):
 
 
 def run() -> CaseOutcome:
-    import mbdsim as mb
-
     model = build_model()
     rod, crank_joint = model.bodies["rod"], model.joints["rev_O"]
-    period = 2 * np.pi / OMEGA0
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
-    t60 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
+    res, t60 = one_revolution(model, crank_joint, OMEGA0)
     at = res.at(t60)
     w = float(at.angular_velocity(rod)[0, 2])
     a = float(at.angular_acceleration(rod)[0, 2])

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbdsim.validation.cases._common import one_revolution
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -100,15 +101,11 @@ def build_model(theta0: float = THETA):
 
 
 def run() -> CaseOutcome:
-    import mbdsim as mb
-
     O, C, A, B = geometry()
     model = build_model()
     link, crank_joint = model.bodies["link_CB"], model.joints["rev_O"]
     mB = link.add_marker("B", point=B)          # end B of the link
-    period = 2 * np.pi / OMEGA_OA
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
-    t30 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
+    res, t30 = one_revolution(model, crank_joint, OMEGA_OA)
     at = res.at(t30)
     w = float(at.angular_velocity(link)[0, 2])
     v_B = float(np.linalg.norm(at.velocity(mB)[0]))

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from mbdsim.validation.cases._common import one_revolution
 from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 # ----------------------------------------------------------------------------- given data
@@ -100,13 +101,9 @@ def build_model():
 
 
 def run() -> CaseOutcome:
-    import mbdsim as mb
-
     model = build_model()
     rod, crank_joint = model.bodies["rod_BD"], model.joints["rev_O"]
-    period = 2 * np.pi / OMEGA0
-    res = mb.kinematics(model, end_time=1.25 * period, output_step=period / 100)
-    t1 = float(res.crossings(lambda r: r.joint_coordinate(crank_joint), 2 * np.pi)[0])
+    res, t1 = one_revolution(model, crank_joint, OMEGA0)
     a = float(res.at(t1).angular_acceleration(rod)[0, 2])
     th = theory()
     q = [Quantity("alpha_BD", "rad/s^2", th["alpha_BD"], *MANUAL["alpha_BD"], a,
