@@ -16,8 +16,10 @@ from scipy import integrate
 from ..errors import MbdsimError, ModelError, SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
+from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
 from .assembly import assemble_state
+from .compiled_run import integrate_compiled
 from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
 from .events import EventTracker
 from .kinematic import check_model, time_grid
@@ -25,6 +27,8 @@ from .state import state_factory
 
 SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, "rk45": integrate.RK45,
                  "radau": integrate.Radau, "bdf": integrate.BDF}
+COMPILED_METHODS = ("dop853", "high-accuracy")   # run by the compiled step loop when the model allows
+USE_COMPILED = True   # False: always the reference scipy path (tests compare the two)
 DEFAULT_TOL = {"dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
                "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-5, 1e-7)}
 
@@ -61,6 +65,11 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
                              "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
                              "'bdf'); the HHT method cannot include it")
         return integrate_hht(sys, rep, times, rtol, atol, max_step)
+    if method in COMPILED_METHODS and USE_COMPILED:
+        try:
+            return integrate_compiled(sys, rep, times, rtol, atol, max_step)
+        except NotCompiled:
+            pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
 
 

@@ -70,16 +70,31 @@ if HAVE_NUMBA:
         return (s * a[0], s * a[1], s * a[2])
 
     @njit(cache=True)
-    def _scatter(J, row, b, Jr, Jp, A, vadr, rigid):
+    def _put(Jc, row, side, b, Jr, Jp, A, rigid):
+        """Row coefficients of frame b (side 0: body_i, 1: body_j): translation, then body-axes rotation Jp A."""
+        for k in range(6):
+            Jc[row, side, k] = 0.0
         if b == 0:
             return
-        c = vadr[b]
-        J[row, c] += Jr[0]
-        J[row, c + 1] += Jr[1]
-        J[row, c + 2] += Jr[2]
+        Jc[row, side, 0] = Jr[0]
+        Jc[row, side, 1] = Jr[1]
+        Jc[row, side, 2] = Jr[2]
         if rigid[b]:
             for k in range(3):  # body axes: Jp A
-                J[row, c + 3 + k] += Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
+                Jc[row, side, 3 + k] = Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
+
+    @njit(cache=True)
+    def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
+        """Dense phi_q (nc, nv) from the compact rows Jc (nc, 2, 6); J zeroed by the caller."""
+        for row in range(Jc.shape[0]):
+            for side in range(2):
+                b = bi_[row] if side == 0 else bj_[row]
+                if b == 0:
+                    continue
+                c = vadr[b]
+                n = 6 if rigid[b] else 3
+                for k in range(n):
+                    J[row, c + k] += Jc[row, side, k]
 
     @njit(cache=True)
     def _dot1(A, w, bi, bj, ai_B, aj_B):
@@ -94,13 +109,16 @@ if HAVE_NUMBA:
         return _dt(ai, aj), c, quad, rate
 
     @njit(cache=True)
-    def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
-                          phi, J, nu, gamma):
-        """Fill phi, J (zeroed by the caller), nu, gamma for every row."""
+    def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
+        """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row.
+
+        Jc[row, 0] holds the row's coefficients on body_i's velocity variables (CM velocity [m/s],
+        body-axes angular velocity [rad/s]), Jc[row, 1] those on body_j's (zero for ground)."""
         zero = (0.0, 0.0, 0.0)
         for row in range(kind.shape[0]):
             k = kind[row]
             bi, bj = bi_[row], bj_[row]
+            nu[row] = 0.0
             wi = (w[bi, 0], w[bi, 1], w[bi, 2])
             wj = (w[bj, 0], w[bj, 1], w[bj, 2])
             if k <= 2:
@@ -113,14 +131,14 @@ if HAVE_NUMBA:
                 ski = _cr(si, e)
                 skj = _cr(sj, e)
                 ski = (-ski[0], -ski[1], -ski[2])
-                _scatter(J, row, bi, (-e[0], -e[1], -e[2]), ski, A, vadr, rigid)
-                _scatter(J, row, bj, e, skj, A, vadr, rigid)
+                _put(Jc, row, 0, bi, (-e[0], -e[1], -e[2]), ski, A, rigid)
+                _put(Jc, row, 1, bj, e, skj, A, rigid)
                 phi[row] = ph
                 gamma[row] = -qd
             elif k == 3:
                 val, c, quad, _ = _dot1(A, w, bi, bj, v1[row], v2[row])
-                _scatter(J, row, bi, zero, c, A, vadr, rigid)
-                _scatter(J, row, bj, zero, _sc(-1.0, c), A, vadr, rigid)
+                _put(Jc, row, 0, bi, zero, c, A, rigid)
+                _put(Jc, row, 1, bj, zero, _sc(-1.0, c), A, rigid)
                 phi[row] = val
                 gamma[row] = -quad
             elif k == 4 or k == 6:
@@ -133,8 +151,8 @@ if HAVE_NUMBA:
                 wai = _cr(wi, ai)
                 quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
                         + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
-                _scatter(J, row, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, vadr, rigid)
-                _scatter(J, row, bj, ai, _cr(sj, ai), A, vadr, rigid)
+                _put(Jc, row, 0, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, rigid)
+                _put(Jc, row, 1, bj, ai, _cr(sj, ai), A, rigid)
                 phi[row] = _dt(ai, d)
                 gamma[row] = -quad
                 if k == 6:
@@ -148,8 +166,8 @@ if HAVE_NUMBA:
                 rho2 = S * S + C * C
                 N = C * Sd - S * Cd
                 Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
-                _scatter(J, row, bi, zero, Jp, A, vadr, rigid)
-                _scatter(J, row, bj, zero, _sc(-1.0, Jp), A, vadr, rigid)
+                _put(Jc, row, 0, bi, zero, Jp, A, rigid)
+                _put(Jc, row, 1, bj, zero, _sc(-1.0, Jp), A, rigid)
                 quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
                 n = drv[row]
                 dth = np.arctan2(S, C) - f[n]
@@ -160,16 +178,26 @@ if HAVE_NUMBA:
 
 if HAVE_NUMBA:
     @njit(cache=True)
-    def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
-        """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
-        r = np.zeros((nf, 3))
-        A = np.zeros((nf, 3, 3))
-        rd = np.zeros((nf, 3))
-        w = np.zeros((nf, 3))
+    def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
+                          phi, J, nu, gamma):
+        """Fill phi, the dense J (nc, nv; zeroed by the caller), nu, gamma for every row."""
+        Jc = np.empty((kind.shape[0], 2, 6))
+        rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma)
+        scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
+
+
+if HAVE_NUMBA:
+    @njit(cache=True)
+    def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
+        """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""
+        nf = r.shape[0]
         for f in range(nf):
-            A[f, 0, 0] = 1.0
-            A[f, 1, 1] = 1.0
-            A[f, 2, 2] = 1.0
+            for c in range(3):
+                r[f, c] = 0.0
+                rd[f, c] = 0.0
+                w[f, c] = 0.0
+                for d in range(3):
+                    A[f, c, d] = 1.0 if c == d else 0.0
         for k in range(r_idx.shape[0]):
             for c in range(3):
                 r[k + 1, c] = q[r_idx[k, c]]
@@ -191,6 +219,15 @@ if HAVE_NUMBA:
             for c in range(3):
                 w[f, c] = (A[f, c, 0] * v[w_idx[k, 0]] + A[f, c, 1] * v[w_idx[k, 1]]
                            + A[f, c, 2] * v[w_idx[k, 2]])
+
+    @njit(cache=True)
+    def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
+        """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
+        r = np.zeros((nf, 3))
+        A = np.zeros((nf, 3, 3))
+        rd = np.zeros((nf, 3))
+        w = np.zeros((nf, 3))
+        frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
         return r, A, rd, w
 
 

@@ -1,0 +1,125 @@
+"""Python side of the compiled integrator: chunks of outputs, failure reports, Result building.
+
+`integrate_compiled` runs `fastdop.run` over the output grid in chunks (Python is re-entered once per
+chunk of outputs, for Ctrl-C and progress), and turns a failure status into a SolverError naming the
+time and the joints while keeping every output written before it. `Result.at` between samples
+re-integrates from the bracketing sample with the same tolerances (dense output on demand, no
+per-step storage).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import MbdsimError, SolverError
+from ..results.result import Result
+from ..system.compiled import Work, compile_system
+from . import fastdop
+from .fastdyn import MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, TINY_STEP
+
+_MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
+             PROJECTION: "projection onto the constraints does not converge",
+             NONFINITE: "non-finite state (the solution diverged)",
+             TINY_STEP: "step size collapsed below the round-off limit (lock-up, singular configuration "
+                        "or a discontinuity)",
+             MAX_STEPS: "step budget exhausted (max_steps)"}
+CHUNK = 256
+
+
+class CompiledRun:
+    """A compiled model and its work arrays for one analysis (immutable model, per-run state)."""
+
+    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000):
+        self.sys, self.rows = sys, rows
+        self.cm = compile_system(sys, rows)
+        self.work = Work.for_model(self.cm)
+        self.rtol, self.atol = float(rtol), float(atol)
+        self.max_step = np.inf if not max_step else float(max_step)
+        self.max_steps = int(max_steps)
+        self.stats = np.zeros(4, dtype=np.int64)
+
+    def integrate(self, t0, y0, tout, progress=None):
+        """Outputs (Y, VD, LAM, n_written, status, t_fail) from the consistent state y0 at t0 over tout."""
+        sys, a, w = self.sys, self.cm.arrays(), self.work.arrays()
+        n, nout = len(y0), len(tout)
+        Y, VD, LAM = np.zeros((nout, n)), np.zeros((nout, sys.nv)), np.zeros((nout, sys.nc))
+        y, f = np.array(y0, dtype=float), np.zeros(n)
+        status = fastdop.rhs(a, w, t0, y, f)
+        iout = 0
+        if status == 0 and abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
+            status = fastdop.write_output(a, w, t0, y, Y[0], VD[0], LAM[0])
+            iout = 1 if status == 0 else 0
+        st = np.array([t0, 0.0])
+        if status == 0:
+            st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n))
+        while status == 0 and iout < nout:
+            status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD, LAM,
+                                       self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
+                                       self.stats)
+            if progress is not None:
+                progress(st[0])
+        return Y, VD, LAM, iout, status, st[0], y
+
+    def states_at(self, times, Y, ts):
+        """(q, v, vd, lambda_) at times ts by re-integrating from the sample at or before each t."""
+        out = []
+        for t in np.atleast_1d(ts):
+            k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
+            if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)):
+                tout = np.array([t])
+                y0 = Y[k]
+            else:
+                tout, y0 = np.array([times[k], t]), Y[k]
+            Yk, VDk, LAMk, m, status, _, _ = self.integrate(times[k], y0, tout)
+            if m < len(tout):
+                raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))
+            out.append((Yk[-1], VDk[-1], LAMk[-1]))
+        nq = self.sys.nq
+        Ys = np.array([o[0] for o in out])
+        return (Ys[:, :nq], Ys[:, nq:], np.array([o[1] for o in out]), np.array([o[2] for o in out]))
+
+
+def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None) -> Result:
+    """Dynamic analysis of System `sys` from the assembled state `rep` over the output grid `times`
+    with the compiled DOP853 (raises NotCompiled when the model needs the reference path)."""
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step)
+    y0 = np.concatenate([rep.q, rep.v])
+    success, message, error = True, "ok", None
+    Y, VD, LAM, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress)
+    if status != 0:
+        from .dynamic import _weak_joints
+        try:
+            joints = _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail, rep.rows)
+        except (MbdsimError, np.linalg.LinAlgError, ValueError):
+            joints = []
+        error = SolverError(_MESSAGES.get(status, "integration failed"), time=float(t_fail), joints=joints,
+                            state=y_fail[:sys.nq])
+        last = f"{times[n - 1]:.9g}" if n else "none"
+        success, message = False, f"{error}; last good output at t = {last} s"
+    LAM = _full_multipliers(sys, rep.rows, times[:n], Y[:n], VD[:n], LAM[:n])
+    nq = sys.nq
+    res = Result(sys, times[:n], Y[:n, :nq], Y[:n, nq:], VD[:n], LAM,
+                 evaluate=lambda ts: run.states_at(times[:n], Y[:n], ts), success=success,
+                 status=0 if success else -1, message=message,
+                 stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
+                        "projections": int(run.stats[3]), "method": "DOP853 (compiled)", "assembly": rep})
+    res.error = error
+    return res
+
+
+def _full_multipliers(sys, rows, times, Y, VD, LAM):
+    """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
+    solution of phi_q^T lambda_ = Q - M vd over all rows (determinate components exact)."""
+    if len(rows) == sys.nc or not len(times):
+        return LAM
+    from ..system.dynamics import applied_forces
+    from ..system.equations import constraint_terms
+    from ..system.frames import body_frames
+    from .state import state_factory
+    sf = state_factory(sys)
+    out = np.zeros_like(LAM)
+    for k, t in enumerate(times):
+        q, v = Y[k, :sys.nq], Y[k, sys.nq:]
+        _, J, _, _ = constraint_terms(sys, q, v, t)
+        Q = applied_forces(sys, body_frames(sys, q, v), t, sf(t, q, v) if sf else None)
+        out[k] = np.linalg.lstsq(J.T, Q - sys.M @ VD[k], rcond=None)[0]
+    return out

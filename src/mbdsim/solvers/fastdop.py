@@ -1,0 +1,211 @@
+"""DOP853 (Hairer's explicit Runge-Kutta 8(5,3) with 7th-order dense output) compiled with numba.
+
+The whole step loop runs in compiled code: stages (the O(N) equations of motion of `fastdyn`), the
+error norm, step-size control, coordinate projection after every accepted step, and the outputs at the
+requested times (dense output, then projection, accelerations and multipliers). Python is re-entered
+only when a chunk of outputs is written, at the end, or on failure. The Butcher tableau is scipy's
+(`scipy.integrate._ivp.dop853_coefficients`); the control follows scipy's `DOP853`: error norm
+|h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2)) with scale atol + rtol max(|y_old|, |y_new|), safety 0.9,
+factor limits 0.2..10, exponent -1/8.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+from scipy.integrate._ivp import dop853_coefficients as _c
+
+from .fastdyn import NONFINITE, OK, TINY_STEP, MAX_STEPS, accelerations, project, rhs
+
+N_STAGES = _c.N_STAGES
+COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
+          np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
+
+
+@njit(cache=True)
+def _rms(x, scale):
+    s = 0.0
+    for i in range(x.shape[0]):
+        s += (x[i] / scale[i]) ** 2
+    return np.sqrt(s / x.shape[0])
+
+
+@njit(cache=True)
+def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work):
+    """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator."""
+    n = y0.shape[0]
+    scale = np.empty(n)
+    for i in range(n):
+        scale[i] = atol + abs(y0[i]) * rtol
+    d0, d1 = _rms(y0, scale), _rms(f0, scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, max_step)
+    y1 = np.empty(n)
+    for i in range(n):
+        y1[i] = y0[i] + h0 * f0[i]
+    if rhs(cm, wk, t0 + h0, y1, work) != OK:
+        return h0
+    for i in range(n):
+        work[i] = work[i] - f0[i]
+    d2 = _rms(work, scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, max_step)
+
+
+@njit(cache=True)
+def write_output(cm, wk, t, y, yout, vdout, lamout):
+    """Accelerations and multipliers at a consistent state y into the output rows; status."""
+    nq = cm[31][0]
+    for i in range(y.shape[0]):
+        yout[i] = y[i]
+    return accelerations(cm, wk, t, y[:nq], y[nq:], vdout, lamout)
+
+
+@njit(cache=True)
+def _dense(F, y_old, t_old, h, t, out):
+    x = (t - t_old) / h
+    for i in range(out.shape[0]):
+        out[i] = 0.0
+    nF = F.shape[0]
+    for a in range(nF):
+        f = F[nF - 1 - a]
+        for i in range(out.shape[0]):
+            out[i] += f[i]
+            out[i] *= x if a % 2 == 0 else (1.0 - x)
+    for i in range(out.shape[0]):
+        out[i] += y_old[i]
+
+
+@njit(cache=True)
+def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_step, max_steps, chunk,
+        proj_tol, stats):
+    """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
+    outputs tout[iout:] into Y, VD, LAM; stops after `chunk` outputs. Returns (status, next iout).
+    stats: steps, rejected, rhs evaluations, projections (int64, accumulated)."""
+    A, B, C, E3, E5, D = co
+    nq = cm[31][0]
+    n = y.shape[0]
+    K = np.empty((16, n))
+    F = np.empty((7, n))
+    ys = np.empty(n)
+    ynew = np.empty(n)
+    yo = np.empty(n)
+    scale = np.empty(n)
+    t, h = st[0], st[1]
+    written = 0
+    rejected = False
+    eps = 2.220446049250313e-16
+    while iout < tout.shape[0]:
+        if stats[0] >= max_steps:
+            st[0], st[1] = t, h
+            return MAX_STEPS, iout
+        hmin = 10.0 * eps * max(abs(t), 1.0)
+        h = min(h, max_step, t_end - t)
+        if h < hmin:
+            if t_end - t > hmin:
+                st[0], st[1] = t, h
+                return TINY_STEP, iout
+            h = t_end - t
+        for i in range(n):
+            K[0, i] = f[i]
+        ok = True
+        for s in range(1, N_STAGES):
+            for i in range(n):
+                acc = 0.0
+                for j in range(s):
+                    acc += A[s, j] * K[j, i]
+                ys[i] = y[i] + h * acc
+            if rhs(cm, wk, t + C[s] * h, ys, K[s]) != OK:
+                ok = False
+                break
+        stats[2] += N_STAGES - 1
+        if ok:
+            for i in range(n):
+                acc = 0.0
+                for j in range(N_STAGES):
+                    acc += B[j] * K[j, i]
+                ynew[i] = y[i] + h * acc
+            ok = rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
+            stats[2] += 1
+        err = np.inf
+        if ok:
+            e5, e3 = 0.0, 0.0
+            for i in range(n):
+                scale[i] = atol + max(abs(y[i]), abs(ynew[i])) * rtol
+                a5, a3 = 0.0, 0.0
+                for j in range(N_STAGES + 1):
+                    a5 += E5[j] * K[j, i]
+                    a3 += E3[j] * K[j, i]
+                e5 += (a5 / scale[i]) ** 2
+                e3 += (a3 / scale[i]) ** 2
+            err = 0.0 if (e5 == 0.0 and e3 == 0.0) else h * e5 / np.sqrt((e5 + 0.01 * e3) * n)
+            if not np.isfinite(err):
+                err = np.inf
+        if err >= 1.0:
+            stats[1] += 1
+            h *= max(0.2, 0.9 * err ** (-1.0 / 8.0)) if np.isfinite(err) else 0.25
+            rejected = True
+            continue
+        fac = 10.0 if err == 0.0 else min(10.0, 0.9 * err ** (-1.0 / 8.0))
+        if rejected:
+            fac = min(1.0, fac)
+        rejected = False
+        t_new = t + h
+        stats[0] += 1
+        if tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):   # outputs inside this step
+            for s in range(N_STAGES + 1, 16):
+                for i in range(n):
+                    acc = 0.0
+                    for j in range(s):
+                        acc += A[s, j] * K[j, i]
+                    ys[i] = y[i] + h * acc
+                rhs(cm, wk, t + C[s] * h, ys, K[s])
+            stats[2] += 3
+            for i in range(n):
+                dy = ynew[i] - y[i]
+                F[0, i] = dy
+                F[1, i] = h * K[0, i] - dy
+                F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
+                for r in range(4):
+                    acc = 0.0
+                    for j in range(16):
+                        acc += D[r, j] * K[j, i]
+                    F[3 + r, i] = h * acc
+            while iout < tout.shape[0] and tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):
+                to = min(tout[iout], t_new)
+                _dense(F, y, t, h, to, yo)
+                s_ = project(cm, wk, to, yo[:nq], yo[nq:], proj_tol)
+                stats[3] += 1
+                if s_ != OK:
+                    st[0], st[1] = t, h
+                    return s_, iout
+                s_ = write_output(cm, wk, to, yo, Y[iout], VD[iout], LAM[iout])
+                if s_ != OK:
+                    st[0], st[1] = t, h
+                    return s_, iout
+                iout += 1
+                written += 1
+        for i in range(n):
+            y[i] = ynew[i]
+        s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol)
+        stats[3] += 1
+        if s_ != OK:
+            st[0], st[1] = t, h
+            return s_, iout
+        s_ = rhs(cm, wk, t_new, y, f)
+        stats[2] += 1
+        for i in range(n):
+            if not np.isfinite(y[i]):
+                st[0], st[1] = t, h
+                return NONFINITE, iout
+        t = t_new
+        h *= fac
+        if s_ != OK:
+            st[0], st[1] = t, h
+            return s_, iout
+        if written >= chunk and iout < tout.shape[0]:
+            break
+    st[0], st[1] = t, h
+    return OK, iout

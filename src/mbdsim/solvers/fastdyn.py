@@ -1,0 +1,314 @@
+"""Compiled equations of motion: right-hand side, projections and accelerations at one state (numba).
+
+State y = [q, v] (system layout, docs/theory.md section 1). Every kernel takes the immutable compiled
+model `cm` (a tuple of arrays, `system.compiled.CompiledModel.arrays()`) and a per-run work tuple `wk`
+(`system.compiled.Work.arrays()`); see those for the field order. Loads and solves use six slots per
+frame: CM translation in ground axes [N, m/s^2], rotation in body axes [N m, rad/s^2].
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+try:   # the expression VM (system.exprvm) compiles drivers; without it drivers stay in Python
+    from ..system.exprvm import eval_program
+    HAVE_VM = True
+except ImportError:   # pragma: no cover - transitional, until system.exprvm lands
+    HAVE_VM = False
+
+    @njit(cache=True)
+    def eval_program(code, consts, tables, start, end, x, stack):
+        return 0.0
+from ..system.kernels import frames_into, rows_kernel
+from .kkt_tree import dense_factor, dense_solve, kkt_factor, kkt_solve
+
+OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS = 0, 1, 2, 3, 4, 5
+
+
+@njit(cache=True)
+def drivers_at(cm, wk, t):
+    """Driver values f, f', f'' at time t [s] from the compiled expression programs."""
+    code, consts, tables, start, end = cm[16], cm[17], cm[18], cm[19], cm[20]
+    fv, x, stack = wk[22], wk[23], wk[24]
+    nd = start.shape[0] // 3
+    x[0] = t
+    for d in range(nd):
+        for k in range(3):
+            p = 3 * d + k
+            fv[k, d] = eval_program(code, consts, tables, start[p], end[p], x, stack)
+
+
+@njit(cache=True)
+def _cross_into(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True)
+def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
+    """Add a ground-axes force at ground offset s from the CM of frame f into F (nf, 6)."""
+    if f == 0:
+        return
+    F[f, 0] += F0
+    F[f, 1] += F1
+    F[f, 2] += F2
+    if rigid[f]:
+        m0, m1, m2 = _cross_into(s0, s1, s2, F0, F1, F2)
+        for k in range(3):
+            F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
+
+
+@njit(cache=True)
+def loads_into(cm, r, A, rd, w, F):
+    """Gravity, gyroscopic torques, constant point forces/torques and linear spring-dampers into F."""
+    mass, inertia, gravity, rigid = cm[9], cm[10], cm[8], cm[6]
+    nf = F.shape[0]
+    for f in range(nf):
+        for k in range(6):
+            F[f, k] = 0.0
+    for f in range(1, nf):
+        for k in range(3):
+            F[f, k] = mass[f] * gravity[k]
+        if rigid[f]:
+            wb = np.empty(3)
+            for i in range(3):
+                wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
+            h0 = inertia[f, 0, 0] * wb[0] + inertia[f, 0, 1] * wb[1] + inertia[f, 0, 2] * wb[2]
+            h1 = inertia[f, 1, 0] * wb[0] + inertia[f, 1, 1] * wb[1] + inertia[f, 1, 2] * wb[2]
+            h2 = inertia[f, 2, 0] * wb[0] + inertia[f, 2, 1] * wb[1] + inertia[f, 2, 2] * wb[2]
+            c0, c1, c2 = _cross_into(wb[0], wb[1], wb[2], h0, h1, h2)
+            F[f, 3] -= c0
+            F[f, 4] -= c1
+            F[f, 5] -= c2
+    pf_f, pf_s, pf_v, pf_ff, pf_R, pf_torque = cm[21], cm[22], cm[23], cm[24], cm[25], cm[26]
+    for e in range(pf_f.shape[0]):   # constant vector loads, axes of frame pf_ff (R: marker in body)
+        f, ff = pf_f[e], pf_ff[e]
+        g = np.empty(3)
+        for i in range(3):
+            loc = pf_R[e, i, 0] * pf_v[e, 0] + pf_R[e, i, 1] * pf_v[e, 1] + pf_R[e, i, 2] * pf_v[e, 2]
+            g[i] = loc
+        G = np.empty(3)
+        for i in range(3):
+            G[i] = A[ff, i, 0] * g[0] + A[ff, i, 1] * g[1] + A[ff, i, 2] * g[2]
+        if f == 0:
+            continue
+        if pf_torque[e]:
+            if rigid[f]:
+                for k in range(3):
+                    F[f, 3 + k] += A[f, 0, k] * G[0] + A[f, 1, k] * G[1] + A[f, 2, k] * G[2]
+        else:
+            s = np.empty(3)
+            for i in range(3):
+                s[i] = A[f, i, 0] * pf_s[e, 0] + A[f, i, 1] * pf_s[e, 1] + A[f, i, 2] * pf_s[e, 2]
+            _point_force(F, A, f, s[0], s[1], s[2], G[0], G[1], G[2], rigid)
+    sp_f, sp_s, sp_par = cm[27], cm[28], cm[29]
+    for e in range(sp_f.shape[0]):   # spring-dampers: tension k (L - L0) + c dL/dt + preload
+        fi, fj = sp_f[e, 0], sp_f[e, 1]
+        si = np.empty(3)
+        sj = np.empty(3)
+        for i in range(3):
+            si[i] = A[fi, i, 0] * sp_s[e, 0, 0] + A[fi, i, 1] * sp_s[e, 0, 1] + A[fi, i, 2] * sp_s[e, 0, 2]
+            sj[i] = A[fj, i, 0] * sp_s[e, 1, 0] + A[fj, i, 1] * sp_s[e, 1, 1] + A[fj, i, 2] * sp_s[e, 1, 2]
+        vi = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], si[0], si[1], si[2])
+        vj = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], sj[0], sj[1], sj[2])
+        d = np.empty(3)
+        dv = np.empty(3)
+        for i in range(3):
+            d[i] = r[fj, i] + sj[i] - r[fi, i] - si[i]
+            dv[i] = rd[fj, i] + vj[i] - rd[fi, i] - vi[i]
+        L = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        inv = 1.0 / L if L > 0 else 0.0
+        Ld = (d[0] * dv[0] + d[1] * dv[1] + d[2] * dv[2]) * inv
+        T = sp_par[e, 0] * (L - sp_par[e, 2]) + sp_par[e, 1] * Ld + sp_par[e, 3]
+        u0, u1, u2 = d[0] * inv * T, d[1] * inv * T, d[2] * inv * T
+        _point_force(F, A, fi, si[0], si[1], si[2], u0, u1, u2, rigid)
+        _point_force(F, A, fj, sj[0], sj[1], sj[2], -u0, -u1, -u2, rigid)
+
+
+@njit(cache=True)
+def _constraints(cm, wk, t, q, v):
+    """Frames, driver values and constraint rows at (q, v, t) into the work arrays."""
+    r_idx, p_idx, rd_idx, w_idx, rigid_fid, rigid = cm[0], cm[1], cm[2], cm[3], cm[4], cm[6]
+    r, A, rd, w, phi, Jc, nu, gamma, fv = wk[0], wk[1], wk[2], wk[3], wk[4], wk[5], wk[6], wk[7], wk[22]
+    frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
+    if cm[19].shape[0] > 0:
+        drivers_at(cm, wk, t)
+    rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[14][0], cm[14][1], cm[14][2], cm[15],
+                fv[0], fv[1], fv[2], rigid, phi, Jc, nu, gamma)
+
+
+@njit(cache=True)
+def _factor(cm, wk):
+    if cm[31][4]:
+        return dense_factor(wk[5], cm[12], cm[13], cm[7], cm[32], wk[32], wk[33])
+    t = cm[30]
+    return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8],
+                      wk[9], wk[10], wk[11], wk[12], wk[13], wk[14], wk[15], wk[16], wk[17], wk[18],
+                      wk[20], wk[21])
+
+
+@njit(cache=True)
+def _solve(cm, wk, F, c_rows, x6, lam):
+    if cm[31][4]:
+        dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam)
+        return
+    t = cm[30]
+    kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
+              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam)
+
+
+@njit(cache=True)
+def accelerations(cm, wk, t, q, v, vd, lam):
+    """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status."""
+    _constraints(cm, wk, t, q, v)
+    F = wk[8]
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    loads_into(cm, r, A, rd, w, F)
+    if not _factor(cm, wk):
+        return SINGULAR
+    x6 = wk[25]
+    for i in range(lam.shape[0]):
+        lam[i] = 0.0
+    _solve(cm, wk, F, wk[7], x6, lam)
+    _from6(cm, x6, vd)
+    for i in range(vd.shape[0]):
+        if not np.isfinite(vd[i]):
+            return NONFINITE
+    return OK
+
+
+@njit(cache=True)
+def _from6(cm, x6, x):
+    """Six slots per frame -> system velocity layout."""
+    vadr, rigid = cm[5], cm[6]
+    for f in range(1, x6.shape[0]):
+        n = 6 if rigid[f] else 3
+        for k in range(n):
+            x[vadr[f] + k] = x6[f, k]
+
+
+@njit(cache=True)
+def _to6(cm, x, x6):
+    vadr, rigid = cm[5], cm[6]
+    for f in range(x6.shape[0]):
+        for k in range(6):
+            x6[f, k] = 0.0
+        if f == 0:
+            continue
+        n = 6 if rigid[f] else 3
+        for k in range(n):
+            x6[f, k] = x[vadr[f] + k]
+
+
+@njit(cache=True)
+def qdot_into(cm, q, v, qd):
+    """dq/dt: CM velocities and Euler-parameter rates 1/2 p (x) (0, w_B)."""
+    r_idx, p_idx, rd_idx, w_idx = cm[0], cm[1], cm[2], cm[3]
+    for k in range(r_idx.shape[0]):
+        for c in range(3):
+            qd[r_idx[k, c]] = v[rd_idx[k, c]]
+    for k in range(p_idx.shape[0]):
+        e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+        x, y, z = v[w_idx[k, 0]], v[w_idx[k, 1]], v[w_idx[k, 2]]
+        qd[p_idx[k, 0]] = 0.5 * (-e1 * x - e2 * y - e3 * z)
+        qd[p_idx[k, 1]] = 0.5 * (e0 * x + e2 * z - e3 * y)
+        qd[p_idx[k, 2]] = 0.5 * (e0 * y - e1 * z + e3 * x)
+        qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
+
+
+@njit(cache=True)
+def rhs(cm, wk, t, y, ydot):
+    """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded)."""
+    nq = cm[31][0]
+    q = y[:nq]
+    v = y[nq:]
+    st = accelerations(cm, wk, t, q, v, ydot[nq:], wk[26])
+    qdot_into(cm, q, v, ydot[:nq])
+    return st
+
+
+@njit(cache=True)
+def increment_into(cm, q, dx6):
+    """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) (body-axes rotation vectors), in place."""
+    r_idx, p_idx, rigid_fid = cm[0], cm[1], cm[4]
+    for k in range(r_idx.shape[0]):
+        for c in range(3):
+            q[r_idx[k, c]] += dx6[k + 1, c]
+    for k in range(p_idx.shape[0]):
+        f = rigid_fid[k]
+        x, y, z = dx6[f, 3], dx6[f, 4], dx6[f, 5]
+        ang = np.sqrt(x * x + y * y + z * z)
+        c0 = np.cos(0.5 * ang)
+        s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
+        b0, b1, b2, b3 = c0, s * x, s * y, s * z
+        a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+        p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
+        p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
+        p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
+        p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
+        n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+        q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
+
+
+@njit(cache=True)
+def normalize_into(cm, q):
+    p_idx = cm[1]
+    for k in range(p_idx.shape[0]):
+        n = 0.0
+        for c in range(4):
+            n += q[p_idx[k, c]] ** 2
+        n = np.sqrt(n)
+        for c in range(4):
+            q[p_idx[k, c]] /= n
+
+
+@njit(cache=True)
+def project(cm, wk, t, q, v, tol):
+    """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu."""
+    active = cm[32]
+    x6, zero6, vz, lam, c = wk[25], wk[27], wk[28], wk[26], wk[29]
+    normalize_into(cm, q)
+    for i in range(vz.shape[0]):
+        vz[i] = 0.0
+    for f in range(zero6.shape[0]):
+        for k in range(6):
+            zero6[f, k] = 0.0
+    ok = False
+    for it in range(12):
+        _constraints(cm, wk, t, q, vz)
+        res = 0.0
+        for i in range(active.shape[0]):
+            res = max(res, abs(wk[4][active[i]]))
+        if res <= tol:
+            ok = True
+            break
+        if not _factor(cm, wk):
+            return SINGULAR
+        for i in range(c.shape[0]):
+            c[i] = -wk[4][i]
+        _solve(cm, wk, zero6, c, x6, lam)
+        increment_into(cm, q, x6)
+    if not ok:
+        return PROJECTION
+    # velocities: v <- v + dv with M dv + J^T mu = 0, J dv = nu - J v (same factorisation: q unchanged)
+    _constraints(cm, wk, t, q, v)
+    if not _factor(cm, wk):
+        return SINGULAR
+    v6 = wk[30]
+    _to6(cm, v, v6)
+    Jc, bi, bj, nu = wk[5], cm[12], cm[13], wk[6]
+    for i in range(active.shape[0]):
+        row = active[i]
+        s = 0.0
+        for side in range(2):
+            f = bi[row] if side == 0 else bj[row]
+            if f != 0:
+                for k in range(6):
+                    s += Jc[row, side, k] * v6[f, k]
+        c[row] = nu[row] - s
+    _solve(cm, wk, zero6, c, x6, lam)
+    vadr, rigid = cm[5], cm[6]
+    for f in range(1, x6.shape[0]):
+        n = 6 if rigid[f] else 3
+        for k in range(n):
+            v[vadr[f] + k] += x6[f, k]
+    return OK

@@ -1,0 +1,344 @@
+"""O(N) solve of the augmented equations of motion over a spanning tree (numba).
+
+    M vd + J_T^T lambda_T + K^T lambda_L = F,    J_T vd = c_T,    K vd = c_L
+
+Bodies are eliminated leaves first (Baraff's linear-time block elimination): for the block j joining
+child body c to its parent p,
+
+    D_c = M_c + sum_k JP_k^T S_k^-1 JP_k      (k: blocks whose parent is c)
+    G_j = JC_j D_c^-1,  S_j = G_j JC_j^T       (m_j x m_j, symmetric positive definite)
+
+and the solve is one backward and one forward sweep. The loop rows K enter through the Schur complement
+(K W) lambda_L = K vd0 - c_L with W = tree solve of K^T, so the cost is O(N (1 + n_loop)). Every body has
+six velocity slots here (CM velocity [m/s], body-axes angular velocity [rad/s]); a particle's rotational
+slots carry a unit dummy inertia and no load. Rows are global row indices into the compact Jacobian
+Jc (nc, 2, 6) of `system.kernels.rows_kernel`. Kernels return False when a pivot is not positive
+(a dependent or singular set of rows).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def chol(A, n, L):
+    """Cholesky factor L (lower) of the leading n x n block of A; False if not positive definite."""
+    for i in range(n):
+        for j in range(i + 1):
+            s = A[i, j]
+            for k in range(j):
+                s -= L[i, k] * L[j, k]
+            if i == j:
+                if not s > 1e-300:
+                    return False
+                L[i, i] = np.sqrt(s)
+            else:
+                L[i, j] = s / L[j, j]
+    return True
+
+
+@njit(cache=True)
+def chol_solve(L, n, b):
+    """Solve (L L^T) x = b in place for the leading n entries of b."""
+    for i in range(n):
+        s = b[i]
+        for k in range(i):
+            s -= L[i, k] * b[k]
+        b[i] = s / L[i, i]
+    for i in range(n - 1, -1, -1):
+        s = b[i]
+        for k in range(i + 1, n):
+            s -= L[k, i] * b[k]
+        b[i] = s / L[i, i]
+
+
+@njit(cache=True)
+def _side(bi, bj, row, f):
+    return 0 if bi[row] == f else 1
+
+
+@njit(cache=True)
+def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
+                LD, G, LS, JC, JP):
+    """Factor the tree part: LD (nf, 6, 6), G, LS, JC, JP (nblk, 6, 6) filled; False on a bad pivot."""
+    D = np.empty((6, 6))
+    X = np.empty(6)
+    for b in range(blk_child.shape[0]):   # gather each block's child- and parent-side rows
+        c, p = blk_child[b], blk_parent[b]
+        for a in range(blk_ptr[b + 1] - blk_ptr[b]):
+            row = blk_rows[blk_ptr[b] + a]
+            sc = _side(bi, bj, row, c)
+            for k in range(6):
+                JC[b, a, k] = Jc[row, sc, k]
+                JP[b, a, k] = Jc[row, 1 - sc, k] if p != 0 else 0.0
+    for ii in range(order.shape[0] - 1, -1, -1):
+        c = order[ii]
+        for i in range(6):
+            for j in range(6):
+                D[i, j] = M6[c, i, j]
+        for a in range(ch_ptr[c], ch_ptr[c + 1]):   # D += JP^T S^-1 JP of each child block
+            k = ch_blk[a]
+            m = blk_ptr[k + 1] - blk_ptr[k]
+            for col in range(6):
+                for r in range(m):
+                    X[r] = JP[k, r, col]
+                chol_solve(LS[k], m, X)
+                for i in range(6):
+                    s = 0.0
+                    for r in range(m):
+                        s += JP[k, r, i] * X[r]
+                    D[i, col] += s
+        if not chol(D, 6, LD[c]):
+            return False
+        j = pblk[c]
+        if j >= 0:
+            m = blk_ptr[j + 1] - blk_ptr[j]
+            for r in range(m):          # G_j = JC_j D^-1 (rows of D^-1 JC_j^T, D symmetric)
+                for k in range(6):
+                    X[k] = JC[j, r, k]
+                chol_solve(LD[c], 6, X)
+                for k in range(6):
+                    G[j, r, k] = X[k]
+            for r in range(m):
+                for s_ in range(m):
+                    s = 0.0
+                    for k in range(6):
+                        s += G[j, r, k] * JC[j, s_, k]
+                    D[r, s_] = s
+            if not chol(D, m, LS[j]):
+                return False
+    return True
+
+
+@njit(cache=True)
+def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u):
+    """Solve the tree system for loads F (nf, 6) and row right-hand sides c_rows (nc,) (global rows);
+    writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6) are work arrays."""
+    X = np.empty(6)
+    for f in range(F.shape[0]):
+        for k in range(6):
+            Qt[f, k] = F[f, k]
+            vd[f, k] = 0.0
+    for ii in range(order.shape[0] - 1, -1, -1):
+        c = order[ii]
+        j = pblk[c]
+        if j < 0:
+            continue
+        m = blk_ptr[j + 1] - blk_ptr[j]
+        for r in range(m):
+            s = -c_rows[blk_rows[blk_ptr[j] + r]]
+            for k in range(6):
+                s += G[j, r, k] * Qt[c, k]
+            u[j, r] = s
+        chol_solve(LS[j], m, u[j])
+        p = blk_parent[j]
+        if p != 0:
+            for k in range(6):
+                s = 0.0
+                for r in range(m):
+                    s += JP[j, r, k] * u[j, r]
+                Qt[p, k] -= s
+    lj = np.empty(6)
+    for ii in range(order.shape[0]):
+        c = order[ii]
+        j = pblk[c]
+        for k in range(6):
+            X[k] = Qt[c, k]
+        if j >= 0:
+            m = blk_ptr[j + 1] - blk_ptr[j]
+            p = blk_parent[j]
+            for r in range(m):
+                s = 0.0
+                if p != 0:
+                    for k in range(6):
+                        s += JP[j, r, k] * vd[p, k]
+                lj[r] = s
+            chol_solve(LS[j], m, lj)
+            for r in range(m):
+                lj[r] += u[j, r]
+                lam[blk_rows[blk_ptr[j] + r]] = lj[r]
+            for k in range(6):
+                s = 0.0
+                for r in range(m):
+                    s += JC[j, r, k] * lj[r]
+                X[k] -= s
+        chol_solve(LD[c], 6, X)
+        for k in range(6):
+            vd[c, k] = X[k]
+
+
+class TreeWork:
+    """Preallocated work arrays of the tree solve for a topology (per run, not shared between threads)."""
+
+    def __init__(self, topo, nf: int, nc: int):
+        nblk = len(topo.blk_child)
+        nl = len(topo.loop_rows)
+        self.LD = np.zeros((nf, 6, 6))
+        self.G = np.zeros((max(nblk, 1), 6, 6))
+        self.LS = np.zeros((max(nblk, 1), 6, 6))
+        self.JC = np.zeros((max(nblk, 1), 6, 6))
+        self.JP = np.zeros((max(nblk, 1), 6, 6))
+        self.Qt = np.zeros((nf, 6))
+        self.u = np.zeros((max(nblk, 1), 6))
+        self.W = np.zeros((max(nl, 1), nf, 6))
+        self.KW = np.zeros((max(nl, 1), max(nl, 1)))
+        self.LK = np.zeros((max(nl, 1), max(nl, 1)))
+        self.lamL = np.zeros(max(nl, 1))
+        self.F2 = np.zeros((nf, 6))
+        self.c0 = np.zeros(nc)
+        self.lam_tmp = np.zeros(nc)
+
+
+@njit(cache=True)
+def _row_dot(Jc, bi, bj, row, x):
+    s = 0.0
+    for side in range(2):
+        f = bi[row] if side == 0 else bj[row]
+        if f != 0:
+            for k in range(6):
+                s += Jc[row, side, k] * x[f, k]
+    return s
+
+
+@njit(cache=True)
+def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
+               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp):
+    """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular."""
+    if not tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
+                       LD, G, LS, JC, JP):
+        return False
+    nl = loop_rows.shape[0]
+    if nl == 0:
+        return True
+    for i in range(c0.shape[0]):
+        c0[i] = 0.0
+    F = np.zeros((M6.shape[0], 6))
+    for i in range(nl):
+        row = loop_rows[i]
+        for side in range(2):
+            f = bi[row] if side == 0 else bj[row]
+            if f != 0:
+                for k in range(6):
+                    F[f, k] = Jc[row, side, k]
+        tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c0, W[i], lam_tmp, Qt, u)
+        for side in range(2):
+            f = bi[row] if side == 0 else bj[row]
+            if f != 0:
+                for k in range(6):
+                    F[f, k] = 0.0
+    for a in range(nl):
+        for b in range(nl):
+            KW[a, b] = _row_dot(Jc, bi, bj, loop_rows[a], W[b])
+    scale = 0.0
+    for a in range(nl):
+        scale = max(scale, KW[a, a])
+    for a in range(nl):
+        for b in range(nl):
+            KW[a, b] = 0.5 * (KW[a, b] + KW[b, a])
+    if not chol(KW, nl, LK):
+        return False
+    for a in range(nl):   # a pivot tiny against the largest diagonal: dependent loop rows
+        if LK[a, a] * LK[a, a] < 1e-13 * scale:
+            return False
+    return True
+
+
+@njit(cache=True)
+def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows, LD, G, LS, JC, JP, Qt, u,
+              W, LK, lamL, F2, F, c_rows, vd, lam):
+    """Solve the factored system for loads F (nf, 6) and row right-hand sides c_rows (nc,);
+    writes vd (nf, 6) and lam (nc,) at every tree and loop row."""
+    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u)
+    nl = loop_rows.shape[0]
+    if nl == 0:
+        return
+    for a in range(nl):
+        lamL[a] = _row_dot(Jc, bi, bj, loop_rows[a], vd) - c_rows[loop_rows[a]]
+    chol_solve(LK, nl, lamL)
+    for f in range(F.shape[0]):
+        for k in range(6):
+            F2[f, k] = F[f, k]
+    for a in range(nl):
+        row = loop_rows[a]
+        lam[row] = lamL[a]
+        for side in range(2):
+            f = bi[row] if side == 0 else bj[row]
+            if f != 0:
+                for k in range(6):
+                    F2[f, k] -= Jc[row, side, k] * lamL[a]
+    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F2, c_rows, vd, lam, Qt, u)
+
+
+@njit(cache=True)
+def dense_factor(Jc, bi, bj, M6, active, KD, piv):
+    """Dense LU (partial pivoting) of the augmented matrix over six slots per body and the active rows,
+    for models with a singular body mass matrix (massless links, point masses on rigid frames)."""
+    nb = M6.shape[0] - 1
+    n = KD.shape[0]
+    for i in range(n):
+        for j in range(n):
+            KD[i, j] = 0.0
+    for f in range(1, nb + 1):
+        for i in range(6):
+            for j in range(6):
+                KD[6 * (f - 1) + i, 6 * (f - 1) + j] = M6[f, i, j]
+    for a in range(active.shape[0]):
+        row = active[a]
+        for side in range(2):
+            f = bi[row] if side == 0 else bj[row]
+            if f != 0:
+                for k in range(6):
+                    KD[6 * nb + a, 6 * (f - 1) + k] += Jc[row, side, k]
+                    KD[6 * (f - 1) + k, 6 * nb + a] += Jc[row, side, k]
+    scale = 0.0
+    for i in range(n):
+        for j in range(n):
+            scale = max(scale, abs(KD[i, j]))
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(KD[i, k]) > abs(KD[p, k]):
+                p = i
+        piv[k] = p
+        if not abs(KD[p, k]) > 1e-13 * scale:
+            return False
+        if p != k:
+            for j in range(n):
+                KD[k, j], KD[p, j] = KD[p, j], KD[k, j]
+        for i in range(k + 1, n):
+            KD[i, k] /= KD[k, k]
+            for j in range(k + 1, n):
+                KD[i, j] -= KD[i, k] * KD[k, j]
+    return True
+
+
+@njit(cache=True)
+def dense_solve(active, KD, piv, F, c_rows, vd, lam):
+    """Solve with the LU of `dense_factor` for loads F (nf, 6) and row right-hand sides c_rows."""
+    nb = F.shape[0] - 1
+    n = KD.shape[0]
+    x = np.empty(n)
+    for f in range(1, nb + 1):
+        for k in range(6):
+            x[6 * (f - 1) + k] = F[f, k]
+    for a in range(active.shape[0]):
+        x[6 * nb + a] = c_rows[active[a]]
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+    for i in range(n):
+        for k in range(i):
+            x[i] -= KD[i, k] * x[k]
+    for i in range(n - 1, -1, -1):
+        for k in range(i + 1, n):
+            x[i] -= KD[i, k] * x[k]
+        x[i] /= KD[i, i]
+    for k in range(6):
+        vd[0, k] = 0.0
+    for f in range(1, nb + 1):
+        for k in range(6):
+            vd[f, k] = x[6 * (f - 1) + k]
+    for a in range(active.shape[0]):
+        lam[active[a]] = x[6 * nb + a]

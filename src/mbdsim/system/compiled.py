@@ -1,0 +1,169 @@
+"""The immutable compiled model (arrays and address maps) and the per-run work arrays.
+
+`compile_system(sys, rows)` turns an assembled System and its independent constraint rows into a
+`CompiledModel`: plain numpy arrays that the numba kernels of `solvers.fastdyn` read, in the spirit of
+MuJoCo's mjModel / Pinocchio's Model. Everything that changes during a run lives in a separate `Work`
+(mjData / pinocchio.Data). A model with an element the compiled kernels do not carry raises
+`NotCompiled` with the reason; the analysis then runs the reference (Python) path.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..model.forces import Force, SpringDamper, Torque
+from . import kernels
+from .measures import locate
+from .topology import Topology, system_topology
+
+
+class NotCompiled(Exception):
+    """The model needs a feature the compiled kernels do not have (reason in the message)."""
+
+
+@dataclass(frozen=True)
+class CompiledModel:
+    """Arrays of one model for the compiled kernels; `arrays()` gives the tuple they take (order fixed)."""
+
+    r_idx: np.ndarray
+    p_idx: np.ndarray
+    rd_idx: np.ndarray
+    w_idx: np.ndarray
+    rigid_fid: np.ndarray
+    vadr: np.ndarray          # (nf,) first velocity slot of each frame (-1 for ground)
+    rigid: np.ndarray         # (nf,) bool
+    M6: np.ndarray            # (nf, 6, 6) mass and inertia [kg, kg m^2]; unit dummy rotation for particles
+    gravity: np.ndarray       # (3,) [m/s^2] ground axes
+    mass: np.ndarray          # (nf,) [kg]
+    inertia: np.ndarray       # (nf, 3, 3) [kg m^2] about the CM, body axes
+    kind: np.ndarray          # constraint rows (system.kernels.pack_rows)
+    bi: np.ndarray
+    bj: np.ndarray
+    vecs: np.ndarray          # (3, nc, 3) body-axes vectors of each row
+    drv: np.ndarray           # (nc,) driver index of each row, -1 if none
+    code: np.ndarray          # driver programs (system.exprvm): value, d1, d2 of each driver
+    consts: np.ndarray
+    tables: np.ndarray
+    start: np.ndarray
+    end: np.ndarray
+    pf_f: np.ndarray          # constant loads: frame, offset s_B [m], vector, axes frame, marker rotation
+    pf_s: np.ndarray
+    pf_v: np.ndarray
+    pf_ff: np.ndarray
+    pf_R: np.ndarray
+    pf_torque: np.ndarray
+    sp_f: np.ndarray          # spring-dampers: frames (i, j), points s_B, (k, c, free length, preload)
+    sp_s: np.ndarray
+    sp_par: np.ndarray
+    topo: Topology
+    dims: np.ndarray          # (nq, nv, nc, nf, dense): dense = 1 when a body's mass matrix is singular
+    active: np.ndarray        # independent rows in force
+    stack_size: int
+
+    def arrays(self) -> tuple:
+        t = self.topo
+        topo = (t.order, t.pblk, t.blk_child, t.blk_parent, t.blk_ptr, t.blk_rows, t.ch_ptr, t.ch_blk,
+                t.loop_rows)
+        return (self.r_idx, self.p_idx, self.rd_idx, self.w_idx, self.rigid_fid, self.vadr, self.rigid,
+                self.M6, self.gravity, self.mass, self.inertia, self.kind, self.bi, self.bj, self.vecs,
+                self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
+                self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
+                self.dims, self.active)
+
+
+@dataclass
+class Work:
+    """Per-run scratch arrays of the compiled kernels (never shared between runs)."""
+
+    arrays_: tuple
+
+    @classmethod
+    def for_model(cls, cm: CompiledModel) -> "Work":
+        nq, nv, nc, nf, dense = (int(x) for x in cm.dims)
+        nk = 6 * (nf - 1) + len(cm.active) if dense else 1   # dense augmented matrix (singular masses)
+        t = cm.topo
+        nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
+        nd = len(cm.start) // 3
+        z = np.zeros
+        a = (z((nf, 3)), z((nf, 3, 3)), z((nf, 3)), z((nf, 3)), z(nc), z((nc, 2, 6)), z(nc), z(nc), z((nf, 6)),
+             z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
+             z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((nl, nl)), z(nl), z(nc), z(nc), z((3, nd)), z(4),
+             z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
+             z((nk, nk)), np.zeros(nk, np.int64))
+        return cls(a)
+
+    def arrays(self) -> tuple:
+        return self.arrays_
+
+
+def _driver_programs(fns):
+    """Packed value/d1/d2 programs of every driver function, or NotCompiled."""
+    if not fns:
+        return np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64), 4
+    try:
+        from . import exprvm
+    except ImportError:
+        raise NotCompiled("the expression compiler (system.exprvm) is not available") from None
+    progs = []
+    for fn in fns:
+        p = exprvm.time_programs(fn)
+        if p is None:
+            raise NotCompiled(f"driver function {fn!r} is a Python callable")
+        progs.extend(p)
+    pk = exprvm.pack(progs)
+    return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size)
+
+
+def _loads(sys):
+    """Constant point forces and torques, and spring-dampers, as arrays; NotCompiled for anything else."""
+    pf, sp = [], []
+    for e in sys.model.forces.values():
+        if isinstance(e, (Force, Torque)):
+            vec = e.force if isinstance(e, Force) else e.torque
+            if callable(vec):
+                raise NotCompiled(f"load '{e.name}' is a Python callable")
+            ff, R = (0, np.eye(3)) if e.frame is None else (lambda x: (x[0], x[2]))(locate(sys, e.frame))
+            s = e.s_B if isinstance(e, Force) else np.zeros(3)
+            pf.append((sys.fid[e.body], s, np.asarray(vec, float), ff, R, isinstance(e, Torque)))
+        elif type(e) is SpringDamper:
+            sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
+                       (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
+        else:
+            raise NotCompiled(f"force element '{e.name}' ({type(e).__name__}) is not compiled yet")
+    arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape)  # noqa: E731
+    n, m = len(pf), len(sp)
+    return (arr([p[0] for p in pf], (n,), np.int64), arr([p[1] for p in pf], (n, 3)),
+            arr([p[2] for p in pf], (n, 3)), arr([p[3] for p in pf], (n,), np.int64),
+            arr([p[4] for p in pf], (n, 3, 3)), arr([p[5] for p in pf], (n,), np.bool_),
+            arr([p[0] for p in sp], (m, 2), np.int64), arr([p[1] for p in sp], (m, 2, 3)),
+            arr([p[2] for p in sp], (m, 4)))
+
+
+def compile_system(sys, rows) -> CompiledModel:
+    """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported."""
+    if len(sys.aux_q_idx):
+        raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
+    if len(sys.lock_rows):
+        raise NotCompiled("joint friction (stick/slip) is not compiled yet")
+    nf = sys.nbody + 1
+    M6 = np.zeros((nf, 6, 6))
+    for f in range(nf):
+        M6[f] = np.eye(6)
+        if f:
+            M6[f, :3, :3] = sys.mass[f] * np.eye(3)
+            if sys.frame_rigid[f]:
+                M6[f, 3:, 3:] = sys.inertia_B[f]
+    kind, bi, bj, v1, v2, v3, drv, fns = kernels.pack_rows(sys)
+    code, consts, tables, start, end, stack = _driver_programs(fns)
+    loads = _loads(sys)
+    rows = np.asarray(rows, dtype=np.int64)
+    dense = any(np.linalg.eigvalsh(M6[f]).min() <= 1e-12 * max(np.abs(M6[f]).max(), 1e-300) for f in range(1, nf))
+    return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
+                         sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),
+                         sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
+                         sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
+                         sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
+                         np.stack([v1, v2, v3]), drv, code, consts, tables, start, end, *loads,
+                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense)], np.int64),
+                         np.sort(rows), stack)

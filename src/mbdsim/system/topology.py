@@ -1,0 +1,106 @@
+"""Spanning tree of a system's constraint rows, for the O(N) solve of the equations of motion.
+
+Frames (bodies) are the nodes and joints the edges. A breadth-first search from ground (then from any
+body not reached, as a floating root) picks one joint per body, its *tree joint*; the body's
+independent rows of that joint and of the motions driving it form the body's *block*. Every other row
+(loop-closing joints, motions on them) is a *loop row*, coupled through a small dense Schur complement.
+See docs/theory.md section "O(N) equations of motion".
+"""
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Topology:
+    """Tree blocks and loop rows over frames 0..nf-1 (0 = ground); arrays only, read by numba kernels.
+
+    order: frames in breadth-first order (roots first, ground excluded); pblk[f]: the block whose child is
+    frame f (-1 for a root); blk_child / blk_parent: child and parent frame of each block (parent 0 =
+    ground); blk_ptr, blk_rows: CSR list of each block's global row indices (at most 6 per block);
+    ch_ptr, ch_blk: CSR list of the blocks whose parent is frame f; loop_rows: the other rows."""
+
+    order: np.ndarray
+    pblk: np.ndarray
+    blk_child: np.ndarray
+    blk_parent: np.ndarray
+    blk_ptr: np.ndarray
+    blk_rows: np.ndarray
+    ch_ptr: np.ndarray
+    ch_blk: np.ndarray
+    loop_rows: np.ndarray
+
+
+def _csr(lists):
+    ptr = np.zeros(len(lists) + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum([len(x) for x in lists])
+    flat = np.array([i for x in lists for i in x], dtype=np.int64)
+    return ptr, flat
+
+
+def spanning_tree(nf: int, edges: list[tuple[str, int, int]], rows_of: dict[str, list[int]]) -> Topology:
+    """Topology from joints `edges` (name, frame_i, frame_j) and each joint's independent rows (its own and
+    its motions'). A joint whose block would exceed 6 rows goes to the loop rows."""
+    adj: dict[int, list[tuple[str, int]]] = {f: [] for f in range(nf)}
+    for name, fi, fj in edges:
+        adj[fi].append((name, fj))
+        adj[fj].append((name, fi))
+    parent_edge: dict[int, tuple[str, int]] = {}
+    seen, order = set(), []
+    tree_names: set[str] = set()
+    for root in range(nf):
+        if root in seen:
+            continue
+        seen.add(root)
+        if root != 0:
+            order.append(root)
+        queue = deque([root])
+        while queue:
+            f = queue.popleft()
+            for name, g in adj[f]:
+                if g in seen or name in tree_names or len(rows_of.get(name, ())) > 6:
+                    continue
+                seen.add(g)
+                tree_names.add(name)
+                parent_edge[g] = (name, f)
+                order.append(g)
+                queue.append(g)
+    pblk = -np.ones(nf, dtype=np.int64)
+    blk_child, blk_parent, blk_rows, children = [], [], [], [[] for _ in range(nf)]
+    for f in order:
+        if f in parent_edge:
+            name, p = parent_edge[f]
+            pblk[f] = len(blk_child)
+            children[p].append(len(blk_child))
+            blk_child.append(f)
+            blk_parent.append(p)
+            blk_rows.append(sorted(rows_of.get(name, [])))
+    loop = sorted(r for name, rs in rows_of.items() if name not in tree_names for r in rs)
+    blk_ptr, blk_flat = _csr(blk_rows)
+    ch_ptr, ch_flat = _csr(children)
+    return Topology(np.array(order, dtype=np.int64), pblk, np.array(blk_child, dtype=np.int64),
+                    np.array(blk_parent, dtype=np.int64), blk_ptr, blk_flat, ch_ptr, ch_flat,
+                    np.array(loop, dtype=np.int64))
+
+
+def system_topology(sys, rows) -> Topology:
+    """Topology of a System for its independent rows `rows` (joints as edges; motions join their joint)."""
+    model = sys.model
+    joint_of = {m.name: m.joint.name for m in model.motions.values()}
+    rows_of: dict[str, list[int]] = {}
+    for r in np.asarray(rows, dtype=int):
+        owner = sys.row_owner[r]
+        rows_of.setdefault(joint_of.get(owner, owner), []).append(int(r))
+    edges = [(j.name, sys.fid[j.body_i], sys.fid[j.body_j]) for j in model.joints.values()
+             if sys.fid[j.body_i] != sys.fid[j.body_j]]
+    known = {e[0] for e in edges}
+    rows_of_edges = {k: v for k, v in rows_of.items() if k in known}
+    topo = spanning_tree(sys.nbody + 1, edges, rows_of_edges)
+    extra = [r for k, v in rows_of.items() if k not in known for r in v]   # rows of non-joint owners
+    if extra:
+        loop = np.array(sorted(list(topo.loop_rows) + extra), dtype=np.int64)
+        topo = Topology(**{**topo.__dict__, "loop_rows": loop})
+    return topo
