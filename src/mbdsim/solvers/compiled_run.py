@@ -50,11 +50,13 @@ class CompiledRun:
             iout = 1 if status == 0 else 0
         st = np.array([t0, 0.0])
         if status == 0:
-            st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n))
+            st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n),
+                                         np.zeros(n), np.zeros(n))
+        K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         while status == 0 and iout < nout:
             status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD, LAM,
                                        self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
-                                       self.stats)
+                                       self.stats, K, F, sc)
             if progress is not None:
                 progress(st[0])
         return Y, VD, LAM, iout, status, st[0], y

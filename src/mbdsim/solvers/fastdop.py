@@ -21,7 +21,7 @@ COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguou
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _rms(x, scale):
     s = 0.0
     for i in range(x.shape[0]):
@@ -29,17 +29,16 @@ def _rms(x, scale):
     return np.sqrt(s / x.shape[0])
 
 
-@njit(cache=True)
-def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work):
-    """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator."""
+@njit(cache=True, _nrt=False)
+def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
+    """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator;
+    work, scale, y1: scratch vectors of the state's size."""
     n = y0.shape[0]
-    scale = np.empty(n)
     for i in range(n):
         scale[i] = atol + abs(y0[i]) * rtol
     d0, d1 = _rms(y0, scale), _rms(f0, scale)
     h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
     h0 = min(h0, max_step)
-    y1 = np.empty(n)
     for i in range(n):
         y1[i] = y0[i] + h0 * f0[i]
     if rhs(cm, wk, t0 + h0, y1, work) != OK:
@@ -54,7 +53,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work):
     return min(100.0 * h0, h1, max_step)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def write_output(cm, wk, t, y, yout, vdout, lamout):
     """Accelerations and multipliers at a consistent state y into the output rows; status."""
     nq = cm[31][0]
@@ -63,7 +62,7 @@ def write_output(cm, wk, t, y, yout, vdout, lamout):
     return accelerations(cm, wk, t, y[:nq], y[nq:], vdout, lamout)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _dense(F, y_old, t_old, h, t, out):
     x = (t - t_old) / h
     for i in range(out.shape[0]):
@@ -78,21 +77,17 @@ def _dense(F, y_old, t_old, h, t, out):
         out[i] += y_old[i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_step, max_steps, chunk,
-        proj_tol, stats):
+        proj_tol, stats, K, F, sc):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
     outputs tout[iout:] into Y, VD, LAM; stops after `chunk` outputs. Returns (status, next iout).
-    stats: steps, rejected, rhs evaluations, projections (int64, accumulated)."""
+    stats: steps, rejected, rhs evaluations, projections (int64, accumulated); K (16, n), F (7, n) and
+    sc (4, n) are scratch."""
     A, B, C, E3, E5, D = co
     nq = cm[31][0]
     n = y.shape[0]
-    K = np.empty((16, n))
-    F = np.empty((7, n))
-    ys = np.empty(n)
-    ynew = np.empty(n)
-    yo = np.empty(n)
-    scale = np.empty(n)
+    ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
     t, h = st[0], st[1]
     written = 0
     rejected = False

@@ -16,7 +16,7 @@ try:   # the expression VM (system.exprvm) compiles drivers; without it drivers 
 except ImportError:   # pragma: no cover - transitional, until system.exprvm lands
     HAVE_VM = False
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
 from ..system.kernels import frames_into, rows_kernel
@@ -25,25 +25,25 @@ from .kkt_tree import dense_factor, dense_solve, kkt_factor, kkt_solve
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS = 0, 1, 2, 3, 4, 5
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def drivers_at(cm, wk, t):
     """Driver values f, f', f'' at time t [s] from the compiled expression programs."""
     code, consts, tables, start, end = cm[16], cm[17], cm[18], cm[19], cm[20]
-    fv, x, stack = wk[22], wk[23], wk[24]
+    fv, x, stack = (wk[34], wk[35], wk[36]), wk[23], wk[24]
     nd = start.shape[0] // 3
     x[0] = t
     for d in range(nd):
         for k in range(3):
             p = 3 * d + k
-            fv[k, d] = eval_program(code, consts, tables, start[p], end[p], x, stack)
+            fv[k][d] = eval_program(code, consts, tables, start[p], end[p], x, stack)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _cross_into(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
     """Add a ground-axes force at ground offset s from the CM of frame f into F (nf, 6)."""
     if f == 0:
@@ -57,10 +57,33 @@ def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
             F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def loads_into(cm, r, A, rd, w, F):
     """Gravity, gyroscopic torques, constant point forces/torques and linear spring-dampers into F."""
-    mass, inertia, gravity, rigid = cm[9], cm[10], cm[8], cm[6]
+    loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
+                 cm[29], r, A, rd, w, F)
+
+
+@njit(cache=True, _nrt=False)
+def _rot(A, f, x0, x1, x2):
+    """A[f] x (body axes -> ground)."""
+    return (A[f, 0, 0] * x0 + A[f, 0, 1] * x1 + A[f, 0, 2] * x2,
+            A[f, 1, 0] * x0 + A[f, 1, 1] * x1 + A[f, 1, 2] * x2,
+            A[f, 2, 0] * x0 + A[f, 2, 1] * x1 + A[f, 2, 2] * x2)
+
+
+@njit(cache=True, _nrt=False)
+def _rotT(A, f, x0, x1, x2):
+    """A[f]^T x (ground -> body axes)."""
+    return (A[f, 0, 0] * x0 + A[f, 1, 0] * x1 + A[f, 2, 0] * x2,
+            A[f, 0, 1] * x0 + A[f, 1, 1] * x1 + A[f, 2, 1] * x2,
+            A[f, 0, 2] * x0 + A[f, 1, 2] * x1 + A[f, 2, 2] * x2)
+
+
+@njit(cache=True, _nrt=False)
+def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, pf_torque, sp_f, sp_s, sp_par,
+                 r, A, rd, w, F):
+    """Loads of `loads_into` with explicit arrays (six slots per frame); no allocation."""
     nf = F.shape[0]
     for f in range(nf):
         for k in range(6):
@@ -69,94 +92,85 @@ def loads_into(cm, r, A, rd, w, F):
         for k in range(3):
             F[f, k] = mass[f] * gravity[k]
         if rigid[f]:
-            wb = np.empty(3)
-            for i in range(3):
-                wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
-            h0 = inertia[f, 0, 0] * wb[0] + inertia[f, 0, 1] * wb[1] + inertia[f, 0, 2] * wb[2]
-            h1 = inertia[f, 1, 0] * wb[0] + inertia[f, 1, 1] * wb[1] + inertia[f, 1, 2] * wb[2]
-            h2 = inertia[f, 2, 0] * wb[0] + inertia[f, 2, 1] * wb[1] + inertia[f, 2, 2] * wb[2]
-            c0, c1, c2 = _cross_into(wb[0], wb[1], wb[2], h0, h1, h2)
+            b0, b1, b2 = _rotT(A, f, w[f, 0], w[f, 1], w[f, 2])
+            h0 = inertia[f, 0, 0] * b0 + inertia[f, 0, 1] * b1 + inertia[f, 0, 2] * b2
+            h1 = inertia[f, 1, 0] * b0 + inertia[f, 1, 1] * b1 + inertia[f, 1, 2] * b2
+            h2 = inertia[f, 2, 0] * b0 + inertia[f, 2, 1] * b1 + inertia[f, 2, 2] * b2
+            c0, c1, c2 = _cross_into(b0, b1, b2, h0, h1, h2)
             F[f, 3] -= c0
             F[f, 4] -= c1
             F[f, 5] -= c2
-    pf_f, pf_s, pf_v, pf_ff, pf_R, pf_torque = cm[21], cm[22], cm[23], cm[24], cm[25], cm[26]
     for e in range(pf_f.shape[0]):   # constant vector loads, axes of frame pf_ff (R: marker in body)
         f, ff = pf_f[e], pf_ff[e]
-        g = np.empty(3)
-        for i in range(3):
-            loc = pf_R[e, i, 0] * pf_v[e, 0] + pf_R[e, i, 1] * pf_v[e, 1] + pf_R[e, i, 2] * pf_v[e, 2]
-            g[i] = loc
-        G = np.empty(3)
-        for i in range(3):
-            G[i] = A[ff, i, 0] * g[0] + A[ff, i, 1] * g[1] + A[ff, i, 2] * g[2]
         if f == 0:
             continue
+        l0 = pf_R[e, 0, 0] * pf_v[e, 0] + pf_R[e, 0, 1] * pf_v[e, 1] + pf_R[e, 0, 2] * pf_v[e, 2]
+        l1 = pf_R[e, 1, 0] * pf_v[e, 0] + pf_R[e, 1, 1] * pf_v[e, 1] + pf_R[e, 1, 2] * pf_v[e, 2]
+        l2 = pf_R[e, 2, 0] * pf_v[e, 0] + pf_R[e, 2, 1] * pf_v[e, 1] + pf_R[e, 2, 2] * pf_v[e, 2]
+        G0, G1, G2 = _rot(A, ff, l0, l1, l2)
         if pf_torque[e]:
             if rigid[f]:
-                for k in range(3):
-                    F[f, 3 + k] += A[f, 0, k] * G[0] + A[f, 1, k] * G[1] + A[f, 2, k] * G[2]
+                t0, t1, t2 = _rotT(A, f, G0, G1, G2)
+                F[f, 3] += t0
+                F[f, 4] += t1
+                F[f, 5] += t2
         else:
-            s = np.empty(3)
-            for i in range(3):
-                s[i] = A[f, i, 0] * pf_s[e, 0] + A[f, i, 1] * pf_s[e, 1] + A[f, i, 2] * pf_s[e, 2]
-            _point_force(F, A, f, s[0], s[1], s[2], G[0], G[1], G[2], rigid)
-    sp_f, sp_s, sp_par = cm[27], cm[28], cm[29]
+            s0, s1, s2 = _rot(A, f, pf_s[e, 0], pf_s[e, 1], pf_s[e, 2])
+            _point_force(F, A, f, s0, s1, s2, G0, G1, G2, rigid)
     for e in range(sp_f.shape[0]):   # spring-dampers: tension k (L - L0) + c dL/dt + preload
         fi, fj = sp_f[e, 0], sp_f[e, 1]
-        si = np.empty(3)
-        sj = np.empty(3)
-        for i in range(3):
-            si[i] = A[fi, i, 0] * sp_s[e, 0, 0] + A[fi, i, 1] * sp_s[e, 0, 1] + A[fi, i, 2] * sp_s[e, 0, 2]
-            sj[i] = A[fj, i, 0] * sp_s[e, 1, 0] + A[fj, i, 1] * sp_s[e, 1, 1] + A[fj, i, 2] * sp_s[e, 1, 2]
-        vi = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], si[0], si[1], si[2])
-        vj = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], sj[0], sj[1], sj[2])
-        d = np.empty(3)
-        dv = np.empty(3)
-        for i in range(3):
-            d[i] = r[fj, i] + sj[i] - r[fi, i] - si[i]
-            dv[i] = rd[fj, i] + vj[i] - rd[fi, i] - vi[i]
-        L = np.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
+        si0, si1, si2 = _rot(A, fi, sp_s[e, 0, 0], sp_s[e, 0, 1], sp_s[e, 0, 2])
+        sj0, sj1, sj2 = _rot(A, fj, sp_s[e, 1, 0], sp_s[e, 1, 1], sp_s[e, 1, 2])
+        vi0, vi1, vi2 = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], si0, si1, si2)
+        vj0, vj1, vj2 = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], sj0, sj1, sj2)
+        d0 = r[fj, 0] + sj0 - r[fi, 0] - si0
+        d1 = r[fj, 1] + sj1 - r[fi, 1] - si1
+        d2 = r[fj, 2] + sj2 - r[fi, 2] - si2
+        e0 = rd[fj, 0] + vj0 - rd[fi, 0] - vi0
+        e1 = rd[fj, 1] + vj1 - rd[fi, 1] - vi1
+        e2 = rd[fj, 2] + vj2 - rd[fi, 2] - vi2
+        L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
         inv = 1.0 / L if L > 0 else 0.0
-        Ld = (d[0] * dv[0] + d[1] * dv[1] + d[2] * dv[2]) * inv
+        Ld = (d0 * e0 + d1 * e1 + d2 * e2) * inv
         T = sp_par[e, 0] * (L - sp_par[e, 2]) + sp_par[e, 1] * Ld + sp_par[e, 3]
-        u0, u1, u2 = d[0] * inv * T, d[1] * inv * T, d[2] * inv * T
-        _point_force(F, A, fi, si[0], si[1], si[2], u0, u1, u2, rigid)
-        _point_force(F, A, fj, sj[0], sj[1], sj[2], -u0, -u1, -u2, rigid)
+        u0, u1, u2 = d0 * inv * T, d1 * inv * T, d2 * inv * T
+        _point_force(F, A, fi, si0, si1, si2, u0, u1, u2, rigid)
+        _point_force(F, A, fj, sj0, sj1, sj2, -u0, -u1, -u2, rigid)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _constraints(cm, wk, t, q, v):
     """Frames, driver values and constraint rows at (q, v, t) into the work arrays."""
     r_idx, p_idx, rd_idx, w_idx, rigid_fid, rigid = cm[0], cm[1], cm[2], cm[3], cm[4], cm[6]
-    r, A, rd, w, phi, Jc, nu, gamma, fv = wk[0], wk[1], wk[2], wk[3], wk[4], wk[5], wk[6], wk[7], wk[22]
+    r, A, rd, w, phi, Jc, nu, gamma = wk[0], wk[1], wk[2], wk[3], wk[4], wk[5], wk[6], wk[7]
     frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
     if cm[19].shape[0] > 0:
         drivers_at(cm, wk, t)
-    rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[14][0], cm[14][1], cm[14][2], cm[15],
-                fv[0], fv[1], fv[2], rigid, phi, Jc, nu, gamma)
+    rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[33], cm[34], cm[35], cm[15],
+                wk[34], wk[35], wk[36], rigid, phi, Jc, nu, gamma)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _factor(cm, wk):
     if cm[31][4]:
         return dense_factor(wk[5], cm[12], cm[13], cm[7], cm[32], wk[32], wk[33])
     t = cm[30]
     return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8],
                       wk[9], wk[10], wk[11], wk[12], wk[13], wk[14], wk[15], wk[16], wk[17], wk[18],
-                      wk[20], wk[21])
+                      wk[20], wk[21], wk[37], wk[38])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _solve(cm, wk, F, c_rows, x6, lam):
     if cm[31][4]:
-        dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam)
+        dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
         return
     t = cm[30]
     kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
-              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam)
+              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam, wk[38])
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def accelerations(cm, wk, t, q, v, vd, lam):
     """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status."""
     _constraints(cm, wk, t, q, v)
@@ -176,7 +190,7 @@ def accelerations(cm, wk, t, q, v, vd, lam):
     return OK
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _from6(cm, x6, x):
     """Six slots per frame -> system velocity layout."""
     vadr, rigid = cm[5], cm[6]
@@ -186,7 +200,7 @@ def _from6(cm, x6, x):
             x[vadr[f] + k] = x6[f, k]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _to6(cm, x, x6):
     vadr, rigid = cm[5], cm[6]
     for f in range(x6.shape[0]):
@@ -199,10 +213,15 @@ def _to6(cm, x, x6):
             x6[f, k] = x[vadr[f] + k]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def qdot_into(cm, q, v, qd):
     """dq/dt: CM velocities and Euler-parameter rates 1/2 p (x) (0, w_B)."""
-    r_idx, p_idx, rd_idx, w_idx = cm[0], cm[1], cm[2], cm[3]
+    qdot_kernel(cm[0], cm[1], cm[2], cm[3], q, v, qd)
+
+
+@njit(cache=True, _nrt=False)
+def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
+    """`qdot_into` with explicit index arrays."""
     for k in range(r_idx.shape[0]):
         for c in range(3):
             qd[r_idx[k, c]] = v[rd_idx[k, c]]
@@ -215,7 +234,7 @@ def qdot_into(cm, q, v, qd):
         qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def rhs(cm, wk, t, y, ydot):
     """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded)."""
     nq = cm[31][0]
@@ -226,10 +245,15 @@ def rhs(cm, wk, t, y, ydot):
     return st
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def increment_into(cm, q, dx6):
     """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) (body-axes rotation vectors), in place."""
-    r_idx, p_idx, rigid_fid = cm[0], cm[1], cm[4]
+    increment_kernel6(cm[0], cm[1], cm[4], q, dx6)
+
+
+@njit(cache=True, _nrt=False)
+def increment_kernel6(r_idx, p_idx, rigid_fid, q, dx6):
+    """`increment_into` with explicit index arrays; dx6 (nf, 6) six slots per frame."""
     for k in range(r_idx.shape[0]):
         for c in range(3):
             q[r_idx[k, c]] += dx6[k + 1, c]
@@ -249,9 +273,14 @@ def increment_into(cm, q, dx6):
         q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def normalize_into(cm, q):
-    p_idx = cm[1]
+    normalize_kernel(cm[1], q)
+
+
+@njit(cache=True, _nrt=False)
+def normalize_kernel(p_idx, q):
+    """Unit-normalise the Euler parameters in q."""
     for k in range(p_idx.shape[0]):
         n = 0.0
         for c in range(4):
@@ -261,7 +290,7 @@ def normalize_into(cm, q):
             q[p_idx[k, c]] /= n
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def project(cm, wk, t, q, v, tol):
     """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu."""
     active = cm[32]

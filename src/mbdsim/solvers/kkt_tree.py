@@ -21,49 +21,49 @@ import numpy as np
 from numba import njit
 
 
-@njit(cache=True)
-def chol(A, n, L):
-    """Cholesky factor L (lower) of the leading n x n block of A; False if not positive definite."""
+@njit(cache=True, _nrt=False)
+def chol(A, n, L3, il):
+    """Cholesky factor L3[il] (lower; its diagonal holds the reciprocals) of the leading n x n block of A;
+    False if not positive definite."""
     for i in range(n):
         for j in range(i + 1):
             s = A[i, j]
             for k in range(j):
-                s -= L[i, k] * L[j, k]
+                s -= L3[il, i, k] * L3[il, j, k]
             if i == j:
                 if not s > 1e-300:
                     return False
-                L[i, i] = np.sqrt(s)
+                L3[il, i, i] = 1.0 / np.sqrt(s)
             else:
-                L[i, j] = s / L[j, j]
+                L3[il, i, j] = s * L3[il, j, j]
     return True
 
 
-@njit(cache=True)
-def chol_solve(L, n, b):
-    """Solve (L L^T) x = b in place for the leading n entries of b."""
+@njit(cache=True, _nrt=False)
+def chol_solve(L3, il, n, b2, ib):
+    """Solve (L L^T) x = b in place for the leading n entries of b2[ib] (L = L3[il] from `chol`)."""
     for i in range(n):
-        s = b[i]
+        s = b2[ib, i]
         for k in range(i):
-            s -= L[i, k] * b[k]
-        b[i] = s / L[i, i]
+            s -= L3[il, i, k] * b2[ib, k]
+        b2[ib, i] = s * L3[il, i, i]
     for i in range(n - 1, -1, -1):
-        s = b[i]
+        s = b2[ib, i]
         for k in range(i + 1, n):
-            s -= L[k, i] * b[k]
-        b[i] = s / L[i, i]
+            s -= L3[il, k, i] * b2[ib, k]
+        b2[ib, i] = s * L3[il, i, i]
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _side(bi, bj, row, f):
     return 0 if bi[row] == f else 1
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-                LD, G, LS, JC, JP):
-    """Factor the tree part: LD (nf, 6, 6), G, LS, JC, JP (nblk, 6, 6) filled; False on a bad pivot."""
-    D = np.empty((6, 6))
-    X = np.empty(6)
+                LD, G, LS, JC, JP, D, X):
+    """Factor the tree part: LD (nf, 6, 6), G, LS, JC, JP (nblk, 6, 6) filled; False on a bad pivot.
+    D (6, 6) and X (2, 6) are scratch."""
     for b in range(blk_child.shape[0]):   # gather each block's child- and parent-side rows
         c, p = blk_child[b], blk_parent[b]
         for a in range(blk_ptr[b + 1] - blk_ptr[b]):
@@ -82,40 +82,37 @@ def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk
             m = blk_ptr[k + 1] - blk_ptr[k]
             for col in range(6):
                 for r in range(m):
-                    X[r] = JP[k, r, col]
-                chol_solve(LS[k], m, X)
+                    X[0, r] = JP[k, r, col]
+                chol_solve(LS, k, m, X, 0)
                 for i in range(6):
                     s = 0.0
                     for r in range(m):
-                        s += JP[k, r, i] * X[r]
+                        s += JP[k, r, i] * X[0, r]
                     D[i, col] += s
-        if not chol(D, 6, LD[c]):
+        if not chol(D, 6, LD, c):
             return False
         j = pblk[c]
         if j >= 0:
             m = blk_ptr[j + 1] - blk_ptr[j]
             for r in range(m):          # G_j = JC_j D^-1 (rows of D^-1 JC_j^T, D symmetric)
                 for k in range(6):
-                    X[k] = JC[j, r, k]
-                chol_solve(LD[c], 6, X)
-                for k in range(6):
-                    G[j, r, k] = X[k]
+                    G[j, r, k] = JC[j, r, k]
+                chol_solve(LD, c, 6, G[j], r)
             for r in range(m):
                 for s_ in range(m):
                     s = 0.0
                     for k in range(6):
                         s += G[j, r, k] * JC[j, s_, k]
                     D[r, s_] = s
-            if not chol(D, m, LS[j]):
+            if not chol(D, m, LS, j):
                 return False
     return True
 
 
-@njit(cache=True)
-def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u):
+@njit(cache=True, _nrt=False)
+def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X):
     """Solve the tree system for loads F (nf, 6) and row right-hand sides c_rows (nc,) (global rows);
-    writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6) are work arrays."""
-    X = np.empty(6)
+    writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6), X (2, 6) are work arrays."""
     for f in range(F.shape[0]):
         for k in range(6):
             Qt[f, k] = F[f, k]
@@ -131,7 +128,7 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F,
             for k in range(6):
                 s += G[j, r, k] * Qt[c, k]
             u[j, r] = s
-        chol_solve(LS[j], m, u[j])
+        chol_solve(LS, j, m, u, j)
         p = blk_parent[j]
         if p != 0:
             for k in range(6):
@@ -139,12 +136,11 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F,
                 for r in range(m):
                     s += JP[j, r, k] * u[j, r]
                 Qt[p, k] -= s
-    lj = np.empty(6)
     for ii in range(order.shape[0]):
         c = order[ii]
         j = pblk[c]
         for k in range(6):
-            X[k] = Qt[c, k]
+            X[0, k] = Qt[c, k]
         if j >= 0:
             m = blk_ptr[j + 1] - blk_ptr[j]
             p = blk_parent[j]
@@ -153,44 +149,22 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F,
                 if p != 0:
                     for k in range(6):
                         s += JP[j, r, k] * vd[p, k]
-                lj[r] = s
-            chol_solve(LS[j], m, lj)
+                X[1, r] = s
+            chol_solve(LS, j, m, X, 1)
             for r in range(m):
-                lj[r] += u[j, r]
-                lam[blk_rows[blk_ptr[j] + r]] = lj[r]
+                X[1, r] += u[j, r]
+                lam[blk_rows[blk_ptr[j] + r]] = X[1, r]
             for k in range(6):
                 s = 0.0
                 for r in range(m):
-                    s += JC[j, r, k] * lj[r]
-                X[k] -= s
-        chol_solve(LD[c], 6, X)
+                    s += JC[j, r, k] * X[1, r]
+                X[0, k] -= s
+        chol_solve(LD, c, 6, X, 0)
         for k in range(6):
-            vd[c, k] = X[k]
+            vd[c, k] = X[0, k]
 
 
-class TreeWork:
-    """Preallocated work arrays of the tree solve for a topology (per run, not shared between threads)."""
-
-    def __init__(self, topo, nf: int, nc: int):
-        nblk = len(topo.blk_child)
-        nl = len(topo.loop_rows)
-        self.LD = np.zeros((nf, 6, 6))
-        self.G = np.zeros((max(nblk, 1), 6, 6))
-        self.LS = np.zeros((max(nblk, 1), 6, 6))
-        self.JC = np.zeros((max(nblk, 1), 6, 6))
-        self.JP = np.zeros((max(nblk, 1), 6, 6))
-        self.Qt = np.zeros((nf, 6))
-        self.u = np.zeros((max(nblk, 1), 6))
-        self.W = np.zeros((max(nl, 1), nf, 6))
-        self.KW = np.zeros((max(nl, 1), max(nl, 1)))
-        self.LK = np.zeros((max(nl, 1), max(nl, 1)))
-        self.lamL = np.zeros(max(nl, 1))
-        self.F2 = np.zeros((nf, 6))
-        self.c0 = np.zeros(nc)
-        self.lam_tmp = np.zeros(nc)
-
-
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def _row_dot(Jc, bi, bj, row, x):
     s = 0.0
     for side in range(2):
@@ -201,19 +175,22 @@ def _row_dot(Jc, bi, bj, row, x):
     return s
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp):
-    """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular."""
+               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D):
+    """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular.
+    F (nf, 6) and D (6, 6) are scratch; the first two rows of D also serve as the solves' (2, 6) scratch."""
     if not tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-                       LD, G, LS, JC, JP):
+                       LD, G, LS, JC, JP, D, F):
         return False
     nl = loop_rows.shape[0]
     if nl == 0:
         return True
     for i in range(c0.shape[0]):
         c0[i] = 0.0
-    F = np.zeros((M6.shape[0], 6))
+    for f in range(F.shape[0]):
+        for k in range(6):
+            F[f, k] = 0.0
     for i in range(nl):
         row = loop_rows[i]
         for side in range(2):
@@ -221,7 +198,7 @@ def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_
             if f != 0:
                 for k in range(6):
                     F[f, k] = Jc[row, side, k]
-        tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c0, W[i], lam_tmp, Qt, u)
+        tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c0, W[i], lam_tmp, Qt, u, D)
         for side in range(2):
             f = bi[row] if side == 0 else bj[row]
             if f != 0:
@@ -236,41 +213,41 @@ def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_
     for a in range(nl):
         for b in range(nl):
             KW[a, b] = 0.5 * (KW[a, b] + KW[b, a])
-    if not chol(KW, nl, LK):
+    if not chol(KW, nl, LK, 0):
         return False
     for a in range(nl):   # a pivot tiny against the largest diagonal: dependent loop rows
-        if LK[a, a] * LK[a, a] < 1e-13 * scale:
+        if 1.0 < 1e-13 * scale * LK[0, a, a] * LK[0, a, a]:
             return False
     return True
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows, LD, G, LS, JC, JP, Qt, u,
-              W, LK, lamL, F2, F, c_rows, vd, lam):
+              W, LK, lamL, F2, F, c_rows, vd, lam, X):
     """Solve the factored system for loads F (nf, 6) and row right-hand sides c_rows (nc,);
-    writes vd (nf, 6) and lam (nc,) at every tree and loop row."""
-    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u)
+    writes vd (nf, 6) and lam (nc,) at every tree and loop row. X (>= 2, 6) is scratch."""
+    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X)
     nl = loop_rows.shape[0]
     if nl == 0:
         return
     for a in range(nl):
-        lamL[a] = _row_dot(Jc, bi, bj, loop_rows[a], vd) - c_rows[loop_rows[a]]
-    chol_solve(LK, nl, lamL)
+        lamL[0, a] = _row_dot(Jc, bi, bj, loop_rows[a], vd) - c_rows[loop_rows[a]]
+    chol_solve(LK, 0, nl, lamL, 0)
     for f in range(F.shape[0]):
         for k in range(6):
             F2[f, k] = F[f, k]
     for a in range(nl):
         row = loop_rows[a]
-        lam[row] = lamL[a]
+        lam[row] = lamL[0, a]
         for side in range(2):
             f = bi[row] if side == 0 else bj[row]
             if f != 0:
                 for k in range(6):
-                    F2[f, k] -= Jc[row, side, k] * lamL[a]
-    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F2, c_rows, vd, lam, Qt, u)
+                    F2[f, k] -= Jc[row, side, k] * lamL[0, a]
+    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F2, c_rows, vd, lam, Qt, u, X)
 
 
-@njit(cache=True)
+@njit(cache=True, _nrt=False)
 def dense_factor(Jc, bi, bj, M6, active, KD, piv):
     """Dense LU (partial pivoting) of the augmented matrix over six slots per body and the active rows,
     for models with a singular body mass matrix (massless links, point masses on rigid frames)."""
@@ -313,12 +290,11 @@ def dense_factor(Jc, bi, bj, M6, active, KD, piv):
     return True
 
 
-@njit(cache=True)
-def dense_solve(active, KD, piv, F, c_rows, vd, lam):
-    """Solve with the LU of `dense_factor` for loads F (nf, 6) and row right-hand sides c_rows."""
+@njit(cache=True, _nrt=False)
+def dense_solve(active, KD, piv, F, c_rows, vd, lam, x):
+    """Solve with the LU of `dense_factor` for loads F (nf, 6) and row right-hand sides c_rows; x scratch (n)."""
     nb = F.shape[0] - 1
     n = KD.shape[0]
-    x = np.empty(n)
     for f in range(1, nb + 1):
         for k in range(6):
             x[6 * (f - 1) + k] = F[f, k]

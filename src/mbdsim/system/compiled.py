@@ -69,7 +69,7 @@ class CompiledModel:
                 self.M6, self.gravity, self.mass, self.inertia, self.kind, self.bi, self.bj, self.vecs,
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
-                self.dims, self.active)
+                self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy())
 
 
 @dataclass
@@ -88,9 +88,9 @@ class Work:
         z = np.zeros
         a = (z((nf, 3)), z((nf, 3, 3)), z((nf, 3)), z((nf, 3)), z(nc), z((nc, 2, 6)), z(nc), z(nc), z((nf, 6)),
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
-             z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((nl, nl)), z(nl), z(nc), z(nc), z((3, nd)), z(4),
+             z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z(nc), z((3, nd)), z(4),
              z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
-             z((nk, nk)), np.zeros(nk, np.int64))
+             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk))
         return cls(a)
 
     def arrays(self) -> tuple:

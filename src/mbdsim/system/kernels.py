@@ -43,33 +43,33 @@ def pack_rows(sys):
 
 
 if HAVE_NUMBA:
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _mv(A, b, x):
         return (A[b, 0, 0] * x[0] + A[b, 0, 1] * x[1] + A[b, 0, 2] * x[2],
                 A[b, 1, 0] * x[0] + A[b, 1, 1] * x[1] + A[b, 1, 2] * x[2],
                 A[b, 2, 0] * x[0] + A[b, 2, 1] * x[1] + A[b, 2, 2] * x[2])
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _cr(a, b):
         return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _dt(a, b):
         return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _add(a, b):
         return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _sub(a, b):
         return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _sc(s, a):
         return (s * a[0], s * a[1], s * a[2])
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _put(Jc, row, side, b, Jr, Jp, A, rigid):
         """Row coefficients of frame b (side 0: body_i, 1: body_j): translation, then body-axes rotation Jp A."""
         for k in range(6):
@@ -96,7 +96,7 @@ if HAVE_NUMBA:
                 for k in range(n):
                     J[row, c + k] += Jc[row, side, k]
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def _dot1(A, w, bi, bj, ai_B, aj_B):
         ai = _mv(A, bi, ai_B)
         aj = _mv(A, bj, aj_B)
@@ -108,7 +108,7 @@ if HAVE_NUMBA:
         rate = _dt(c, wi) - _dt(c, wj)
         return _dt(ai, aj), c, quad, rate
 
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
         """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row.
 
@@ -187,7 +187,7 @@ if HAVE_NUMBA:
 
 
 if HAVE_NUMBA:
-    @njit(cache=True)
+    @njit(cache=True, _nrt=False)
     def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
         """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""
         nf = r.shape[0]
