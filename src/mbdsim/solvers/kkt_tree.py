@@ -6,8 +6,10 @@ Bodies are eliminated leaves first (Baraff's linear-time block elimination): for
 child body c to its parent p,
 
     D_c = M_c + sum_k JP_k^T S_k^-1 JP_k      (k: blocks whose parent is c)
-    G_j = JC_j D_c^-1,  S_j = G_j JC_j^T       (m_j x m_j, symmetric positive definite)
+    S_j = JC_j D_c^-1 JC_j^T                   (m_j x m_j, symmetric positive definite)
 
+both formed from triangular solves with the Cholesky factors (D = L L^T: S_j = Z Z^T, Z = L_D^-1 JC^T;
+JP^T S^-1 JP = Y^T Y, Y = L_S^-1 JP),
 and the solve is one backward and one forward sweep. The loop rows K enter through the Schur complement
 (K W) lambda_L = K vd0 - c_L with W = tree solve of K^T, so the cost is O(N (1 + n_loop)). Every body has
 six velocity slots here (CM velocity [m/s], body-axes angular velocity [rad/s]); a particle's rotational
@@ -60,10 +62,31 @@ def _side(bi, bj, row, f):
 
 
 @njit(cache=True, _nrt=False)
+def _fwd(L3, il, n, b2, ib):
+    """b2[ib] <- L^-1 b2[ib] (forward substitution with L = L3[il] from `chol`)."""
+    for i in range(n):
+        s = b2[ib, i]
+        for k in range(i):
+            s -= L3[il, i, k] * b2[ib, k]
+        b2[ib, i] = s * L3[il, i, i]
+
+
+@njit(cache=True, _nrt=False)
+def _bwd(L3, il, n, b2, ib):
+    """b2[ib] <- L^-T b2[ib] (back substitution with L = L3[il] from `chol`)."""
+    for i in range(n - 1, -1, -1):
+        s = b2[ib, i]
+        for k in range(i + 1, n):
+            s -= L3[il, k, i] * b2[ib, k]
+        b2[ib, i] = s * L3[il, i, i]
+
+
+@njit(cache=True, _nrt=False)
 def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-                LD, G, LS, JC, JP, D, X):
-    """Factor the tree part: LD (nf, 6, 6), G, LS, JC, JP (nblk, 6, 6) filled; False on a bad pivot.
-    D (6, 6) and X (2, 6) are scratch."""
+                LD, Y, LS, JC, JP, D, Z):
+    """Factor the tree part, leaves first: LD[c] = chol(D_c), LS[j] = chol(S_j), Y[j] = LS_j^-1 JP_j
+    (so that JP^T S^-1 JP = Y^T Y); JC, JP: each block's child- and parent-side rows. D (6, 6) and
+    Z (>= 6, 6) are scratch. False on a pivot that is not positive (dependent rows)."""
     for b in range(blk_child.shape[0]):   # gather each block's child- and parent-side rows
         c, p = blk_child[b], blk_parent[b]
         for a in range(blk_ptr[b + 1] - blk_ptr[b]):
@@ -77,42 +100,50 @@ def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk
         for i in range(6):
             for j in range(6):
                 D[i, j] = M6[c, i, j]
-        for a in range(ch_ptr[c], ch_ptr[c + 1]):   # D += JP^T S^-1 JP of each child block
+        for a in range(ch_ptr[c], ch_ptr[c + 1]):   # D += Y_k^T Y_k of each child block
             k = ch_blk[a]
             m = blk_ptr[k + 1] - blk_ptr[k]
-            for col in range(6):
-                for r in range(m):
-                    X[0, r] = JP[k, r, col]
-                chol_solve(LS, k, m, X, 0)
-                for i in range(6):
+            for i in range(6):
+                for j in range(i + 1):
                     s = 0.0
                     for r in range(m):
-                        s += JP[k, r, i] * X[0, r]
-                    D[i, col] += s
+                        s += Y[k, r, i] * Y[k, r, j]
+                    D[i, j] += s
+                    if j != i:
+                        D[j, i] += s
         if not chol(D, 6, LD, c):
             return False
         j = pblk[c]
-        if j >= 0:
-            m = blk_ptr[j + 1] - blk_ptr[j]
-            for r in range(m):          # G_j = JC_j D^-1 (rows of D^-1 JC_j^T, D symmetric)
+        if j < 0:
+            continue
+        m = blk_ptr[j + 1] - blk_ptr[j]
+        for r in range(m):          # Z rows: L_D^-1 JC_j^T, so that S_j = JC D^-1 JC^T = Z Z^T
+            for k in range(6):
+                Z[r, k] = JC[j, r, k]
+            _fwd(LD, c, 6, Z, r)
+        for r in range(m):
+            for q in range(r + 1):
+                s = 0.0
                 for k in range(6):
-                    G[j, r, k] = JC[j, r, k]
-                chol_solve(LD, c, 6, G[j], r)
-            for r in range(m):
-                for s_ in range(m):
-                    s = 0.0
-                    for k in range(6):
-                        s += G[j, r, k] * JC[j, s_, k]
-                    D[r, s_] = s
-            if not chol(D, m, LS, j):
-                return False
+                    s += Z[r, k] * Z[q, k]
+                D[r, q] = s
+                D[q, r] = s
+        if not chol(D, m, LS, j):
+            return False
+        if blk_parent[j] != 0:      # Y_j = LS_j^-1 JP_j, column by column
+            for k in range(6):
+                for r in range(m):
+                    Z[0, r] = JP[j, r, k]
+                _fwd(LS, j, m, Z, 0)
+                for r in range(m):
+                    Y[j, r, k] = Z[0, r]
     return True
 
 
 @njit(cache=True, _nrt=False)
-def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X):
+def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, Y, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X):
     """Solve the tree system for loads F (nf, 6) and row right-hand sides c_rows (nc,) (global rows);
-    writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6), X (2, 6) are work arrays."""
+    writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6), X (>= 2, 6) are work."""
     for f in range(F.shape[0]):
         for k in range(6):
             Qt[f, k] = F[f, k]
@@ -123,12 +154,15 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F,
         if j < 0:
             continue
         m = blk_ptr[j + 1] - blk_ptr[j]
+        for k in range(6):
+            X[0, k] = Qt[c, k]
+        chol_solve(LD, c, 6, X, 0)                  # D_c^-1 Qt_c
         for r in range(m):
             s = -c_rows[blk_rows[blk_ptr[j] + r]]
             for k in range(6):
-                s += G[j, r, k] * Qt[c, k]
+                s += JC[j, r, k] * X[0, k]
             u[j, r] = s
-        chol_solve(LS, j, m, u, j)
+        chol_solve(LS, j, m, u, j)                  # u_j = S^-1 (JC D^-1 Qt - c)
         p = blk_parent[j]
         if p != 0:
             for k in range(6):
@@ -144,13 +178,14 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F,
         if j >= 0:
             m = blk_ptr[j + 1] - blk_ptr[j]
             p = blk_parent[j]
-            for r in range(m):
+            for r in range(m):                      # lambda_j = u_j + LS^-T (Y_j vd_p)
                 s = 0.0
                 if p != 0:
                     for k in range(6):
-                        s += JP[j, r, k] * vd[p, k]
+                        s += Y[j, r, k] * vd[p, k]
                 X[1, r] = s
-            chol_solve(LS, j, m, X, 1)
+            if p != 0:
+                _bwd(LS, j, m, X, 1)
             for r in range(m):
                 X[1, r] += u[j, r]
                 lam[blk_rows[blk_ptr[j] + r]] = X[1, r]
@@ -177,11 +212,11 @@ def _row_dot(Jc, bi, bj, row, x):
 
 @njit(cache=True, _nrt=False)
 def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D):
+               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D, Z):
     """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular.
-    F (nf, 6) and D (6, 6) are scratch; the first two rows of D also serve as the solves' (2, 6) scratch."""
+    F (nf, 6), D (6, 6) and Z (6, 6) are scratch."""
     if not tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-                       LD, G, LS, JC, JP, D, F):
+                       LD, G, LS, JC, JP, D, Z):
         return False
     nl = loop_rows.shape[0]
     if nl == 0:
