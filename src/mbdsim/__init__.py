@@ -5,6 +5,7 @@ Public API (a contract; everything else may change): Model and its add_* methods
 types, and the Adams-style function library (STEP, STEP5, HAVSIN, IMPACT, BISTOP, POLY, SHF, AKISPL)
 with the safe expression parser `parse`.
 """
+from . import _jitcache  # noqa: F401  (first: numba's cache directory for this version of the kernels)
 from . import expressions, functions
 from .errors import AssemblyError, MbdsimError, ModelError, SolverError
 from .expressions import ExpressionError, parse

@@ -157,7 +157,7 @@ def _factor(cm, wk):
     t = cm[30]
     return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8],
                       wk[9], wk[10], wk[11], wk[12], wk[13], wk[14], wk[15], wk[16], wk[17], wk[18],
-                      wk[20], wk[21], wk[37], wk[38], wk[40])
+                      wk[20], wk[21], wk[37], wk[38], wk[40], wk[41])
 
 
 @njit(cache=True, _nrt=False)
@@ -167,7 +167,7 @@ def _solve(cm, wk, F, c_rows, x6, lam):
         return
     t = cm[30]
     kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
-              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam, wk[38])
+              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam, wk[38], wk[41])
 
 
 @njit(cache=True, _nrt=False)

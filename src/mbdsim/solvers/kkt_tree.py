@@ -212,7 +212,7 @@ def _row_dot(Jc, bi, bj, row, x):
 
 @njit(cache=True, _nrt=False)
 def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D, Z):
+               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D, Z, perm):
     """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular.
     F (nf, 6), D (6, 6) and Z (6, 6) are scratch."""
     if not tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
@@ -242,37 +242,72 @@ def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_
     for a in range(nl):
         for b in range(nl):
             KW[a, b] = _row_dot(Jc, bi, bj, loop_rows[a], W[b])
-    scale = 0.0
     for a in range(nl):
-        scale = max(scale, KW[a, a])
-    for a in range(nl):
-        for b in range(nl):
-            KW[a, b] = 0.5 * (KW[a, b] + KW[b, a])
-    if not chol(KW, nl, LK, 0):
-        return False
-    for a in range(nl):   # a pivot tiny against the largest diagonal: dependent loop rows
-        if 1.0 < 1e-13 * scale * LK[0, a, a] * LK[0, a, a]:
-            return False
-    return True
+        for b in range(a):
+            s = 0.5 * (KW[a, b] + KW[b, a])
+            KW[a, b] = s
+            KW[b, a] = s
+    return pivoted_chol(KW, nl, LK, perm) >= 0
+
+
+@njit(cache=True, _nrt=False)
+def pivoted_chol(A, n, L3, perm):
+    """Cholesky with diagonal pivoting of the symmetric positive semi-definite A (overwritten): the
+    factor of the permuted leading block goes to L3[0] (reciprocal diagonal, as `chol`), the order to
+    perm[1:], the rank to perm[0]. Pivots below 1e-10 of the largest diagonal count as zero: rows that
+    are (nearly) dependent at this configuration, such as a four-bar's loop at a change point, are left
+    out of the solve (their multipliers are zero) instead of making it singular. Returns the rank."""
+    big = 0.0
+    for i in range(n):
+        perm[1 + i] = i
+        big = max(big, A[i, i])
+    tol = 1e-10 * big
+    rank = n
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if A[perm[1 + i], perm[1 + i]] > A[perm[1 + p], perm[1 + p]]:
+                p = i
+        perm[1 + k], perm[1 + p] = perm[1 + p], perm[1 + k]
+        for j in range(k):
+            L3[0, k, j], L3[0, p, j] = L3[0, p, j], L3[0, k, j]
+        pk = perm[1 + k]
+        if not A[pk, pk] > tol:
+            rank = k
+            break
+        d = np.sqrt(A[pk, pk])
+        L3[0, k, k] = 1.0 / d
+        for i in range(k + 1, n):
+            L3[0, i, k] = A[perm[1 + i], pk] / d
+        for i in range(k + 1, n):
+            pi_ = perm[1 + i]
+            for j in range(k + 1, i + 1):
+                pj = perm[1 + j]
+                A[pi_, pj] -= L3[0, i, k] * L3[0, j, k]
+                A[pj, pi_] = A[pi_, pj]
+    perm[0] = rank
+    return rank
 
 
 @njit(cache=True, _nrt=False)
 def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows, LD, G, LS, JC, JP, Qt, u,
-              W, LK, lamL, F2, F, c_rows, vd, lam, X):
+              W, LK, lamL, F2, F, c_rows, vd, lam, X, perm):
     """Solve the factored system for loads F (nf, 6) and row right-hand sides c_rows (nc,);
     writes vd (nf, 6) and lam (nc,) at every tree and loop row. X (>= 2, 6) is scratch."""
     tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X)
     nl = loop_rows.shape[0]
     if nl == 0:
         return
-    for a in range(nl):
-        lamL[0, a] = _row_dot(Jc, bi, bj, loop_rows[a], vd) - c_rows[loop_rows[a]]
-    chol_solve(LK, 0, nl, lamL, 0)
+    rank = perm[0]
+    for a in range(nl):   # in pivot order; dependent rows (beyond the rank) get zero multipliers
+        row = loop_rows[perm[1 + a]]
+        lamL[0, a] = _row_dot(Jc, bi, bj, row, vd) - c_rows[row] if a < rank else 0.0
+    chol_solve(LK, 0, rank, lamL, 0)
     for f in range(F.shape[0]):
         for k in range(6):
             F2[f, k] = F[f, k]
     for a in range(nl):
-        row = loop_rows[a]
+        row = loop_rows[perm[1 + a]]
         lam[row] = lamL[0, a]
         for side in range(2):
             f = bi[row] if side == 0 else bj[row]
