@@ -1,0 +1,276 @@
+"""Time-history plots of a Result (or of its exported DataFrame) with matplotlib.
+
+`plot(res, signal, x=None, ax=None, **kw)` draws curves against time [s], or against another signal
+given as `x`, with axis labels carrying SI units, and marks the run's events with vertical lines.
+A signal is one of:
+
+* a callable of the Result, e.g. ``lambda r: r.joint_coordinate("pin")``: when it returns a Result
+  measure unchanged, the label and unit are taken from that measure ("pin angle [rad]");
+* a column name of ``res.to_dataframe()`` ("pin.angle [rad]"), matched leniently: exactly, then
+  case-insensitively ignoring the unit suffix, then by a unique case-insensitive prefix;
+* a pair ``("label [unit]", callable)`` to name a computed signal yourself.
+
+matplotlib is imported only when a plot is drawn (Agg backend when none was chosen).
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from .errors import ModelError
+
+TIME_COLUMN = "time [s]"
+_UNIT_RE = re.compile(r"^(.*?)\s*\[([^\]]*)\]\s*$")
+
+# Result measures: (label suffix, unit) for single-call signals; joint coordinates depend on the joint kind
+_MEASURE_UNITS = {
+    "position": ("position", "m"), "velocity": ("velocity", "m/s"), "acceleration": ("acceleration", "m/s^2"),
+    "angular_velocity": ("angular velocity", "rad/s"),
+    "angular_acceleration": ("angular acceleration", "rad/s^2"),
+    "reaction_force": ("reaction force", "N"), "reaction_torque": ("reaction torque", "N m"),
+    "kinetic_energy": ("kinetic energy", "J"), "potential_energy": ("potential energy", "J"),
+    "dissipated_energy": ("dissipated energy", "J"),
+}
+_JOINT_UNITS = {  # joint kind -> (coordinate unit, component names or None for a scalar)
+    "revolute": ("rad", None), "translational": ("m", None), "cylindrical": (None, ("angle", "slide")),
+    "spherical": ("rad", ("rx", "ry", "rz")), "universal": ("rad", ("rx", "ry", "rz")),
+    "fixed": ("rad", ("rx", "ry", "rz")), "planar": (None, ("u", "v", "angle")),
+}
+
+
+@dataclass
+class Signal:
+    """A resolved signal: `values` (N,) or (N, k), a label without unit and its unit ('' if unknown)."""
+
+    label: str
+    unit: str
+    values: np.ndarray
+    components: tuple[str, ...] | None = None
+
+    @property
+    def title(self) -> str:
+        """'label [unit]' (or just the label when the unit is unknown)."""
+        return f"{self.label} [{self.unit}]" if self.unit else self.label
+
+
+def split_unit(name: str) -> tuple[str, str]:
+    """'pin.angle [rad]' -> ('pin.angle', 'rad'); a name without brackets has unit ''."""
+    m = _UNIT_RE.match(str(name))
+    return (m.group(1), m.group(2)) if m else (str(name), "")
+
+
+def match_column(columns: Sequence[str], name: str) -> str:
+    """The column of `columns` that `name` designates: exact, then case-insensitive ignoring the unit
+    suffix, then a unique case-insensitive prefix of the unit-less name.  Raises ModelError listing
+    the valid columns when nothing (or more than one column) matches."""
+    cols = [str(c) for c in columns]
+    if name in cols:
+        return name
+    key = split_unit(name)[0].strip().lower()
+    bases = {c: split_unit(c)[0].strip().lower() for c in cols}
+    exact = [c for c in cols if bases[c] == key]
+    if len(exact) == 1:
+        return exact[0]
+    pref = [c for c in cols if bases[c].startswith(key)] if key else []
+    if len(pref) == 1:
+        return pref[0]
+    if len(pref) > 1:
+        raise ModelError(f"signal {name!r}", "signal", "is ambiguous, it matches the columns "
+                         + ", ".join(repr(c) for c in pref))
+    raise ModelError(f"signal {name!r}", "signal", "matches no column; valid columns: "
+                     + ", ".join(repr(c) for c in cols))
+
+
+class _Recorder:
+    """Wraps a Result and records the measures a signal callable asks for (to label it with units)."""
+
+    def __init__(self, res):
+        self._res = res
+        self.calls: list[tuple[str, tuple, Any]] = []
+
+    def __getattr__(self, name):
+        attr = getattr(self._res, name)
+        if not callable(attr):
+            return attr
+
+        def call(*args, **kwargs):
+            out = attr(*args, **kwargs)
+            self.calls.append((name, args, out))
+            return out
+        return call
+
+
+def _entity_name(obj) -> str:
+    return str(getattr(obj, "name", obj))
+
+
+def _measure_label(res, name: str, args: tuple) -> tuple[str, str, tuple[str, ...] | None]:
+    """(label, unit, components) of the Result measure `name` called with `args`."""
+    who = _entity_name(args[0]) if args else ""
+    if name in ("joint_coordinate", "joint_velocity", "joint_acceleration") and args:
+        joint = res._joint(args[0])  # noqa: SLF001 - the Result's own name lookup
+        unit, comps = _JOINT_UNITS.get(joint.kind, ("", None))
+        if joint.kind == "revolute" and joint.body_j.is_particle:
+            unit = "m"
+        order = {"joint_coordinate": "", "joint_velocity": "/s", "joint_acceleration": "/s^2"}[name]
+        noun = {"revolute": "angle", "translational": "displacement"}.get(joint.kind, "coordinate")
+        what = {"joint_coordinate": noun, "joint_velocity": f"{noun} rate",
+                "joint_acceleration": f"{noun} acceleration"}[name]
+        return f"{who} {what}", (unit + order) if unit else "", comps
+    if name in ("spring_length", "spring_velocity", "spring_force"):
+        el = res._element(args[0])  # noqa: SLF001
+        rot = type(el).__name__ in ("TorsionSpring",) or getattr(el, "dof", "") == "rotation" or \
+            getattr(getattr(el, "joint", None), "kind", "") == "revolute"
+        unit = {"spring_length": "rad" if rot else "m", "spring_velocity": "rad/s" if rot else "m/s",
+                "spring_force": "N m" if rot else "N"}[name]
+        return f"{who} {name.split('_')[1]}", unit, None
+    if name in _MEASURE_UNITS:
+        what, unit = _MEASURE_UNITS[name]
+        return (f"{who} {what}" if who else what), unit, None
+    return name, "", None
+
+
+def resolve(res, spec, frame=None) -> Signal:
+    """Evaluate a signal spec (callable, column name or ("label [unit]", callable)) on a Result or a
+    DataFrame exported from one; see the module docstring."""
+    if isinstance(spec, tuple) and len(spec) == 2 and isinstance(spec[0], str) and callable(spec[1]):
+        label, unit = split_unit(spec[0])
+        return Signal(label, unit, _as_array(spec[1](res), spec[0], res))
+    if callable(spec):
+        return _resolve_callable(res, spec)
+    if isinstance(spec, str):
+        df = frame if frame is not None else _dataframe(res)
+        col = match_column(df.columns, spec)
+        label, unit = split_unit(col)
+        return Signal(label, unit, np.asarray(df[col], dtype=float))
+    raise ModelError(f"signal {spec!r}", "signal", "expected a callable of the Result, a column name of "
+                     "res.to_dataframe() or a ('label [unit]', callable) pair")
+
+
+def _resolve_callable(res, fn: Callable) -> Signal:
+    if _is_dataframe(res):
+        raise ModelError(f"signal {getattr(fn, '__name__', fn)!r}", "signal",
+                         "a callable needs a Result; for a results file give a column name")
+    rec = _Recorder(res)
+    out = fn(rec)
+    values = _as_array(out, getattr(fn, "__name__", "signal"), res)
+    if len(rec.calls) == 1 and rec.calls[0][2] is out:
+        name, args, _ = rec.calls[0]
+        label, unit, comps = _measure_label(res, name, args)
+        if values.ndim == 2 and comps is None and values.shape[1] == 3:
+            comps = ("x", "y", "z")
+        return Signal(label, unit, values, comps)
+    label = getattr(fn, "__name__", "signal")
+    return Signal("signal" if label == "<lambda>" else label, "", values)
+
+
+def _as_array(out, what, res) -> np.ndarray:
+    a = np.asarray(out, dtype=float)
+    n = len(_time(res))
+    if a.ndim == 0 or a.shape[0] != n:
+        raise ModelError(f"signal {what!r}", "signal", f"must give one value (or row) per output time "
+                         f"({n}), got shape {a.shape}")
+    return a
+
+
+def _is_dataframe(obj) -> bool:
+    return hasattr(obj, "columns") and hasattr(obj, "iloc")
+
+
+def _dataframe(res):
+    if _is_dataframe(res):
+        return res
+    if not hasattr(res, "_df_cache"):
+        res._df_cache = res.to_dataframe()
+    return res._df_cache
+
+
+def _time(res) -> np.ndarray:
+    if _is_dataframe(res):
+        return np.asarray(res[match_column(res.columns, TIME_COLUMN)], dtype=float)
+    return np.asarray(res.time, dtype=float)
+
+
+def event_times(res) -> list[float]:
+    """Times [s] of the run's events: `res.events` when the Result offers them (times, or objects / pairs
+    carrying a time), plus the stick/slip transitions of its joint-friction elements."""
+    if _is_dataframe(res):
+        return []
+    out: list[float] = []
+    for ev in getattr(res, "events", None) or ():
+        t = getattr(ev, "time", ev[0] if isinstance(ev, (tuple, list)) else ev)
+        out.append(float(t))
+    model = getattr(getattr(res, "system", None), "model", None)
+    for el in getattr(model, "forces", {}).values():
+        if type(el).__name__ == "JointFriction" and hasattr(res, "friction_events"):
+            try:
+                out += [float(e[0]) for e in res.friction_events(el)]
+            except Exception:  # noqa: BLE001 - markers are decoration; a failed measure must not stop the plot
+                pass
+    t = _time(res)
+    return sorted({x for x in out if t[0] < x <= t[-1]})
+
+
+def _pyplot():
+    """matplotlib.pyplot, on the Agg backend when no backend was chosen and there is no display."""
+    import os
+    import sys
+
+    import matplotlib
+    if "matplotlib.pyplot" not in sys.modules and not os.environ.get("MPLBACKEND") \
+            and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt
+
+
+def plot(res, signal, x=None, ax=None, events=True, **kw):
+    """Plot one signal or a list of signals of a Result (or of a DataFrame from `res.to_dataframe()` /
+    a results file) against time [s], or against the signal `x`; returns the matplotlib Axes.
+
+    Vector signals (N, 3) give one curve per component.  Vertical dotted lines mark the run's events
+    (`event_times`) when `events` is true and curves are against time.  Extra keyword arguments go to
+    `Axes.plot`.  Never calls `plt.show()`.
+    """
+    specs = list(signal) if isinstance(signal, list) else [signal]
+    if not specs:
+        raise ModelError("plot", "signal", "give at least one signal")
+    frame = _dataframe(res) if any(isinstance(s, str) for s in specs + [x]) else None
+    sigs = [resolve(res, s, frame) for s in specs]
+    xs = resolve(res, x, frame) if x is not None else Signal("time", "s", _time(res))
+    if xs.values.ndim != 1:
+        raise ModelError("plot", "x", f"must be a scalar signal, {xs.title} has shape {xs.values.shape}")
+    if ax is None:
+        plt = _pyplot()
+        _, ax = plt.subplots(figsize=kw.pop("figsize", (7.0, 4.0)), layout="constrained")
+    for s in sigs:
+        _draw(ax, xs.values, s, len(sigs) > 1, kw)
+    ax.set_xlabel(xs.title)
+    ax.set_ylabel(_ylabel(sigs))
+    if sum(1 if s.values.ndim == 1 else s.values.shape[1] for s in sigs) > 1:
+        ax.legend(fontsize="small")
+    if events and x is None:
+        for t in event_times(res):
+            ax.axvline(t, color="0.5", lw=0.8, ls=":", zorder=0)
+    ax.grid(True, alpha=0.3)
+    return ax
+
+
+def _draw(ax, xv, s: Signal, several: bool, kw):
+    if s.values.ndim == 1:
+        ax.plot(xv, s.values, label=s.label, **kw)
+        return
+    comps = s.components or tuple(str(k) for k in range(s.values.shape[1]))
+    for k in range(s.values.shape[1]):
+        ax.plot(xv, s.values[:, k], label=f"{s.label} {comps[k]}", **kw)
+
+
+def _ylabel(sigs: list[Signal]) -> str:
+    units = {s.unit for s in sigs}
+    if len(sigs) == 1:
+        return sigs[0].title
+    return f"[{units.pop()}]" if len(units) == 1 and "" not in units else \
+        ", ".join(s.title for s in sigs)
