@@ -18,6 +18,8 @@ from .solvers.assembly import AssemblyReport, RedundantConstraintWarning, assemb
 from .solvers.dynamic import simulate
 from .solvers.kinematic import kinematics
 from .solvers.static import equilibrium
+from .plotting import plot
+from .viewer import animate
 
 __version__ = "0.1.0"
 
@@ -27,5 +29,6 @@ __all__ = [
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "MbdsimError", "ModelError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
     "expressions", "functions", "parse",
+    "plot", "animate",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]
