@@ -259,6 +259,9 @@ class Model(ForceElementsMixin, FrictionPathMixin):
             raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {joint.kind} joint {joint.name!r}")
         return dof
 
+    def _repr_html_(self) -> str:  # Jupyter summary
+        from ..viewer.notebook import model_html; return model_html(self)  # noqa: E702
+
     def __repr__(self) -> str:
         return (f"Model({self.name!r}: {len(self.bodies) - 1} bodies, {len(self.joints)} joints, "
                 f"{len(self.motions)} motions, {len(self.forces)} forces)")

@@ -41,6 +41,9 @@ class Result:
     def __repr__(self):
         return f"Result({len(self)} samples, t=[{self.time[0]:.6g}, {self.time[-1]:.6g}] s, success={self.success})"
 
+    def _repr_html_(self):  # Jupyter summary
+        from ..viewer.notebook import result_html; return result_html(self)  # noqa: E702
+
     @property
     def frames(self):
         if self._fr is None:
