@@ -249,6 +249,11 @@ def _escape(s: str) -> str:
     return escape(s)
 
 
+from mbdsim.cli import view_cmds as _view_cmds  # noqa: E402 - plot, animate
+
+_view_cmds.register(app)
+
+
 def main(argv: Optional[List[str]] = None) -> None:
     """Console-script entry point (``mbdsim = "mbdsim.cli.app:main"``)."""
     app(args=argv, prog_name="mbdsim")

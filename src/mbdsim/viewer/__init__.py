@@ -10,18 +10,18 @@ from pathlib import Path
 
 from ..errors import ModelError
 from .page import THREE_VERSION, build_page
-from .scene import MAX_FRAMES, Scene, build_scene
+from ..plotting import TIME_COLUMN, match_column
+from .scene import MAX_FRAMES, Scene, build_scene, scene_from_table
 
 __all__ = ["animate", "build_page", "build_scene", "Scene", "MAX_FRAMES", "THREE_VERSION", "default_signal"]
 
 
-def default_signal(res):
-    """The first joint coordinate column of `res.to_dataframe()` (e.g. "pin.angle [rad]"), or None."""
-    names = [j.name for j in res.system.model.joints.values()]
-    for col in res.to_dataframe().columns:
-        base = col.split(" [")[0]
-        if base.rsplit(".", 1)[0] in names and base.rsplit(".", 1)[-1] in ("angle", "displacement"):
-            return col
+def default_signal(columns) -> str | None:
+    """The first joint coordinate column ("pin.angle [rad]", "slider.displacement [m]") among `columns`
+    (those of `res.to_dataframe()`), or None."""
+    for col in columns:
+        if str(col).endswith((".angle [rad]", ".displacement [m]")):
+            return str(col)
     return None
 
 
@@ -55,7 +55,8 @@ def _end_time(end_time) -> float:
 def animate(res_or_model, path="anim.html", signal="auto", end_time=None, geometry=None,
             max_frames: int = MAX_FRAMES, title: str | None = None) -> Path:
     """Write a self-contained HTML page playing a Result (a Model is simulated first, over `end_time` [s],
-    default 2 s, 1000 output steps) and return its path.
+    default 2 s, 1000 output steps; a DataFrame from `res.to_dataframe()` shows its bodies' centres of mass
+    as spheres) and return its path.
 
     signal: shown as a value and a small chart beside the 3D view; a callable of the Result, a column of
     `res.to_dataframe()` or ("label [unit]", callable) as in `mbdsim.plot`; "auto" (default) picks the
@@ -66,10 +67,16 @@ def animate(res_or_model, path="anim.html", signal="auto", end_time=None, geomet
     out = Path(path)
     if out.suffix.lower() not in (".html", ".htm"):
         raise ModelError("animation", "path", f"must end in .html, got {str(out)!r}")
-    res = _result(res_or_model, end_time)
-    if isinstance(signal, str) and signal == "auto":
-        signal = default_signal(res)
-    scene = build_scene(res, signal=signal, geometry=geometry, max_frames=max_frames, title=title)
+    if hasattr(res_or_model, "columns") and hasattr(res_or_model, "iloc"):   # an exported results table
+        df = res_or_model if end_time is None else \
+            res_or_model[res_or_model[match_column(res_or_model.columns, TIME_COLUMN)] <= _end_time(end_time)]
+        sig = default_signal(df.columns) if isinstance(signal, str) and signal == "auto" else signal
+        scene = scene_from_table(df, signal=sig, max_frames=max_frames, title=title or "results")
+    else:
+        res = _result(res_or_model, end_time)
+        if isinstance(signal, str) and signal == "auto":
+            signal = default_signal(res.to_dataframe().columns)
+        scene = build_scene(res, signal=signal, geometry=geometry, max_frames=max_frames, title=title)
     out.parent.mkdir(parents=True, exist_ok=True)
     out.write_text(build_page(scene.to_json(), title), encoding="utf-8")
     return out

@@ -204,8 +204,36 @@ def _elements(model, index) -> tuple[list, list]:
 def _signal(res, spec) -> dict:
     from ..plotting import resolve
     s = resolve(res, spec)
-    vals = s.values.reshape(len(res.time), -1)
+    vals = s.values.reshape(len(s.values), -1)
     comps = s.components or (("",) if vals.shape[1] == 1 else tuple(str(k) for k in range(vals.shape[1])))
     return {"label": s.label, "unit": s.unit,
             "series": [{"name": (f"{s.label} {c}".strip()), "values": _r(vals[:, k])} for k, c in enumerate(comps)]}
 
+
+
+def scene_from_table(df, signal=None, max_frames: int = MAX_FRAMES, title: str = "results") -> Scene:
+    """A scene from an exported results table (`res.to_dataframe()` read back from .csv/.parquet).
+
+    Such a table holds centre-of-mass positions only ("<body>.x [m]", ".y", ".z"): every body is drawn
+    as a sphere at its centre of mass without rotation, and no joints or force elements.  `signal` is a
+    column name (matched leniently) or None."""
+    from ..plotting import TIME_COLUMN, match_column
+    time_col = match_column(df.columns, TIME_COLUMN)
+    names = [c[:-len(".x [m]")] for c in df.columns if str(c).endswith(".x [m]")]
+    if not names:
+        raise ModelError(f"results table {title!r}", "columns", "has no body position columns "
+                         "('<body>.x [m]', '.y [m]', '.z [m]'); was it written from res.to_dataframe()?")
+    idx = frame_indices(len(df), max_frames)
+    sub = df.iloc[idx].reset_index(drop=True)
+    pos = {n: sub[[f"{n}.{a} [m]" for a in "xyz"]].to_numpy(dtype=float) for n in names}
+    pts = np.concatenate(list(pos.values()))
+    ext = float(np.linalg.norm(pts.max(0) - pts.min(0)))
+    scale = ext if ext > 1e-9 else 1.0
+    scene = Scene(title, [0.0, 1.0, 0.0], float(f"{scale:.6g}"), _r(sub[time_col], 9))
+    sphere = {"kind": "sphere", "radius": float(f"{0.03 * scale:.6g}"), "center": [0.0, 0.0, 0.0]}
+    for k, n in enumerate(names):
+        scene.bodies.append({"name": n, "color": PALETTE[k % len(PALETTE)], "shape": sphere,
+                             "pos": _r(pos[n]), "quat": _r(np.tile([0.0, 0.0, 0.0, 1.0], (len(sub), 1)))})
+    if signal is not None:
+        scene.signal = _signal(sub, signal)
+    return scene

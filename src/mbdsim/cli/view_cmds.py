@@ -1,0 +1,125 @@
+"""``mbdsim plot`` and ``mbdsim animate``: figures and 3D pages from results files and model files.
+
+Commands::
+
+    mbdsim plot RESULTS SIGNAL... [--x SIGNAL] -o fig.png|svg|pdf
+    mbdsim animate MODEL|RESULTS -o anim.html [--end T] [--signal SIGNAL]
+
+RESULTS is a .csv or .parquet file written from ``res.to_dataframe()``; SIGNAL a column name, matched
+leniently (exactly, then case-insensitively ignoring the unit suffix, then by a unique prefix).  A
+MODEL file is read with ``mbdsim.load_model`` and simulated over ``--end`` seconds.  Exit status 0 on
+success, 1 when the run or a file operation fails, 2 for bad arguments (unknown column, bad file).
+Only typer is imported here; pandas, matplotlib and the engine load when a command runs.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import List, Optional
+
+import typer
+
+RESULT_SUFFIXES = (".csv", ".parquet", ".pq")
+FIGURE_SUFFIXES = (".png", ".svg", ".pdf")
+
+
+def _fail(message: str, code: int = 2) -> None:
+    typer.echo(f"error: {message}", err=True)
+    raise typer.Exit(code)
+
+
+def read_results(path: Path):
+    """The DataFrame of a results file (.csv or .parquet written from `res.to_dataframe()`)."""
+    import pandas as pd
+
+    if not path.is_file():
+        _fail(f"results file {str(path)!r} does not exist")
+    suffix = path.suffix.lower()
+    if suffix not in RESULT_SUFFIXES:
+        _fail(f"results file {str(path)!r}: expected .csv or .parquet, got {suffix or 'no suffix'!r}")
+    try:
+        return pd.read_csv(path) if suffix == ".csv" else pd.read_parquet(path)
+    except Exception as exc:  # noqa: BLE001 - any reader failure: one clear line, no traceback
+        _fail(f"cannot read results file {str(path)!r}: {type(exc).__name__}: {exc}")
+
+
+def plot_cmd(
+    results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.csv or .parquet from res.to_dataframe())."),
+    signals: List[str] = typer.Argument(..., metavar="SIGNAL...", help="Column names to plot (lenient match)."),
+    x: Optional[str] = typer.Option(None, "--x", metavar="SIGNAL", help="Plot against this column instead of time."),
+    out: Path = typer.Option(Path("fig.png"), "--out", "-o", metavar="FILE", help="Figure file: .png, .svg or .pdf."),
+) -> None:
+    """Plot columns of a results file against time (or against --x) into a PNG/SVG/PDF figure."""
+    if out.suffix.lower() not in FIGURE_SUFFIXES:
+        _fail(f"--out {str(out)!r}: expected a .png, .svg or .pdf file")
+    df = read_results(results)
+    from mbdsim.errors import ModelError
+    from mbdsim.plotting import plot
+
+    try:
+        ax = plot(df, list(signals), x=x)
+    except ModelError as exc:
+        _fail(str(exc))
+    ax.set_title(results.name)
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        ax.figure.savefig(out, dpi=150)
+    except OSError as exc:
+        _fail(f"cannot write {str(out)!r}: {exc}", 1)
+    finally:
+        import matplotlib.pyplot as plt
+        plt.close(ax.figure)
+    typer.echo(f"figure: {out}")
+
+
+def load_model_file(path: Path):
+    """A Model from a model file, via `mbdsim.load_model` (mbdsim.io) when this install has it."""
+    import mbdsim
+
+    loader = getattr(mbdsim, "load_model", None)
+    if loader is None:
+        try:
+            from mbdsim.io import load_model as loader  # type: ignore[no-redef]
+        except ImportError:
+            _fail(f"{str(path)!r}: reading model files needs mbdsim.load_model, which this install lacks; "
+                  "give a results file (.csv/.parquet) or call mb.animate(model) from Python")
+    try:
+        return loader(path)
+    except mbdsim.MbdsimError as exc:
+        _fail(f"model file {str(path)!r}: {exc}")
+
+
+def animate_cmd(
+    source: Path = typer.Argument(..., metavar="MODEL|RESULTS", help="Model file, or results file (.csv/.parquet)."),
+    out: Path = typer.Option(Path("anim.html"), "--out", "-o", metavar="FILE", help="HTML page to write."),
+    end: Optional[float] = typer.Option(None, "--end", metavar="T", help="End time [s] (model: simulated span, "
+                                        "default 2 s; results: cut there)."),
+    signal: Optional[str] = typer.Option(None, "--signal", metavar="SIGNAL",
+                                         help="Column shown beside the 3D view (default: first joint coordinate)."),
+) -> None:
+    """Write a self-contained HTML page (three.js inlined, no network) playing a model's motion."""
+    if out.suffix.lower() not in (".html", ".htm"):
+        _fail(f"--out {str(out)!r}: expected an .html file")
+    if not source.is_file():
+        _fail(f"{str(source)!r} does not exist")
+    from mbdsim.errors import MbdsimError
+    from mbdsim.viewer import animate
+
+    if source.suffix.lower() in RESULT_SUFFIXES:
+        what = read_results(source)
+        title = source.stem
+    else:
+        what = load_model_file(source)
+        title = None
+    try:
+        page = animate(what, out, signal=signal or "auto", end_time=end, title=title)
+    except MbdsimError as exc:
+        _fail(str(exc), 2 if isinstance(exc, ValueError) else 1)
+    except OSError as exc:
+        _fail(f"cannot write {str(out)!r}: {exc}", 1)
+    typer.echo(f"animation: {page}")
+
+
+def register(app: typer.Typer) -> None:
+    """Add ``plot`` and ``animate`` to the ``mbdsim`` command line."""
+    app.command("plot")(plot_cmd)
+    app.command("animate")(animate_cmd)
