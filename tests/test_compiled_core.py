@@ -187,3 +187,51 @@ def test_callable_loads_use_the_reference_path():
     with pytest.raises(NotCompiled):
         compile_system(sys, np.arange(sys.nc))
     assert not mb.simulate(m, 0.1, method="dop853").stats["method"].endswith("(compiled)")
+
+
+def _parallelogram(w0, a=1.0, b=0.4):
+    """Parallelogram four-bar (ground and coupler a, crank and rocker b) spinning freely at w0 [rad/s];
+    every half turn it passes a change point (all links collinear), where its loop rows are dependent."""
+    m = mb.Model("parallelogram")
+    up = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    rod = lambda L: (1e-4, L * L / 12, L * L / 12)  # noqa: E731
+    crank = m.add_body("crank", 1.0, rod(b), position=(0, b / 2, 0), orientation=up,
+                       velocity=(-w0 * b / 2, 0, 0), angular_velocity=(0, 0, w0))
+    coupler = m.add_body("coupler", 1.0, rod(a), position=(a / 2, b, 0), velocity=(-w0 * b, 0, 0))
+    rocker = m.add_body("rocker", 1.0, rod(b), position=(a, b / 2, 0), orientation=up,
+                        velocity=(-w0 * b / 2, 0, 0), angular_velocity=(0, 0, w0))
+    z = (0, 0, 1)
+    m.add_revolute("A", m.ground, crank, (0, 0, 0), z)
+    m.add_revolute("B", crank, coupler, (0, b, 0), z)
+    m.add_revolute("C", coupler, rocker, (a, b, 0), z)
+    m.add_revolute("D", rocker, m.ground, (a, 0, 0), z)
+    return m
+
+
+def test_default_method_runs_through_change_points():
+    """Free parallelogram: with no gravity its inertia is constant, so it turns at constant rate w0 and the
+    coupler translates on a circle of radius b; four change points in two turns, default settings."""
+    w0, b = 2 * np.pi, 0.4
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
+        res = mb.simulate(_parallelogram(w0, b=b), 2.0, output_step=0.01)
+    assert res.success and res.stats["method"].startswith("auto: DOP853")
+    t = res.time
+    assert np.max(np.abs(res.angular_velocity("crank")[:, 2] - w0)) < 1e-5
+    assert np.max(np.abs(res.angular_velocity("rocker")[:, 2] - w0)) < 1e-5   # parallelogram branch kept
+    centre = res.position("coupler")
+    expected = np.stack([0.5 + b * np.cos(np.pi / 2 + w0 * t), b * np.sin(np.pi / 2 + w0 * t)], axis=1)
+    assert np.max(np.abs(centre[:, :2] - expected)) < 1e-6
+
+
+def test_default_method_switches_to_implicit_when_stiff():
+    """An overdamped 1e9 N/m spring with 1e5 N s/m (eigenvalues near -1e4 and -1e5 1/s) under gravity:
+    the explicit method is limited by stability, the automatic method hands over to HHT and the mass
+    settles at the static deflection m g / k."""
+    m = mb.Model("stiff", gravity=(-9.81, 0, 0))
+    p = m.add_particle("p", 1.0, position=(1.0, 0, 0))
+    m.add_translational("slide", m.ground, p, (1.0, 0, 0), (1, 0, 0))
+    m.add_spring_damper("k", m.ground, p, 1e9, 1e5, 1.0)
+    res = mb.simulate(m, 0.05, output_step=0.01)
+    assert res.success and "stiffness detected" in res.stats["method"]
+    assert abs(res.position(p)[-1, 0] - (1.0 - 9.81 / 1e9)) < 1e-10

@@ -1,4 +1,4 @@
-"""HHT-alpha integrator: order of accuracy, error control, stiff robustness, redundant constraints."""
+"""HHT-alpha integrator (method="hht"; no longer the default): order of accuracy, error control, stiff robustness, redundant constraints."""
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -26,7 +26,7 @@ def test_second_order_convergence_fixed_steps():
     th = exact_angle(1.0)
     errs = []
     for n in (50, 100, 200):
-        res = mb.simulate(m, 1.0, 0.5, rtol=1e6, atol=1e6, max_step=1.0 / n)  # error control off
+        res = mb.simulate(m, 1.0, 0.5, rtol=1e6, atol=1e6, max_step=1.0 / n, method="hht")  # error control off
         errs.append(abs(res.joint_coordinate(pin)[-1] - th))
     rates = np.log2(np.array(errs[:-1]) / np.array(errs[1:]))
     assert np.all(rates > 1.8), (errs, rates)
@@ -36,7 +36,7 @@ def test_error_control_meets_tolerance_on_period():
     m, rod, pin = pendulum()
     w0 = np.sqrt(3 * 9.81 / 2)
     half_period = 2 / w0 * ellipk(0.5)
-    res = mb.simulate(m, 1.2, 0.01, rtol=1e-7, atol=1e-7)
+    res = mb.simulate(m, 1.2, 0.01, rtol=1e-7, atol=1e-7, method="hht")
     assert res.success and res.stats["method"] == "HHT"
     t_min, th_min = res.minimum(lambda r: r.joint_coordinate(pin))
     assert abs(t_min - half_period) < 1e-4
@@ -51,7 +51,7 @@ def test_stiff_spring_large_steps_stable():
     m = mb.Model("stiff", gravity=(0, -9.81, 0))
     b = m.add_particle("b", mass=1.0, position=(0, -1.0, 0))
     m.add_spring_damper("s", (m.ground, (0, 0, 0)), (b, (0, -1.0, 0)), stiffness=1e8, free_length=1.0)
-    res = mb.simulate(m, 1.0, 0.05, rtol=1e2, atol=1e2, max_step=1e-2)
+    res = mb.simulate(m, 1.0, 0.05, rtol=1e2, atol=1e2, max_step=1e-2, method="hht")
     assert res.success
     y = res.position(b)[:, 1]
     assert np.all(np.abs(y + 1.0 + 9.81 / 1e8) < 1e-6)
@@ -68,7 +68,7 @@ def test_redundant_four_bar_runs_with_hht():
     m.add_revolute("C", coupler, rocker, c, (0, 0, 1))
     m.add_revolute("D", rocker, m.ground, (2, 0, 0), (0, 0, 1))
     with pytest.warns(mb.RedundantConstraintWarning):
-        res = mb.simulate(m, 1.0, 0.05, rtol=1e-6, atol=1e-8)
+        res = mb.simulate(m, 1.0, 0.05, rtol=1e-6, atol=1e-8, method="hht")
     assert res.success
     E = res.kinetic_energy() + res.potential_energy()
     assert np.ptp(E) < 1e-3 * np.abs(E).max()
@@ -80,13 +80,13 @@ def test_hht_locates_contact_onset_and_follows_torsion_spring_past_half_turns():
     m = mb.Model(gravity=(0, -9.81, 0))
     ball = m.add_body("ball", 1.0, (0.004, 0.004, 0.004), position=(0, 1.0, 0))
     m.add_contact("c", mb.Sphere(ball, 0.1), mb.Plane(m.ground, (0, 0, 0), (0, 1, 0)), 1e5, 1.5, 10.0, 1e-3)
-    res = mb.simulate(m, 0.6, 0.01)
+    res = mb.simulate(m, 0.6, 0.01, method="hht")
     t_on = res.crossings(lambda r: r.position(ball)[:, 1], 0.1)[0]
     assert abs(t_on - np.sqrt(2 * 0.9 / 9.81)) < 1e-9
     m = mb.Model()
     disk = m.add_body("d", 2.0, (0.3, 0.3, 0.5), angular_velocity=(0, 0, 20))
     jt = m.add_revolute("r", m.ground, disk, (0, 0, 0), (0, 0, 1))
     m.add_torsion_spring("ts", jt, 8.0, 0.4)
-    a = mb.simulate(m, 2.0, 0.01).spring_length("ts")
+    a = mb.simulate(m, 2.0, 0.01, method="hht").spring_length("ts")
     b = mb.simulate(m, 2.0, 0.01, method="dop853").spring_length("ts")
     assert np.max(np.abs(a)) > np.pi and np.max(np.abs(a - b)) < 1e-2

@@ -14,28 +14,30 @@ from ..errors import MbdsimError, SolverError
 from ..results.result import Result
 from ..system.compiled import Work, compile_system
 from . import fastdop
-from .fastdyn import MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, TINY_STEP
+from .fastdyn import MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
              PROJECTION: "projection onto the constraints does not converge",
              NONFINITE: "non-finite state (the solution diverged)",
              TINY_STEP: "step size collapsed below the round-off limit (lock-up, singular configuration "
                         "or a discontinuity)",
-             MAX_STEPS: "step budget exhausted (max_steps)"}
+             MAX_STEPS: "step budget exhausted (max_steps)",
+             STIFF: "the model is stiff for an explicit method"}
 CHUNK = 256
 
 
 class CompiledRun:
     """A compiled model and its work arrays for one analysis (immutable model, per-run state)."""
 
-    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000):
+    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False):
         self.sys, self.rows = sys, rows
         self.cm = compile_system(sys, rows)
         self.work = Work.for_model(self.cm)
         self.rtol, self.atol = float(rtol), float(atol)
         self.max_step = np.inf if not max_step else float(max_step)
         self.max_steps = int(max_steps)
-        self.stats = np.zeros(4, dtype=np.int64)
+        self.stats = np.zeros(6, dtype=np.int64)
+        self.stiff_check = bool(stiff_check)
 
     def integrate(self, t0, y0, tout, progress=None):
         """Outputs (Y, VD, LAM, n_written, status, t_fail) from the consistent state y0 at t0 over tout."""
@@ -56,7 +58,7 @@ class CompiledRun:
         while status == 0 and iout < nout:
             status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD, LAM,
                                        self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
-                                       self.stats, K, F, sc)
+                                       self.stats, K, F, sc, self.stiff_check)
             if progress is not None:
                 progress(st[0])
         return Y, VD, LAM, iout, status, st[0], y
@@ -80,13 +82,24 @@ class CompiledRun:
         return (Ys[:, :nq], Ys[:, nq:], np.array([o[1] for o in out]), np.array([o[2] for o in out]))
 
 
-def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None) -> Result:
+class Stiff(Exception):
+    """The explicit method detected stiffness (the automatic method then switches to an implicit one)."""
+
+    def __init__(self, t):
+        super().__init__(f"stiff at t = {t:.9g} s")
+        self.time = t
+
+
+def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, stiff_check=False) -> Result:
     """Dynamic analysis of System `sys` from the assembled state `rep` over the output grid `times`
-    with the compiled DOP853 (raises NotCompiled when the model needs the reference path)."""
-    run = CompiledRun(sys, rep.rows, rtol, atol, max_step)
+    with the compiled DOP853 (raises NotCompiled when the model needs the reference path, and Stiff
+    when stiff_check is set and the model is stiff)."""
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
     Y, VD, LAM, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress)
+    if status == STIFF:
+        raise Stiff(float(t_fail))
     if status != 0:
         from .dynamic import _weak_joints
         try:
@@ -103,7 +116,9 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None) -> 
                  evaluate=lambda ts: run.states_at(times[:n], Y[:n], ts), success=success,
                  status=0 if success else -1, message=message,
                  stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
-                        "projections": int(run.stats[3]), "method": "DOP853 (compiled)", "assembly": rep})
+                        "njev": 0, "factorizations": int(run.stats[2] + 2 * run.stats[3]),
+                        "projections": int(run.stats[3]), "order": 8, "method": "DOP853 (compiled)",
+                        "assembly": rep})
     res.error = error
     return res
 

@@ -19,7 +19,7 @@ from ..system.assemble import assemble_system
 from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
 from .assembly import assemble_state
-from .compiled_run import integrate_compiled
+from .compiled_run import Stiff, integrate_compiled
 from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
 from .events import EventTracker
 from .kinematic import check_model, time_grid
@@ -29,7 +29,7 @@ SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, 
                  "radau": integrate.Radau, "bdf": integrate.BDF}
 COMPILED_METHODS = ("dop853", "high-accuracy")   # run by the compiled step loop when the model allows
 USE_COMPILED = True   # False: always the reference scipy path (tests compare the two)
-DEFAULT_TOL = {"dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
+DEFAULT_TOL = {"auto": (1e-8, 1e-10), "dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
                "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-5, 1e-7)}
 
 
@@ -37,34 +37,67 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
              start_time=0.0) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
-    method: "hht" (default, implicit, error-controlled), "dop853" (high accuracy, index-1 with
-    projection), "rk45", "radau", "bdf".  A model with stick/slip joint friction defaults to "dop853",
-    whose event-driven mode switching the friction model needs.  rtol/atol: integrator tolerances (relative, absolute in SI)."""
+    method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
+    element of the model is compiled, switching to HHT when it detects stiffness; otherwise the
+    previous default ("hht", or "dop853" for joint friction). Named methods: "dop853" (high accuracy,
+    index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
+    damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
+    the coordinates and velocities); atol follows a given rtol in the method's default ratio.
+    `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations."""
     check_model(model)
-    method = method or _default_method(model)
+    method = "auto" if method is None else method
     if not isinstance(method, str):
         raise ModelError("simulate", "method", f"expected a method name, got {method!r}")
     method = method.lower()
-    if method not in SCIPY_METHODS and method != "hht":
+    if method not in SCIPY_METHODS and method not in ("hht", "auto"):
         raise ModelError("simulate", "method", f"unknown method {method!r}; choose from "
-                         f"{sorted(list(SCIPY_METHODS) + ['hht'])}")
-    d_rtol, d_atol = DEFAULT_TOL[method]
-    rtol = d_rtol if rtol is None else _positive("rtol", rtol)
-    # atol follows a user's rtol in the default ratio, so that rtol alone tightens (or loosens) the run;
-    # atol = 0 would divide by zero in the error norms
-    atol = d_atol * rtol / d_rtol if atol is None else _positive("atol", atol)
+                         f"{sorted(list(SCIPY_METHODS) + ['hht', 'auto'])}")
+    user_rtol = None if rtol is None else _positive("rtol", rtol)
+    user_atol = None if atol is None else _positive("atol", atol)
     max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
+    if method == "auto":
+        rt, at = _tolerances("auto", user_rtol, user_atol)
+        try:
+            if USE_COMPILED:
+                res = integrate_compiled(sys, rep, times, rt, at, max_step, stiff_check=True)
+                res.stats["method"] = "auto: " + res.stats["method"]
+                return res
+        except NotCompiled as exc:
+            reason = str(exc)
+        except Stiff as exc:
+            reason = f"stiffness detected at t = {exc.time:.6g} s"
+        else:
+            reason = "compiled path disabled"
+        method = _default_method(model)
+        res = _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step)
+        res.stats["method"] = f"auto: {res.stats.get('method', method)} ({reason})"
+        return res
+    return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step)
+
+
+def _tolerances(method, rtol, atol):
+    """(rtol, atol) of a method: its defaults, or the user's rtol with atol following in the default ratio
+    (so that rtol alone tightens or loosens a run; atol = 0 would divide by zero in the error norms)."""
+    d_rtol, d_atol = DEFAULT_TOL[method]
+    r = d_rtol if rtol is None else rtol
+    return r, (d_atol * r / d_rtol if atol is None else atol)
+
+
+def _run(sys, rep, times, method, rtol, atol, max_step) -> Result:
+    """One named method over the output grid from the assembled state."""
     if method == "hht":
         from .hht import integrate_hht
-        if _default_method(model) != "hht":
-            names = [e.name for e in model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
+        if _default_method(sys.model) != "hht":
+            names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
             raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
                              "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
                              "'bdf'); the HHT method cannot include it")
-        return integrate_hht(sys, rep, times, rtol, atol, max_step)
+        res = integrate_hht(sys, rep, times, rtol, atol, max_step)
+        res.stats.setdefault("method", "HHT")
+        return res
     if method in COMPILED_METHODS and USE_COMPILED:
         try:
             return integrate_compiled(sys, rep, times, rtol, atol, max_step)

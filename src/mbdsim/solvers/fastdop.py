@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _c
 
-from .fastdyn import NONFINITE, OK, TINY_STEP, MAX_STEPS, accelerations, project, rhs
+from .fastdyn import MAX_STEPS, NONFINITE, OK, STIFF, TINY_STEP, accelerations, project, rhs
 
 N_STAGES = _c.N_STAGES
 COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
@@ -79,11 +79,12 @@ def _dense(F, y_old, t_old, h, t, out):
 
 @njit(cache=True, _nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_step, max_steps, chunk,
-        proj_tol, stats, K, F, sc):
+        proj_tol, stats, K, F, sc, stiff_check):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
     outputs tout[iout:] into Y, VD, LAM; stops after `chunk` outputs. Returns (status, next iout).
-    stats: steps, rejected, rhs evaluations, projections (int64, accumulated); K (16, n), F (7, n) and
-    sc (4, n) are scratch."""
+    stats: steps, rejected, rhs evaluations, projections, stiffness counters (int64, accumulated);
+    K (16, n), F (7, n) and sc (4, n) are scratch. With stiff_check, Hairer's test (h |df| / |dy| > 6.1
+    on the last stage, 15 times without 6 non-stiff steps between) stops the run with STIFF."""
     A, B, C, E3, E5, D = co
     nq = cm[31][0]
     n = y.shape[0]
@@ -149,6 +150,21 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
         rejected = False
         t_new = t + h
         stats[0] += 1
+        if stiff_check:   # stats[4]: consecutive stiff verdicts, stats[5]: non-stiff ones since
+            num, den = 0.0, 0.0
+            for i in range(n):
+                num += (K[N_STAGES, i] - K[N_STAGES - 1, i]) ** 2
+                den += (ynew[i] - ys[i]) ** 2
+            if den > 0.0 and h * np.sqrt(num / den) > 6.1:
+                stats[5] = 0
+                stats[4] += 1
+                if stats[4] >= 15:
+                    st[0], st[1] = t, h
+                    return STIFF, iout
+            else:
+                stats[5] += 1
+                if stats[5] >= 6:
+                    stats[4] = 0
         if tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):   # outputs inside this step
             for s in range(N_STAGES + 1, 16):
                 for i in range(n):
