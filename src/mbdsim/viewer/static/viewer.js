@@ -1,5 +1,5 @@
 // mbdsim viewer: plays the scene JSON embedded in the page (element #mbdsim-data) with three.js.
-// Exposes window.mbdsimViewer = {setTime(t), play(), pause(), time, duration, frames, ready}.
+// Exposes window.mbdsimViewer = {setTime(t), play(), pause(), time, duration, frames, ready, project(body)}.
 // setTime(t) pauses playback, poses every body at time t [s] (interpolated between frames) and renders.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
@@ -239,7 +239,14 @@ resize();
 show(t0);
 play();
 requestAnimationFrame(loop);
+// pixel position [x, y] (CSS pixels, page coordinates) of a body's centre of mass at the current time
+function project(name) {
+  const g = groups[data.bodies.findIndex((b) => b.name === name)];
+  if (!g) throw new Error('no body named ' + name);
+  const p = g.getWorldPosition(new THREE.Vector3()).project(camera), r = renderer.domElement.getBoundingClientRect();
+  return [r.left + (p.x + 1) / 2 * r.width, r.top + (1 - p.y) / 2 * r.height];
+}
 window.mbdsimViewer = {
   setTime, play, pause: () => setTime(time), get time() { return time; }, get playing() { return playing; },
-  duration: t1 - t0, start: t0, end: t1, frames: N, ready: true, scene, camera, render,
+  duration: t1 - t0, start: t0, end: t1, frames: N, ready: true, project, scene, camera, render,
 };
