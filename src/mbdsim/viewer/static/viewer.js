@@ -134,7 +134,7 @@ scene.add(new THREE.AxesHelper(0.15 * S));
 // look from the front-right, a little above, at the centre of the motion
 const side = Math.abs(up.z) > 0.9 ? new THREE.Vector3(0, -1, 0) : new THREE.Vector3(0, 0, 1);
 const right = new THREE.Vector3().crossVectors(up, side).normalize();
-camera.position.copy(center).addScaledVector(side, 1.9 * S).addScaledVector(right, 0.6 * S).addScaledVector(up, 0.5 * S);
+camera.position.copy(center).addScaledVector(side, 1.5 * S).addScaledVector(right, 0.5 * S).addScaledVector(up, 0.45 * S);
 sun.position.copy(center).addScaledVector(side, 2 * S).addScaledVector(up, 3 * S).addScaledVector(right, S);
 const controls = new OrbitControls(camera, renderer.domElement);
 controls.target.copy(center);
