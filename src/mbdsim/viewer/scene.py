@@ -10,6 +10,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ..errors import ModelError
+from ..model.shapes import Sphere
 
 MAX_FRAMES = 2000
 PALETTE = ("#4e79a7", "#f28e2b", "#59a14f", "#e15759", "#76b7b2", "#edc948", "#b07aa1", "#ff9da7",
@@ -82,7 +83,8 @@ def _local(body, point_ground) -> list:
 def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int = MAX_FRAMES,
                 title: str | None = None) -> Scene:
     """Extract the scene of a Result: at most `max_frames` frames; `signal` as in `mbdsim.plot` (or None);
-    `geometry` maps a body (or its name) to an mb.Sphere drawn instead of its equivalent box."""
+    `geometry` maps a body (or its name) to an mb.Sphere drawn instead of its equivalent box (its centre
+    in ground at t=0, default the body's CM)."""
     system, model = res.system, res.system.model
     if len(res.time) == 0:
         raise ModelError("animation", "result", "the result holds no samples")
@@ -122,18 +124,15 @@ def _given_geometry(geometry: dict, model) -> dict:
         name = getattr(key, "name", key)
         if name not in model.bodies or name == "ground":
             raise ModelError(f"geometry for {name!r}", "geometry", "is not a (moving) body of the model")
-        if type(shape).__name__ not in ("Sphere", "Box", "Cylinder"):
-            raise ModelError(f"geometry for {name!r}", "geometry", f"expected mb.Sphere (or mb.Box / "
-                             f"mb.Cylinder), got {shape!r}")
+        if not isinstance(shape, Sphere):
+            raise ModelError(f"geometry for {name!r}", "geometry", f"expected an mb.Sphere, got {shape!r}")
         out[name] = shape
     return out
 
 
 def _body_shape(body, given, scale: float, model) -> dict:
     """Shape of a body in body axes: given geometry, else its own contact sphere, else the equivalent box."""
-    shape = given if given is not None else getattr(body, "geometry", None)
-    if shape is None:
-        shape = _contact_sphere(body, model)
+    shape = given if given is not None else _contact_sphere(body, model)
     if shape is not None:
         return _shape_dict(body, shape)
     minimum = 0.02 * scale
@@ -153,17 +152,9 @@ def _contact_sphere(body, model):
 
 
 def _shape_dict(body, shape) -> dict:
-    kind = type(shape).__name__
-    center = getattr(shape, "center", None)
-    c = [0.0, 0.0, 0.0] if center is None else _local(body, center)
-    if kind == "Sphere":
-        return {"kind": "sphere", "radius": float(shape.radius), "center": c}
-    if kind == "Box":
-        return {"kind": "box", "size": _r(shape.size), "quat": [0.0, 0.0, 0.0, 1.0], "center": c}
-    if kind == "Cylinder":
-        return {"kind": "cylinder", "radius": float(shape.radius), "length": float(shape.length),
-                "axis": _r(body.orientation.T @ np.asarray(getattr(shape, "axis", (0, 0, 1)), float)), "center": c}
-    raise ModelError(f"geometry of body '{body.name}'", "geometry", f"cannot draw {shape!r}")
+    """An mb.Sphere in body axes (its centre from the body's CM)."""
+    c = [0.0, 0.0, 0.0] if shape.center is None else _local(body, shape.center)
+    return {"kind": "sphere", "radius": float(shape.radius), "center": c}
 
 
 def _on(body, index) -> int:

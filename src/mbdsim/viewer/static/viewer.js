@@ -40,13 +40,9 @@ function material(color, opts = {}) {
 }
 
 function shapeMesh(sh, color) {
-  let geo, mesh;
-  if (sh.kind === 'box') geo = new THREE.BoxGeometry(...sh.size);
-  else if (sh.kind === 'sphere') geo = new THREE.SphereGeometry(sh.radius, 32, 16);
-  else geo = new THREE.CylinderGeometry(sh.radius, sh.radius, sh.length, 32);
-  mesh = new THREE.Mesh(geo, material(color));
+  const geo = sh.kind === 'box' ? new THREE.BoxGeometry(...sh.size) : new THREE.SphereGeometry(sh.radius, 32, 16);
+  const mesh = new THREE.Mesh(geo, material(color));
   if (sh.quat) mesh.quaternion.set(...sh.quat);
-  if (sh.kind === 'cylinder') mesh.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), new THREE.Vector3(...sh.axis).normalize());
   if (sh.center) mesh.position.set(...sh.center);
   return mesh;
 }
