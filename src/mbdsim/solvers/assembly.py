@@ -63,7 +63,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
                             time=t, joints=dict.fromkeys(worst), state=q)
     J = constraint_terms(sys, q, v0, t)[1][sys.fixed_rows]
-    rows = independent_rows(J)
+    rows = independent_rows(J, sys=sys)
     redundant = dependent_owners(sys, J, rows)
     if redundant:
         warnings.warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
