@@ -151,3 +151,29 @@ def test_notebook_summaries(rig):
     assert "0 .. 0.3 s" in r and f"<td>{len(rig.time)}</td>" in r and "success" in r
     bad = mb.Model("<b>x</b>")
     assert "&lt;b&gt;x&lt;/b&gt;" in bad._repr_html_()
+
+
+def test_cli_animate_model_file_through_load_model(tmp_path, monkeypatch):
+    """`mbdsim animate MODEL` reads the file with mb.load_model (stubbed here with a Python-built model)."""
+    from typer.testing import CliRunner
+
+    from mbdsim.cli.app import app
+    seen = []
+
+    def load_model(path):
+        seen.append(path)
+        if path.suffix == ".bad":
+            raise mb.ModelError("joint 'pin'", "axis", "must be non-zero")
+        return rich_model()
+
+    monkeypatch.setattr(mb, "load_model", load_model, raising=False)
+    (tmp_path / "rig.yaml").write_text("model: rig\n")
+    (tmp_path / "rig.bad").write_text("model: rig\n")
+    r = CliRunner().invoke(app, ["animate", str(tmp_path / "rig.yaml"), "-o", str(tmp_path / "rig.html"),
+                                 "--end", "0.02"])
+    assert r.exit_code == 0, r.output
+    data = json.loads(_scripts_body((tmp_path / "rig.html").read_text()))
+    assert seen == [tmp_path / "rig.yaml"] and data["title"] == "rig" and data["time"][-1] == pytest.approx(0.02)
+    assert len(data["springs"]) == 1 and len(data["shapes"]) == 2
+    r = CliRunner().invoke(app, ["animate", str(tmp_path / "rig.bad"), "-o", str(tmp_path / "bad.html")])
+    assert r.exit_code == 2 and "joint 'pin'.axis: must be non-zero" in r.output
