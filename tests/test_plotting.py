@@ -109,14 +109,21 @@ def test_cli_plot_csv_parquet(res, tmp_path):
     p = _cli("plot", str(tmp_path / "r.parquet"), "PIN.ANGLE", "rod.x", "-o", str(tmp_path / "f.png"))
     assert p.returncode == 0, p.stderr
     assert (tmp_path / "f.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
-    p = _cli("plot", str(tmp_path / "r.csv"), "rod.y", "--x", "rod.x", "-o", str(tmp_path / "f.svg"))
-    assert p.returncode == 0, p.stderr
+    from typer.testing import CliRunner
+
+    from mbdsim.cli.app import app
+    cli = lambda *a: CliRunner().invoke(app, list(a))  # noqa: E731 - in-process for the other cases
+    r = cli("plot", str(tmp_path / "r.csv"), "rod.y", "--x", "rod.x", "-o", str(tmp_path / "f.svg"))
+    assert r.exit_code == 0, r.output
     assert "<svg" in (tmp_path / "f.svg").read_text()
-    p = _cli("plot", str(tmp_path / "r.csv"), "crank", "-o", str(tmp_path / "g.png"))
-    assert p.returncode == 2 and "valid columns" in p.stderr and "'pin.angle [rad]'" in p.stderr
-    assert "Traceback" not in p.stderr and not (tmp_path / "g.png").exists()
-    p = _cli("plot", str(tmp_path / "missing.csv"), "rod.x")
-    assert p.returncode == 2 and "does not exist" in p.stderr
+    r = cli("plot", str(tmp_path / "r.csv"), "crank", "-o", str(tmp_path / "g.png"))
+    assert r.exit_code == 2 and "valid columns" in r.output and "'pin.angle [rad]'" in r.output
+    assert r.exception is None or isinstance(r.exception, SystemExit)
+    assert not (tmp_path / "g.png").exists()
+    r = cli("plot", str(tmp_path / "missing.csv"), "rod.x")
+    assert r.exit_code == 2 and "does not exist" in r.output
+    r = cli("plot", str(tmp_path / "r.csv"), "rod.x", "-o", str(tmp_path / "f.jpg"))
+    assert r.exit_code == 2 and "expected a .png, .svg or .pdf" in r.output
 
 
 def test_cli_imports_stay_lazy():
@@ -125,3 +132,17 @@ def test_cli_imports_stay_lazy():
             "('matplotlib', 'pandas', 'pyarrow', 'selenium')))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert out.stdout.strip() == "[]", out.stdout + out.stderr
+
+
+def test_friction_stop_marked_at_closed_form_time():
+    """A car sliding on a rail with Coulomb friction stops at t = v0 / (mu g): the stick event is marked."""
+    g, mu, v0 = 9.81, 0.3, 1.5
+    m = mb.Model("rail", gravity=(0, -g, 0))
+    car = m.add_particle("car", 2.0, velocity=(v0, 0, 0))
+    rail = m.add_translational("rail", m.ground, car, (0, 0, 0), (1, 0, 0))
+    m.add_friction("friction", rail, mu, mu)
+    res = mb.simulate(m, end_time=1.0, output_step=0.01)
+    ax = mb.plot(res, lambda r: r.joint_coordinate(rail))
+    assert ax.get_ylabel() == "rail displacement [m]"
+    marks = [ln.get_xdata()[0] for ln in ax.lines[1:]]
+    assert marks == [pytest.approx(v0 / (mu * g), rel=1e-6)]
