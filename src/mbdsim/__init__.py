@@ -5,21 +5,40 @@ Public API (a contract; everything else may change): Model and its add_* methods
 types, and the Adams-style function library (STEP, STEP5, HAVSIN, IMPACT, BISTOP, POLY, SHF, AKISPL)
 with the safe expression parser `parse`.
 """
-from . import _jitcache  # noqa: F401  (first: numba's cache directory for this version of the kernels)
-from . import expressions, functions
+from importlib import import_module
+
 from .errors import AssemblyError, MbdsimError, ModelError, SolverError
-from .expressions import ExpressionError, parse
-from .functions import AKISPL, BISTOP, HAVSIN, IMPACT, POLY, SHF, STEP, STEP5, Akima, CubicSplineTable
-from .model import Body, Force, Joint, Marker, Model, Motion, SpringDamper, Torque
-from .model.curves import Curve, Spline
-from .model.shapes import Plane, Sphere
-from .results import Result
-from .solvers.assembly import AssemblyReport, RedundantConstraintWarning, assemble
-from .solvers.dynamic import simulate
-from .solvers.kinematic import kinematics
-from .solvers.static import equilibrium
-from .plotting import plot
-from .viewer import animate
+
+# Public names load their module on first use (PEP 562), so `import mbdsim` stays fast and the solvers,
+# scipy and numba load with the first analysis. One line per name: where it lives.
+_LAZY = {
+    "expressions": ".expressions", "functions": ".functions",
+    "ExpressionError": ".expressions", "parse": ".expressions",
+    "AKISPL": ".functions", "BISTOP": ".functions", "HAVSIN": ".functions", "IMPACT": ".functions",
+    "POLY": ".functions", "SHF": ".functions", "STEP": ".functions", "STEP5": ".functions",
+    "Akima": ".functions", "CubicSplineTable": ".functions",
+    "Body": ".model", "Force": ".model", "Joint": ".model", "Marker": ".model", "Model": ".model",
+    "Motion": ".model", "SpringDamper": ".model", "Torque": ".model",
+    "Curve": ".model.curves", "Spline": ".model.curves", "Plane": ".model.shapes", "Sphere": ".model.shapes",
+    "Result": ".results",
+    "AssemblyReport": ".solvers.assembly", "RedundantConstraintWarning": ".solvers.assembly",
+    "assemble": ".solvers.assembly", "simulate": ".solvers.dynamic", "kinematics": ".solvers.kinematic",
+    "equilibrium": ".solvers.static", "plot": ".plotting", "animate": ".viewer",
+}
+
+
+def __getattr__(name):
+    if name in _LAZY:
+        mod = import_module(_LAZY[name], __name__)
+        value = mod if name in ("expressions", "functions") else getattr(mod, name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'mbdsim' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(set(globals()) | set(_LAZY))
+
 
 __version__ = "0.1.0"
 

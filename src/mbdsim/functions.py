@@ -19,7 +19,6 @@ from math import factorial, pi
 
 import numpy as np
 from numpy.polynomial import polynomial as _P
-from scipy.interpolate import Akima1DInterpolator, CubicSpline
 
 __all__ = [
     "step", "step5", "havsin", "poly", "shf", "impact", "bistop", "akispl",
@@ -225,6 +224,7 @@ class Akima(_Table):
     def __init__(self, xs, ys, *, extrapolate=True, method="akima"):
         self.xs, self.ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
         _check_table(self.xs, self.ys)
+        from scipy.interpolate import Akima1DInterpolator, CubicSpline   # lazy: keeps `import mbdsim` fast
         if self.xs.size == 2:                         # scipy needs >= 2 points; 2 points = line
             self._interp = CubicSpline(self.xs, self.ys, bc_type="natural", extrapolate=extrapolate)
         else:
@@ -237,6 +237,7 @@ class CubicSplineTable(_Table):
     def __init__(self, xs, ys, *, bc_type="not-a-knot", extrapolate=True):
         self.xs, self.ys = np.asarray(xs, dtype=float), np.asarray(ys, dtype=float)
         _check_table(self.xs, self.ys)
+        from scipy.interpolate import CubicSpline
         self._interp = CubicSpline(self.xs, self.ys, bc_type=bc_type, extrapolate=extrapolate)
 
 

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from scipy.integrate._ivp import dop853_coefficients as _c
 
 from .fastdyn import MAX_STEPS, NONFINITE, OK, STIFF, TINY_STEP, accelerations, project, rhs

@@ -10,6 +10,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+
 try:   # the expression VM (system.exprvm) compiles drivers; without it drivers stay in Python
     from ..system.exprvm import eval_program
     HAVE_VM = True

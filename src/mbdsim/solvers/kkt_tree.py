@@ -22,6 +22,8 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+
 
 @njit(cache=True, _nrt=False)
 def chol(A, n, L3, il):

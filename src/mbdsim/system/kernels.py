@@ -11,6 +11,7 @@ import numpy as np
 
 try:  # numba is optional at run time: without it the numpy path is used
     from numba import njit
+    from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
     HAVE_NUMBA = True
 except ImportError:  # pragma: no cover
     HAVE_NUMBA = False
