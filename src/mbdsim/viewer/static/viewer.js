@@ -117,24 +117,14 @@ function updateSprings() {
   }
 }
 
-// ------------------------------------------------------------------ floor grid and camera framing
-const box = new THREE.Box3();
-data.bodies.forEach((b) => { for (let k = 0; k < b.pos.length; k += 3) box.expandByPoint(_a.set(b.pos[k], b.pos[k + 1], b.pos[k + 2])); });
-data.joints.forEach((j) => { if (j.body < 0) box.expandByPoint(_a.set(...j.local)); });
-const center = box.getCenter(new THREE.Vector3());
-const grid = new THREE.GridHelper(4 * S, 20, 0xb8bec8, 0xd9dde3);
-grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), up);
-grid.position.copy(center).addScaledVector(up, -up.dot(_d.subVectors(center, box.min)) - 0.05 * S);
-scene.add(grid);
-scene.add(new THREE.AxesHelper(0.15 * S));
-// look from the front-right, a little above, at the centre of the motion
+// ------------------------------------------------------------------ floor grid and camera (placed by fitView)
 const side = Math.abs(up.z) > 0.9 ? new THREE.Vector3(0, -1, 0) : new THREE.Vector3(0, 0, 1);
 const right = new THREE.Vector3().crossVectors(up, side).normalize();
-camera.position.copy(center).addScaledVector(side, 1.5 * S).addScaledVector(right, 0.5 * S).addScaledVector(up, 0.45 * S);
-sun.position.copy(center).addScaledVector(side, 2 * S).addScaledVector(up, 3 * S).addScaledVector(right, S);
 const controls = new OrbitControls(camera, renderer.domElement);
-controls.target.copy(center);
-controls.update();
+const grid = new THREE.GridHelper(4 * S, 20, 0xb8bec8, 0xd9dde3);
+grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), up);
+scene.add(grid);
+scene.add(new THREE.AxesHelper(0.15 * S));
 
 // ------------------------------------------------------------------ time, pose, signal
 let time = t0, playing = true, speed = 1, last = null;
@@ -203,6 +193,37 @@ function show(t) {
   return time;
 }
 
+// frame everything drawn over the whole motion: look from the front-right, a little above, at its
+// centre, from the distance where its bounding sphere fills the view; the floor grid just below it
+function fitView() {
+  const box = new THREE.Box3(), step = Math.max(1, Math.floor(N / 60));
+  for (let k = 0; k < N; k += step) { pose(T[k]); groups.forEach((g) => box.expandByObject(g)); }
+  pose(T[N - 1]); groups.forEach((g) => box.expandByObject(g));
+  data.joints.forEach((j) => { if (j.body < 0) box.expandByPoint(_a.set(...j.local)); });
+  if (box.isEmpty()) box.expandByPoint(_a.set(0, 0, 0));
+  const center = box.getCenter(new THREE.Vector3());
+  const dir = new THREE.Vector3().addScaledVector(side, 1.5).addScaledVector(right, 0.5).addScaledVector(up, 0.45).normalize();
+  const camUp = up.clone().addScaledVector(dir, -up.dot(dir)).normalize(), camRight = new THREE.Vector3().crossVectors(camUp, dir);
+  const tv = Math.tan(THREE.MathUtils.degToRad(camera.fov) / 2), th = tv * camera.aspect;
+  let dist = 0.1 * S;     // the nearest distance at which every corner of the box is in view, plus a margin
+  for (let c = 0; c < 8; c++) {
+    _a.set(c & 1 ? box.max.x : box.min.x, c & 2 ? box.max.y : box.min.y, c & 4 ? box.max.z : box.min.z).sub(center);
+    dist = Math.max(dist, _a.dot(dir) + Math.abs(_a.dot(camRight)) / th, _a.dot(dir) + Math.abs(_a.dot(camUp)) / tv);
+  }
+  dist *= 1.12;
+  camera.position.copy(center).addScaledVector(dir, dist);
+  camera.near = dist * 1e-3; camera.far = dist * 100; camera.updateProjectionMatrix();
+  sun.position.copy(center).addScaledVector(side, 2 * dist).addScaledVector(up, 3 * dist).addScaledVector(right, dist);
+  let lowest = Infinity;
+  for (let c = 0; c < 8; c++) {
+    _a.set(c & 1 ? box.max.x : box.min.x, c & 2 ? box.max.y : box.min.y, c & 4 ? box.max.z : box.min.z);
+    lowest = Math.min(lowest, up.dot(_a));
+  }
+  grid.position.copy(center).addScaledVector(up, lowest - up.dot(center) - 0.02 * S);
+  controls.target.copy(center);
+  controls.update();
+}
+
 // ------------------------------------------------------------------ controls and loop
 $('title').textContent = data.title;
 if (!sig) $('sigbox').style.display = 'none';
@@ -232,6 +253,7 @@ function loop(now) {
   requestAnimationFrame(loop);
 }
 resize();
+fitView();
 show(t0);
 play();
 requestAnimationFrame(loop);
