@@ -102,8 +102,10 @@ def test_page_plays_in_chromium(driver, tmp_path):
         own, there = _patch(img, xy), _patch(other, xy)
         assert np.abs(own - background).sum(-1).mean() > 60, f"no body drawn at its centre (shot {k})"
         assert np.abs(own - there).sum(-1).mean() > 40, f"screenshots do not differ where the rod moved (shot {k})"
-    # the rest of the 3D view (far from the rod) is unchanged: the camera did not move
-    assert np.abs(a[-150:-80, :150] - b[-150:-80, :150]).max() == 0
+    # the rest of the 3D view (far from the rod, below the title) is unchanged: the camera did not move
+    assert np.abs(a[60:120, :150] - b[60:120, :150]).max() == 0
+    # the signal chart's cursor moved with the time
+    assert np.abs(a[-140:-60] - b[-140:-60]).sum() > 0
 
     # playback advances time
     driver.execute_script(f"{v}.setTime(0); {v}.play()")

@@ -121,9 +121,7 @@ function updateSprings() {
 const side = Math.abs(up.z) > 0.9 ? new THREE.Vector3(0, -1, 0) : new THREE.Vector3(0, 0, 1);
 const right = new THREE.Vector3().crossVectors(up, side).normalize();
 const controls = new OrbitControls(camera, renderer.domElement);
-const grid = new THREE.GridHelper(4 * S, 20, 0xb8bec8, 0xd9dde3);
-grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), up);
-scene.add(grid);
+let grid = null;
 scene.add(new THREE.AxesHelper(0.15 * S));
 
 // ------------------------------------------------------------------ time, pose, signal
@@ -177,6 +175,8 @@ function drawChart(t) {
     c.stroke();
   });
   c.strokeStyle = '#222'; c.lineWidth = 1; c.beginPath(); c.moveTo(X(t), 0); c.lineTo(X(t), H); c.stroke();
+  c.fillStyle = '#667'; c.font = '11px system-ui, sans-serif';
+  c.fillText('max ' + fmt(hi), 6, 12); c.fillText('min ' + fmt(lo), 6, H - 6);
 }
 
 function render() { renderer.render(scene, camera); }
@@ -219,14 +219,21 @@ function fitView() {
     _a.set(c & 1 ? box.max.x : box.min.x, c & 2 ? box.max.y : box.min.y, c & 4 ? box.max.z : box.min.z);
     lowest = Math.min(lowest, up.dot(_a));
   }
+  // a floor about twice the size of the motion: it stays in front of the camera (lines crossing the
+  // camera plane are lost by some software renderers)
+  const size = 2 * Math.max(box.getSize(_a).length(), 0.1 * S);
+  if (grid) scene.remove(grid);
+  grid = new THREE.GridHelper(size, 20, 0xb8bec8, 0xd9dde3);
+  grid.quaternion.setFromUnitVectors(new THREE.Vector3(0, 1, 0), up);
   grid.position.copy(center).addScaledVector(up, lowest - up.dot(center) - 0.02 * S);
+  scene.add(grid);
   controls.target.copy(center);
   controls.update();
 }
 
 // ------------------------------------------------------------------ controls and loop
 $('title').textContent = data.title;
-if (!sig) $('sigbox').style.display = 'none';
+if (!sig) document.body.classList.add('nosignal');
 $('play').addEventListener('click', () => (playing ? setTime(time) : play()));
 $('slider').addEventListener('input', (e) => setTime(t0 + (t1 - t0) * Number(e.target.value) / 1000));
 $('speed').addEventListener('change', (e) => { speed = Number(e.target.value); });
@@ -241,6 +248,7 @@ function resize() {
   renderer.domElement.style.width = '100%'; renderer.domElement.style.height = '100%';
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
+  if (sig) { chart.width = chart.clientWidth; chart.height = chart.clientHeight; drawChart(time); }
   render();
 }
 window.addEventListener('resize', resize);
