@@ -15,6 +15,7 @@ matplotlib is imported only when a plot is drawn (Agg backend when none was chos
 from __future__ import annotations
 
 import re
+import weakref
 from dataclasses import dataclass
 from typing import Any, Callable, Sequence
 
@@ -113,8 +114,6 @@ def _measure_label(res, name: str, args: tuple) -> tuple[str, str, tuple[str, ..
     if name in ("joint_coordinate", "joint_velocity", "joint_acceleration") and args:
         joint = res._joint(args[0])  # noqa: SLF001 - the Result's own name lookup
         unit, comps = _JOINT_UNITS.get(joint.kind, ("", None))
-        if joint.kind == "revolute" and joint.body_j.is_particle:
-            unit = "m"
         order = {"joint_coordinate": "", "joint_velocity": "/s", "joint_acceleration": "/s^2"}[name]
         noun = {"revolute": "angle", "translational": "displacement"}.get(joint.kind, "coordinate")
         what = {"joint_coordinate": noun, "joint_velocity": f"{noun} rate",
@@ -180,12 +179,18 @@ def _is_dataframe(obj) -> bool:
     return hasattr(obj, "columns") and hasattr(obj, "iloc")
 
 
+_FRAMES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()   # Result -> its to_dataframe()
+
+
 def _dataframe(res):
     if _is_dataframe(res):
         return res
-    if not hasattr(res, "_df_cache"):
-        res._df_cache = res.to_dataframe()
-    return res._df_cache
+    try:
+        if res not in _FRAMES:
+            _FRAMES[res] = res.to_dataframe()
+        return _FRAMES[res]
+    except TypeError:    # not weak-referenceable / hashable: no cache
+        return res.to_dataframe()
 
 
 def _time(res) -> np.ndarray:
