@@ -284,3 +284,64 @@ def test_expression_drivers_run_compiled_and_match_reference():
     x = r * np.cos(th) + np.sqrt(L * L - (r * np.sin(th)) ** 2)
     assert np.max(np.abs(a.position(slider)[:, 0] - x)) < 1e-9
     assert np.max(np.abs(a.reaction_force("guide") - b.reaction_force("guide"))) < 1e-6
+
+
+def _slider_crank_reference(r, L, m, g, th0, w0, times):
+    """Crank angle of a free slider-crank (uniform crank and rod of mass m, slider m) from its one-DOF
+    Lagrange equation J(th) th'' + J'(th) th'^2 / 2 + V'(th) = 0, derived here independently of mbdsim
+    (J' and V' by complex step); integrated by scipy's DOP853 at rtol 1e-12."""
+    from scipy.integrate import solve_ivp
+
+    def kin(th):
+        s = np.sqrt(L * L - (r * np.sin(th)) ** 2)
+        ds = -r * r * np.sin(th) * np.cos(th) / s
+        dx = -r * np.sin(th) + ds
+        dphi = (s * (-r * np.cos(th)) - (-r * np.sin(th)) * ds) / (L * L)
+        dG = (0.5 * (-r * np.sin(th) + dx), 0.5 * r * np.cos(th))
+        return dx, dphi, dG
+
+    def J(th):
+        dx, dphi, dG = kin(th)
+        crank = m * r * r / 12 + m * r * r / 4
+        return crank + m * (dG[0] ** 2 + dG[1] ** 2) + m * L * L / 12 * dphi ** 2 + m * dx ** 2
+
+    V = lambda th: g * m * (0.5 * r * np.sin(th) + 0.5 * r * np.sin(th))  # noqa: E731
+    cs = lambda f, th: (f(th + 1e-30j)).imag / 1e-30  # noqa: E731
+
+    def rhs(t, y):
+        th, w = y
+        return [w, -(0.5 * cs(J, th) * w * w + cs(V, th)) / J(th)]
+
+    sol = solve_ivp(rhs, (times[0], times[-1]), [th0, w0], t_eval=times, rtol=1e-12, atol=1e-12, method="DOP853")
+    return sol.y[0], kin
+
+
+def test_free_slider_crank_through_dead_centres_at_default_settings():
+    r, L, mass, g = 0.1, 0.3, 1.0, 9.81
+    th0, w0 = np.pi / 3, 12.0
+    times = np.linspace(0.0, 2.0, 201)
+    ref, kin = _slider_crank_reference(r, L, mass, g, th0, w0, times)
+    assert ref[-1] - ref[0] > 4 * np.pi              # at least two turns: four dead centres
+    c, s = np.cos(th0), np.sin(th0)
+    dx, dphi, dG = kin(th0)
+    x0 = r * c + np.sqrt(L * L - (r * s) ** 2)
+    phi0 = np.arctan2(-r * s, x0 - r * c)
+    Rz = lambda a: [[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]]  # noqa: E731
+    m = mb.Model("free slider-crank", gravity=(0, -g, 0))
+    rod_I = lambda l: (1e-4, mass * l * l / 12, mass * l * l / 12)  # noqa: E731
+    crank = m.add_body("crank", mass, rod_I(r), position=(r / 2 * c, r / 2 * s, 0), orientation=Rz(th0),
+                       velocity=(-r / 2 * s * w0, r / 2 * c * w0, 0), angular_velocity=(0, 0, w0))
+    rod = m.add_body("rod", mass, rod_I(L), position=((r * c + x0) / 2, r * s / 2, 0), orientation=Rz(phi0),
+                     velocity=(dG[0] * w0, dG[1] * w0, 0), angular_velocity=(0, 0, dphi * w0))
+    slider = m.add_body("slider", mass, (1e-3, 1e-3, 1e-3), position=(x0, 0, 0), velocity=(dx * w0, 0, 0))
+    pin = m.add_revolute("pin", m.ground, crank, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("A", crank, rod, (r * c, r * s, 0), (0, 0, 1))
+    m.add_revolute("B", rod, slider, (x0, 0, 0), (0, 0, 1))
+    m.add_translational("guide", m.ground, slider, (x0, 0, 0), (1, 0, 0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
+        res = mb.simulate(m, 2.0, output_step=0.01)
+    assert res.success and res.stats["method"].startswith("auto: DOP853")
+    assert res.stats.get("assembly").velocity_changed == {}            # the given velocities were consistent
+    th = th0 + res.joint_coordinate(pin)
+    assert np.max(np.abs(th - ref)) < 1e-6
