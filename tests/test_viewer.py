@@ -127,6 +127,7 @@ def test_geometry_and_table_scene(tmp_path, rig):
     page = mb.animate(df, tmp_path / "t.html", max_frames=30)
     data = json.loads(_scripts_body(page.read_text()))
     assert [b["name"] for b in data["bodies"]] == ["rod", "bob", "ball"] and len(data["time"]) <= 30
+    assert data["trails"] is True and sc.trails is False     # table: CM paths drawn; full scene: none
     np.testing.assert_allclose(np.reshape(data["bodies"][0]["pos"], (-1, 3))[-1], df.iloc[-1, 1:4], atol=1e-5)
 
 

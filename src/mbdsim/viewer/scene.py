@@ -30,12 +30,13 @@ class Scene:
     springs: list = field(default_factory=list)
     shapes: list = field(default_factory=list)
     signal: dict | None = None
+    trails: bool = False      # draw each body's centre-of-mass path
 
     def to_json(self) -> dict:
         """The scene as a JSON-ready dict."""
         return {"title": self.title, "up": self.up, "scale": self.scale, "time": self.time,
                 "bodies": self.bodies, "joints": self.joints, "springs": self.springs,
-                "shapes": self.shapes, "signal": self.signal}
+                "shapes": self.shapes, "signal": self.signal, "trails": self.trails}
 
 
 def frame_indices(n: int, max_frames: int = MAX_FRAMES) -> np.ndarray:
@@ -206,7 +207,7 @@ def scene_from_table(df, signal=None, max_frames: int = MAX_FRAMES, title: str =
     """A scene from an exported results table (`res.to_dataframe()` read back from .csv/.parquet).
 
     Such a table holds centre-of-mass positions only ("<body>.x [m]", ".y", ".z"): every body is drawn
-    as a sphere at its centre of mass without rotation, and no joints or force elements.  `signal` is a
+    as a sphere at its centre of mass without rotation, with its path; no joints or force elements.  `signal` is a
     column name (matched leniently) or None."""
     from ..plotting import TIME_COLUMN, match_column
     time_col = match_column(df.columns, TIME_COLUMN)
@@ -220,7 +221,7 @@ def scene_from_table(df, signal=None, max_frames: int = MAX_FRAMES, title: str =
     pts = np.concatenate(list(pos.values()))
     ext = float(np.linalg.norm(pts.max(0) - pts.min(0)))
     scale = ext if ext > 1e-9 else 1.0
-    scene = Scene(title, [0.0, 1.0, 0.0], float(f"{scale:.6g}"), _r(sub[time_col], 9))
+    scene = Scene(title, [0.0, 1.0, 0.0], float(f"{scale:.6g}"), _r(sub[time_col], 9), trails=True)
     sphere = {"kind": "sphere", "radius": float(f"{0.03 * scale:.6g}"), "center": [0.0, 0.0, 0.0]}
     for k, n in enumerate(names):
         scene.bodies.append({"name": n, "color": PALETTE[k % len(PALETTE)], "shape": sphere,

@@ -31,6 +31,12 @@ const groups = data.bodies.map((b) => {
   scene.add(g);
   return g;
 });
+// centre-of-mass paths, when the scene asks for them (results tables: bodies are bare spheres)
+if (data.trails) data.bodies.forEach((b) => {
+  const geo = new THREE.BufferGeometry();
+  geo.setAttribute('position', new THREE.BufferAttribute(new Float32Array(b.pos.map(Number)), 3));
+  scene.add(new THREE.Line(geo, new THREE.LineBasicMaterial({ color: b.color, transparent: true, opacity: 0.5 })));
+});
 const ground = new THREE.Group();
 scene.add(ground);
 const holder = (k) => (k < 0 ? ground : groups[k]);
