@@ -60,10 +60,13 @@ def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
 
 
 @njit(cache=True, _nrt=False)
-def loads_into(cm, r, A, rd, w, F):
+def loads_into(cm, wk, r, A, rd, w, F):
     """Gravity, gyroscopic torques, constant point forces/torques and linear spring-dampers into F."""
     loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
                  cm[29], r, A, rd, w, F)
+    if cm[36].shape[0]:
+        bushings_kernel(cm[36], cm[37], cm[38], cm[39], cm[40], cm[41], r, A, rd, w, cm[6], F, wk[42][0],
+                        wk[42][1])
 
 
 @njit(cache=True, _nrt=False)
@@ -141,6 +144,108 @@ def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, p
 
 
 @njit(cache=True, _nrt=False)
+def _rotvec(r00, r01, r02, r10, r11, r12, r20, r21, r22):
+    """Rotation vector [rad] of a rotation matrix (angle in [0, pi]), via the unit quaternion."""
+    tr = r00 + r11 + r22
+    if tr > 0.0:
+        s = 2.0 * np.sqrt(tr + 1.0)
+        w, x, y, z = 0.25 * s, (r21 - r12) / s, (r02 - r20) / s, (r10 - r01) / s
+    elif r00 > r11 and r00 > r22:
+        s = 2.0 * np.sqrt(1.0 + r00 - r11 - r22)
+        w, x, y, z = (r21 - r12) / s, 0.25 * s, (r01 + r10) / s, (r02 + r20) / s
+    elif r11 > r22:
+        s = 2.0 * np.sqrt(1.0 + r11 - r00 - r22)
+        w, x, y, z = (r02 - r20) / s, (r01 + r10) / s, 0.25 * s, (r12 + r21) / s
+    else:
+        s = 2.0 * np.sqrt(1.0 + r22 - r00 - r11)
+        w, x, y, z = (r10 - r01) / s, (r02 + r20) / s, (r12 + r21) / s, 0.25 * s
+    if w < 0.0:
+        w, x, y, z = -w, -x, -y, -z
+    n = np.sqrt(x * x + y * y + z * z)
+    if n < 1e-300:
+        return 0.0, 0.0, 0.0
+    ang = 2.0 * np.arctan2(n, w)
+    return ang * x / n, ang * y / n, ang * z / n
+
+
+@njit(cache=True, _nrt=False)
+def bushings_kernel(bu_f, bu_s, bu_R, bu_k, bu_c, bu_f0, r, A, rd, w, rigid, F, Mi, Mj):
+    """Linear six-component bushings (Adams BUSHING semantics, see model.element_specs.Bushing) into F.
+    Mi, Mj (3, 3): scratch for the markers' axes in ground."""
+    for e in range(bu_f.shape[0]):
+        fi, fj = bu_f[e, 0], bu_f[e, 1]
+        for a in range(3):
+            for b in range(3):
+                si = 0.0
+                sj = 0.0
+                for k in range(3):
+                    si += A[fi, a, k] * bu_R[e, 0, k, b]
+                    sj += A[fj, a, k] * bu_R[e, 1, k, b]
+                Mi[a, b] = si
+                Mj[a, b] = sj
+        pi0, pi1, pi2 = _rot(A, fi, bu_s[e, 0, 0], bu_s[e, 0, 1], bu_s[e, 0, 2])
+        pj0, pj1, pj2 = _rot(A, fj, bu_s[e, 1, 0], bu_s[e, 1, 1], bu_s[e, 1, 2])
+        vi0, vi1, vi2 = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], pi0, pi1, pi2)
+        vj0, vj1, vj2 = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], pj0, pj1, pj2)
+        d0 = r[fj, 0] + pj0 - r[fi, 0] - pi0
+        d1 = r[fj, 1] + pj1 - r[fi, 1] - pi1
+        d2 = r[fj, 2] + pj2 - r[fi, 2] - pi2
+        c0, c1, c2 = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], d0, d1, d2)
+        e0 = rd[fj, 0] + vj0 - rd[fi, 0] - vi0 - c0
+        e1 = rd[fj, 1] + vj1 - rd[fi, 1] - vi1 - c1
+        e2 = rd[fj, 2] + vj2 - rd[fi, 2] - vi2 - c2
+        wr0, wr1, wr2 = w[fj, 0] - w[fi, 0], w[fj, 1] - w[fi, 1], w[fj, 2] - w[fi, 2]
+        # relative rotation Mi^T Mj
+        r00 = Mi[0, 0] * Mj[0, 0] + Mi[1, 0] * Mj[1, 0] + Mi[2, 0] * Mj[2, 0]
+        r01 = Mi[0, 0] * Mj[0, 1] + Mi[1, 0] * Mj[1, 1] + Mi[2, 0] * Mj[2, 1]
+        r02 = Mi[0, 0] * Mj[0, 2] + Mi[1, 0] * Mj[1, 2] + Mi[2, 0] * Mj[2, 2]
+        r10 = Mi[0, 1] * Mj[0, 0] + Mi[1, 1] * Mj[1, 0] + Mi[2, 1] * Mj[2, 0]
+        r11 = Mi[0, 1] * Mj[0, 1] + Mi[1, 1] * Mj[1, 1] + Mi[2, 1] * Mj[2, 1]
+        r12 = Mi[0, 1] * Mj[0, 2] + Mi[1, 1] * Mj[1, 2] + Mi[2, 1] * Mj[2, 2]
+        r20 = Mi[0, 2] * Mj[0, 0] + Mi[1, 2] * Mj[1, 0] + Mi[2, 2] * Mj[2, 0]
+        r21 = Mi[0, 2] * Mj[0, 1] + Mi[1, 2] * Mj[1, 1] + Mi[2, 2] * Mj[2, 1]
+        r22 = Mi[0, 2] * Mj[0, 2] + Mi[1, 2] * Mj[1, 2] + Mi[2, 2] * Mj[2, 2]
+        a0, a1, a2 = _rotvec(r00, r01, r02, r10, r11, r12, r20, r21, r22)
+        # marker_i components: x = Mi^T d, xd = Mi^T e, w = Mi^T wr
+        x0 = Mi[0, 0] * d0 + Mi[1, 0] * d1 + Mi[2, 0] * d2
+        x1 = Mi[0, 1] * d0 + Mi[1, 1] * d1 + Mi[2, 1] * d2
+        x2 = Mi[0, 2] * d0 + Mi[1, 2] * d1 + Mi[2, 2] * d2
+        xd0 = Mi[0, 0] * e0 + Mi[1, 0] * e1 + Mi[2, 0] * e2
+        xd1 = Mi[0, 1] * e0 + Mi[1, 1] * e1 + Mi[2, 1] * e2
+        xd2 = Mi[0, 2] * e0 + Mi[1, 2] * e1 + Mi[2, 2] * e2
+        w0 = Mi[0, 0] * wr0 + Mi[1, 0] * wr1 + Mi[2, 0] * wr2
+        w1 = Mi[0, 1] * wr0 + Mi[1, 1] * wr1 + Mi[2, 1] * wr2
+        w2 = Mi[0, 2] * wr0 + Mi[1, 2] * wr1 + Mi[2, 2] * wr2
+        k, c, f0 = bu_k, bu_c, bu_f0
+        F0 = -k[e, 0] * x0 - c[e, 0] * xd0 + f0[e, 0]
+        F1 = -k[e, 1] * x1 - c[e, 1] * xd1 + f0[e, 1]
+        F2 = -k[e, 2] * x2 - c[e, 2] * xd2 + f0[e, 2]
+        T0 = -k[e, 3] * a0 - c[e, 3] * w0 + f0[e, 3]
+        T1 = -k[e, 4] * a1 - c[e, 4] * w1 + f0[e, 4]
+        T2 = -k[e, 5] * a2 - c[e, 5] * w2 + f0[e, 5]
+        G0 = Mi[0, 0] * F0 + Mi[0, 1] * F1 + Mi[0, 2] * F2
+        G1 = Mi[1, 0] * F0 + Mi[1, 1] * F1 + Mi[1, 2] * F2
+        G2 = Mi[2, 0] * F0 + Mi[2, 1] * F1 + Mi[2, 2] * F2
+        H0 = Mi[0, 0] * T0 + Mi[0, 1] * T1 + Mi[0, 2] * T2
+        H1 = Mi[1, 0] * T0 + Mi[1, 1] * T1 + Mi[1, 2] * T2
+        H2 = Mi[2, 0] * T0 + Mi[2, 1] * T1 + Mi[2, 2] * T2
+        _point_force(F, A, fj, pj0, pj1, pj2, G0, G1, G2, rigid)
+        # body_i: -F at the same ground point (offset from its CM: r_j + p_j - r_i)
+        oi0, oi1, oi2 = r[fj, 0] + pj0 - r[fi, 0], r[fj, 1] + pj1 - r[fi, 1], r[fj, 2] + pj2 - r[fi, 2]
+        _point_force(F, A, fi, oi0, oi1, oi2, -G0, -G1, -G2, rigid)
+        if fj != 0 and rigid[fj]:
+            t0, t1, t2 = _rotT(A, fj, H0, H1, H2)
+            F[fj, 3] += t0
+            F[fj, 4] += t1
+            F[fj, 5] += t2
+        if fi != 0 and rigid[fi]:
+            t0, t1, t2 = _rotT(A, fi, H0, H1, H2)
+            F[fi, 3] -= t0
+            F[fi, 4] -= t1
+            F[fi, 5] -= t2
+
+
+@njit(cache=True, _nrt=False)
 def _constraints(cm, wk, t, q, v):
     """Frames, driver values and constraint rows at (q, v, t) into the work arrays."""
     r_idx, p_idx, rd_idx, w_idx, rigid_fid, rigid = cm[0], cm[1], cm[2], cm[3], cm[4], cm[6]
@@ -178,7 +283,7 @@ def accelerations(cm, wk, t, q, v, vd, lam):
     _constraints(cm, wk, t, q, v)
     F = wk[8]
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
-    loads_into(cm, r, A, rd, w, F)
+    loads_into(cm, wk, r, A, rd, w, F)
     if not _factor(cm, wk):
         return SINGULAR
     x6 = wk[25]

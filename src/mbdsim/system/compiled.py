@@ -12,6 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..model.element_specs import Bushing
 from ..model.forces import Force, SpringDamper, Torque
 from . import kernels
 from .measures import locate
@@ -60,6 +61,8 @@ class CompiledModel:
     dims: np.ndarray          # (nq, nv, nc, nf, dense): dense = 1 when a body's mass matrix is singular
     active: np.ndarray        # independent rows in force
     stack_size: int
+    bushings: tuple = ()      # (frames (n, 2), marker points s_B (n, 2, 3), marker axes R_BM (n, 2, 3, 3),
+    #                           stiffness, damping, preload (n, 6) each), see model.element_specs.Bushing
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -69,7 +72,8 @@ class CompiledModel:
                 self.M6, self.gravity, self.mass, self.inertia, self.kind, self.bi, self.bj, self.vecs,
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
-                self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy())
+                self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy(),
+                *self.bushings)
 
 
 @dataclass
@@ -90,7 +94,7 @@ class Work:
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
              z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z(nc), z((3, nd)), z(4),
              z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
-             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64))
+             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)))
         return cls(a)
 
     def arrays(self) -> tuple:
@@ -116,8 +120,9 @@ def _driver_programs(fns):
 
 
 def _loads(sys):
-    """Constant point forces and torques, and spring-dampers, as arrays; NotCompiled for anything else."""
-    pf, sp = [], []
+    """Constant point forces and torques, spring-dampers and bushings as arrays; NotCompiled for anything
+    else."""
+    pf, sp, bu = [], [], []
     for e in sys.model.forces.values():
         if isinstance(e, (Force, Torque)):
             vec = e.force if isinstance(e, Force) else e.torque
@@ -126,14 +131,21 @@ def _loads(sys):
             ff, R = (0, np.eye(3)) if e.frame is None else (lambda x: (x[0], x[2]))(locate(sys, e.frame))
             s = e.s_B if isinstance(e, Force) else np.zeros(3)
             pf.append((sys.fid[e.body], s, np.asarray(vec, float), ff, R, isinstance(e, Torque)))
+        elif type(e) is Bushing:
+            mi, mj = e.marker_i, e.marker_j
+            bu.append(((sys.fid[mi.body], sys.fid[mj.body]), (mi.s_B, mj.s_B), (mi.R_BM, mj.R_BM),
+                       e.stiffness, e.damping, e.preload))
         elif type(e) is SpringDamper:
             sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
         else:
             raise NotCompiled(f"force element '{e.name}' ({type(e).__name__}) is not compiled yet")
     arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape)  # noqa: E731
-    n, m = len(pf), len(sp)
-    return (arr([p[0] for p in pf], (n,), np.int64), arr([p[1] for p in pf], (n, 3)),
+    n, m, nb = len(pf), len(sp), len(bu)
+    bushings = (arr([b[0] for b in bu], (nb, 2), np.int64), arr([b[1] for b in bu], (nb, 2, 3)),
+                arr([b[2] for b in bu], (nb, 2, 3, 3)), arr([b[3] for b in bu], (nb, 6)),
+                arr([b[4] for b in bu], (nb, 6)), arr([b[5] for b in bu], (nb, 6)))
+    return bushings, (arr([p[0] for p in pf], (n,), np.int64), arr([p[1] for p in pf], (n, 3)),
             arr([p[2] for p in pf], (n, 3)), arr([p[3] for p in pf], (n,), np.int64),
             arr([p[4] for p in pf], (n, 3, 3)), arr([p[5] for p in pf], (n,), np.bool_),
             arr([p[0] for p in sp], (m, 2), np.int64), arr([p[1] for p in sp], (m, 2, 3)),
@@ -156,7 +168,7 @@ def compile_system(sys, rows) -> CompiledModel:
                 M6[f, 3:, 3:] = sys.inertia_B[f]
     kind, bi, bj, v1, v2, v3, drv, fns = kernels.pack_rows(sys)
     code, consts, tables, start, end, stack = _driver_programs(fns)
-    loads = _loads(sys)
+    bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
     dense = any(np.linalg.eigvalsh(M6[f]).min() <= 1e-12 * max(np.abs(M6[f]).max(), 1e-300) for f in range(1, nf))
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
@@ -166,4 +178,4 @@ def compile_system(sys, rows) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          np.stack([v1, v2, v3]), drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense)], np.int64),
-                         np.sort(rows), stack)
+                         np.sort(rows), stack, bushings)
