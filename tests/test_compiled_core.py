@@ -362,3 +362,18 @@ def test_free_slider_crank_through_dead_centres_at_default_settings():
     assert res.stats.get("assembly").velocity_changed == {}            # the given velocities were consistent
     th = th0 + res.joint_coordinate(pin)
     assert np.max(np.abs(th - ref)) < 1e-6
+
+
+def test_progress_callback_and_interrupt_keep_the_outputs():
+    model = _pendulum_chain(3)
+    seen = []
+    res = mb.simulate(model, 20.0, output_step=0.01, progress=seen.append)
+    assert res.success and seen == sorted(seen) and seen[-1] == pytest.approx(20.0)
+
+    def stop(t):
+        if t > 5.0:
+            raise KeyboardInterrupt
+    part = mb.simulate(model, 20.0, output_step=0.01, progress=stop)
+    assert not part.success and "interrupted" in part.message
+    n = len(part.time)
+    assert 500 <= n < 2001 and np.allclose(part.q, res.q[:n], atol=1e-12)

@@ -14,7 +14,7 @@ from ..errors import MbdsimError, SolverError
 from ..results.result import Result
 from ..system.compiled import Work, compile_system
 from . import fastdop
-from .fastdyn import MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
+from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
              PROJECTION: "projection onto the constraints does not converge",
@@ -22,7 +22,8 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
              TINY_STEP: "step size collapsed below the round-off limit (lock-up, singular configuration "
                         "or a discontinuity)",
              MAX_STEPS: "step budget exhausted (max_steps)",
-             STIFF: "the model is stiff for an explicit method"}
+             STIFF: "the model is stiff for an explicit method",
+             INTERRUPTED: "interrupted (KeyboardInterrupt)"}
 CHUNK = 256
 
 
@@ -55,12 +56,15 @@ class CompiledRun:
             st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n),
                                          np.zeros(n), np.zeros(n))
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
-        while status == 0 and iout < nout:
-            status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD, LAM,
-                                       self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
-                                       self.stats, K, F, sc, self.stiff_check)
-            if progress is not None:
-                progress(st[0])
+        try:
+            while status == 0 and iout < nout:
+                status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD,
+                                           LAM, self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
+                                           1e-12, self.stats, K, F, sc, self.stiff_check)
+                if progress is not None:
+                    progress(float(st[0]))
+        except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
+            status = INTERRUPTED
         return Y, VD, LAM, iout, status, st[0], y
 
     def states_at(self, times, Y, ts):
@@ -93,7 +97,8 @@ class Stiff(Exception):
 def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, stiff_check=False) -> Result:
     """Dynamic analysis of System `sys` from the assembled state `rep` over the output grid `times`
     with the compiled DOP853 (raises NotCompiled when the model needs the reference path, and Stiff
-    when stiff_check is set and the model is stiff)."""
+    when stiff_check is set and the model is stiff). progress(t) is called with the time reached [s]
+    every chunk of outputs; Ctrl-C ends the run with success=False and every output before it."""
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
@@ -103,7 +108,8 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     if status != 0:
         from .dynamic import _weak_joints
         try:
-            joints = _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail, rep.rows)
+            joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
+                                                                   rep.rows)
         except (MbdsimError, np.linalg.LinAlgError, ValueError):
             joints = []
         error = SolverError(_MESSAGES.get(status, "integration failed"), time=float(t_fail), joints=joints,

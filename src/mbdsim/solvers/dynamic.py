@@ -34,7 +34,7 @@ DEFAULT_TOL = {"auto": (1e-8, 1e-10), "dop853": (1e-10, 1e-12), "high-accuracy":
 
 
 def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
-             start_time=0.0) -> Result:
+             start_time=0.0, progress=None) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
@@ -43,7 +43,9 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
-    `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations."""
+    `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations.
+    progress: optional callable progress(t) receiving the simulated time reached [s] now and then
+    (compiled runs; Ctrl-C there returns the partial Result with success=False)."""
     check_model(model)
     method = "auto" if method is None else method
     if not isinstance(method, str):
@@ -62,7 +64,7 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
             if USE_COMPILED:
-                res = integrate_compiled(sys, rep, times, rt, at, max_step, stiff_check=True)
+                res = integrate_compiled(sys, rep, times, rt, at, max_step, progress, stiff_check=True)
                 res.stats["method"] = "auto: " + res.stats["method"]
                 return res
         except NotCompiled as exc:
@@ -72,10 +74,10 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
         else:
             reason = "compiled path disabled"
         method = _default_method(model)
-        res = _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step)
+        res = _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
         res.stats["method"] = f"auto: {res.stats.get('method', method)} ({reason})"
         return res
-    return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step)
+    return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
 
 
 def _tolerances(method, rtol, atol):
@@ -86,7 +88,7 @@ def _tolerances(method, rtol, atol):
     return r, (d_atol * r / d_rtol if atol is None else atol)
 
 
-def _run(sys, rep, times, method, rtol, atol, max_step) -> Result:
+def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
     """One named method over the output grid from the assembled state."""
     if method == "hht":
         from .hht import integrate_hht
@@ -100,7 +102,7 @@ def _run(sys, rep, times, method, rtol, atol, max_step) -> Result:
         return res
     if method in COMPILED_METHODS and USE_COMPILED:
         try:
-            return integrate_compiled(sys, rep, times, rtol, atol, max_step)
+            return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)

@@ -93,6 +93,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
     ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
     t, h = st[0], st[1]
     written = 0
+    steps0 = stats[0]
     rejected = False
     eps = 2.220446049250313e-16
     while iout < tout.shape[0]:
@@ -218,7 +219,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
         if s_ != OK:
             st[0], st[1] = t, h
             return s_, iout
-        if written >= chunk and iout < tout.shape[0]:
-            break
+        if (written >= chunk or stats[0] - steps0 >= 50 * chunk) and iout < tout.shape[0]:
+            break   # back to Python now and then (progress, Ctrl-C), also between sparse outputs
     st[0], st[1] = t, h
     return OK, iout

@@ -24,7 +24,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
 from ..system.kernels import frames_into, rows_kernel
 from .kkt_tree import dense_factor, dense_solve, kkt_factor, kkt_solve
 
-OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF = 0, 1, 2, 3, 4, 5, 6
+OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
 
 
 @njit(cache=True, _nrt=False)
