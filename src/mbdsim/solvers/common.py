@@ -5,7 +5,6 @@ import numpy as np
 import scipy.linalg as sla
 
 from ..errors import SolverError
-from ..math.rotation import quat_exp, quat_mul, quat_rate
 from ..system.dynamics import applied_forces, solve_kkt
 from ..system import kernels
 from ..system.equations import constraint_terms
@@ -14,17 +13,9 @@ from ..system.frames import body_frames
 
 def increment(sys, q, dx):
     """q (+) dx: translate CMs by dx [m], rotate bodies by the body-axes rotation vector dx [rad]."""
-    if kernels.HAVE_NUMBA:
-        q = kernels.increment_kernel(np.asarray(q, dtype=float), np.asarray(dx, dtype=float), sys.r_idx,
-                                     sys.rd_idx, sys.p_idx, sys.w_idx)
-        q[sys.aux_q_idx] += dx[sys.aux_v_idx]
-        return q
-    q = q.copy()
-    q[sys.r_idx] += dx[sys.rd_idx]
+    q = kernels.increment_kernel(np.asarray(q, dtype=float), np.asarray(dx, dtype=float), sys.r_idx,
+                                 sys.rd_idx, sys.p_idx, sys.w_idx)
     q[sys.aux_q_idx] += dx[sys.aux_v_idx]   # auxiliary coordinates (curve parameters): plain sums
-    if len(sys.p_idx):
-        p = quat_mul(q[sys.p_idx], quat_exp(dx[sys.w_idx]))
-        q[sys.p_idx] = p / np.linalg.norm(p, axis=-1, keepdims=True)
     return q
 
 
@@ -39,16 +30,9 @@ def normalize(sys, q):
 
 def qdot(sys, q, v):
     """dq/dt from velocity variables: rd for positions, 1/2 p (x) (0, w_B) for Euler parameters."""
-    if kernels.HAVE_NUMBA:
-        qd = kernels.qdot_kernel(np.asarray(q, dtype=float), np.asarray(v, dtype=float), sys.r_idx,
-                                 sys.rd_idx, sys.p_idx, sys.w_idx, sys.nq)
-        qd[sys.aux_q_idx] = v[sys.aux_v_idx]
-        return qd
-    qd = np.zeros(sys.nq)
-    qd[sys.r_idx] = v[sys.rd_idx]
+    qd = kernels.qdot_kernel(np.asarray(q, dtype=float), np.asarray(v, dtype=float), sys.r_idx,
+                             sys.rd_idx, sys.p_idx, sys.w_idx, sys.nq)
     qd[sys.aux_q_idx] = v[sys.aux_v_idx]
-    if len(sys.p_idx):
-        qd[sys.p_idx] = quat_rate(q[sys.p_idx], v[sys.w_idx])
     return qd
 
 

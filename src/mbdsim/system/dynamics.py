@@ -8,7 +8,6 @@ from __future__ import annotations
 import numpy as np
 
 from . import kernels
-from .constraints.primitives import cross
 from .force_elements import evaluator
 from .force_elements import loads  # noqa: F401  (registers the built-in evaluators)
 from .frames import Frames
@@ -24,16 +23,8 @@ def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
 
 def inertial_forces(sys, fr: Frames) -> np.ndarray:
     """Q (nv,) of gravity on every CM [N] and the gyroscopic torques -w_B x (J w_B) [N m, body axes]."""
-    if kernels.HAVE_NUMBA:
-        return kernels.inertial_forces_kernel(fr.A, fr.w, sys.mass, sys.inertia_B, sys.rd_idx, sys.w_idx,
-                                              sys.rigid_fid, sys.model.gravity, sys.nv)
-    Q = np.zeros(sys.nv)
-    Q[sys.rd_idx] += sys.mass[1:, None] * sys.model.gravity
-    rig = sys.rigid_fid
-    if len(rig):
-        w_B = np.einsum("nji,nj->ni", fr.A[rig], fr.w[rig])
-        Q[sys.w_idx] -= cross(w_B, np.einsum("nij,nj->ni", sys.inertia_B[rig], w_B))
-    return Q
+    return kernels.inertial_forces_kernel(fr.A, fr.w, sys.mass, sys.inertia_B, sys.rd_idx, sys.w_idx,
+                                          sys.rigid_fid, sys.model.gravity, sys.nv)
 
 
 def solve_kkt(M, J, Q, gamma):

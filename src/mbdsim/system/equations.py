@@ -66,12 +66,9 @@ def scatter_jacobian(sys, fr: Frames, idx, rows, out):
         np.add.at(out, (idx, aux[0]), aux[1])
 
 
-USE_KERNEL = kernels.HAVE_NUMBA
-
-
 def constraint_terms(sys, q, v, t, jacobian=True):
     """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False."""
-    if USE_KERNEL and sys.nc and not len(sys.aux_q_idx):   # path constraints: numpy path
+    if sys.nc and not len(sys.aux_q_idx):   # path constraints (auxiliary coordinates): numpy path
         return _terms_compiled(sys, q, v, t, jacobian)
     return constraint_terms_numpy(sys, q, v, t, jacobian)
 

@@ -29,7 +29,7 @@ class Frames:
 def body_frames(sys, q, v=None, vd=None) -> Frames:
     """Frames of all bodies from q (..., nq), v (..., nv) and optionally vd (..., nv)."""
     q = np.asarray(q, dtype=float)
-    if q.ndim == 1 and vd is None and kernels.HAVE_NUMBA:
+    if q.ndim == 1 and vd is None:   # one state: compiled; time axes: numpy below
         vv = np.zeros(sys.nv) if v is None else np.asarray(v, dtype=float)
         return Frames(*kernels.frames_kernel(q, vv, sys.r_idx, sys.p_idx, sys.rd_idx, sys.w_idx,
                                              sys.rigid_fid, sys.nbody + 1))

@@ -1,20 +1,17 @@
 """Compiled (numba) kernel of the constraint equations: the same maths as `constraints.primitives`,
 evaluated row by row in one pass with scalar arithmetic, scattered straight into phi, phi_q, nu, gamma.
 
-`primitives` stays the reference implementation (and the path used without numba); the tests check
-that both agree to round-off.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
+`primitives` (numpy) evaluates the same rows batched over time samples (Result measures, path
+constraints); the tests check that both agree to round-off.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
 (driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `pack_rows`).
 """
 from __future__ import annotations
 
 import numpy as np
 
-try:  # numba is optional at run time: without it the numpy path is used
-    from numba import njit
-    from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
-    HAVE_NUMBA = True
-except ImportError:  # pragma: no cover
-    HAVE_NUMBA = False
+from numba import njit
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 
 KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6}
 
@@ -43,252 +40,246 @@ def pack_rows(sys):
     return kind, bi, bj, v[0], v[1], v[2], drv, fns
 
 
-if HAVE_NUMBA:
-    @njit(cache=True, _nrt=False)
-    def _mv(A, b, x):
-        return (A[b, 0, 0] * x[0] + A[b, 0, 1] * x[1] + A[b, 0, 2] * x[2],
-                A[b, 1, 0] * x[0] + A[b, 1, 1] * x[1] + A[b, 1, 2] * x[2],
-                A[b, 2, 0] * x[0] + A[b, 2, 1] * x[1] + A[b, 2, 2] * x[2])
+@njit(cache=True, _nrt=False)
+def _mv(A, b, x):
+    return (A[b, 0, 0] * x[0] + A[b, 0, 1] * x[1] + A[b, 0, 2] * x[2],
+            A[b, 1, 0] * x[0] + A[b, 1, 1] * x[1] + A[b, 1, 2] * x[2],
+            A[b, 2, 0] * x[0] + A[b, 2, 1] * x[1] + A[b, 2, 2] * x[2])
 
-    @njit(cache=True, _nrt=False)
-    def _cr(a, b):
-        return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+@njit(cache=True, _nrt=False)
+def _cr(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
-    @njit(cache=True, _nrt=False)
-    def _dt(a, b):
-        return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+@njit(cache=True, _nrt=False)
+def _dt(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
-    @njit(cache=True, _nrt=False)
-    def _add(a, b):
-        return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+@njit(cache=True, _nrt=False)
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
-    @njit(cache=True, _nrt=False)
-    def _sub(a, b):
-        return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+@njit(cache=True, _nrt=False)
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
-    @njit(cache=True, _nrt=False)
-    def _sc(s, a):
-        return (s * a[0], s * a[1], s * a[2])
+@njit(cache=True, _nrt=False)
+def _sc(s, a):
+    return (s * a[0], s * a[1], s * a[2])
 
-    @njit(cache=True, _nrt=False)
-    def _put(Jc, row, side, b, Jr, Jp, A, rigid):
-        """Row coefficients of frame b (side 0: body_i, 1: body_j): translation, then body-axes rotation Jp A."""
-        for k in range(6):
-            Jc[row, side, k] = 0.0
-        if b == 0:
-            return
-        Jc[row, side, 0] = Jr[0]
-        Jc[row, side, 1] = Jr[1]
-        Jc[row, side, 2] = Jr[2]
-        if rigid[b]:
-            for k in range(3):  # body axes: Jp A
-                Jc[row, side, 3 + k] = Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
+@njit(cache=True, _nrt=False)
+def _put(Jc, row, side, b, Jr, Jp, A, rigid):
+    """Row coefficients of frame b (side 0: body_i, 1: body_j): translation, then body-axes rotation Jp A."""
+    for k in range(6):
+        Jc[row, side, k] = 0.0
+    if b == 0:
+        return
+    Jc[row, side, 0] = Jr[0]
+    Jc[row, side, 1] = Jr[1]
+    Jc[row, side, 2] = Jr[2]
+    if rigid[b]:
+        for k in range(3):  # body axes: Jp A
+            Jc[row, side, 3 + k] = Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
 
-    @njit(cache=True)
-    def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
-        """Dense phi_q (nc, nv) from the compact rows Jc (nc, 2, 6); J zeroed by the caller."""
-        for row in range(Jc.shape[0]):
-            for side in range(2):
-                b = bi_[row] if side == 0 else bj_[row]
-                if b == 0:
-                    continue
-                c = vadr[b]
-                n = 6 if rigid[b] else 3
-                for k in range(n):
-                    J[row, c + k] += Jc[row, side, k]
+@njit(cache=True)
+def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
+    """Dense phi_q (nc, nv) from the compact rows Jc (nc, 2, 6); J zeroed by the caller."""
+    for row in range(Jc.shape[0]):
+        for side in range(2):
+            b = bi_[row] if side == 0 else bj_[row]
+            if b == 0:
+                continue
+            c = vadr[b]
+            n = 6 if rigid[b] else 3
+            for k in range(n):
+                J[row, c + k] += Jc[row, side, k]
 
-    @njit(cache=True, _nrt=False)
-    def _dot1(A, w, bi, bj, ai_B, aj_B):
-        ai = _mv(A, bi, ai_B)
-        aj = _mv(A, bj, aj_B)
+@njit(cache=True, _nrt=False)
+def _dot1(A, w, bi, bj, ai_B, aj_B):
+    ai = _mv(A, bi, ai_B)
+    aj = _mv(A, bj, aj_B)
+    wi = (w[bi, 0], w[bi, 1], w[bi, 2])
+    wj = (w[bj, 0], w[bj, 1], w[bj, 2])
+    c = _cr(ai, aj)
+    wai, waj = _cr(wi, ai), _cr(wj, aj)
+    quad = _dt(_cr(wi, wai), aj) + 2.0 * _dt(wai, waj) + _dt(ai, _cr(wj, waj))
+    rate = _dt(c, wi) - _dt(c, wj)
+    return _dt(ai, aj), c, quad, rate
+
+@njit(cache=True, _nrt=False)
+def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
+    """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row.
+
+    Jc[row, 0] holds the row's coefficients on body_i's velocity variables (CM velocity [m/s],
+    body-axes angular velocity [rad/s]), Jc[row, 1] those on body_j's (zero for ground)."""
+    zero = (0.0, 0.0, 0.0)
+    for row in range(kind.shape[0]):
+        k = kind[row]
+        bi, bj = bi_[row], bj_[row]
+        nu[row] = 0.0
         wi = (w[bi, 0], w[bi, 1], w[bi, 2])
         wj = (w[bj, 0], w[bj, 1], w[bj, 2])
-        c = _cr(ai, aj)
-        wai, waj = _cr(wi, ai), _cr(wj, aj)
-        quad = _dt(_cr(wi, wai), aj) + 2.0 * _dt(wai, waj) + _dt(ai, _cr(wj, waj))
-        rate = _dt(c, wi) - _dt(c, wj)
-        return _dt(ai, aj), c, quad, rate
-
-    @njit(cache=True, _nrt=False)
-    def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
-        """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row.
-
-        Jc[row, 0] holds the row's coefficients on body_i's velocity variables (CM velocity [m/s],
-        body-axes angular velocity [rad/s]), Jc[row, 1] those on body_j's (zero for ground)."""
-        zero = (0.0, 0.0, 0.0)
-        for row in range(kind.shape[0]):
-            k = kind[row]
-            bi, bj = bi_[row], bj_[row]
-            nu[row] = 0.0
-            wi = (w[bi, 0], w[bi, 1], w[bi, 2])
-            wj = (w[bj, 0], w[bj, 1], w[bj, 2])
-            if k <= 2:
-                si = _mv(A, bi, v1[row])
-                sj = _mv(A, bj, v2[row])
-                ph = (r[bj, k] + sj[k] - r[bi, k] - si[k])
-                qd = _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k]
-                e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
-                # row k of skew(s): (s~)_k. = e_k x ... ; J_pi = s~_i row k, J_pj = -s~_j row k
-                ski = _cr(si, e)
-                skj = _cr(sj, e)
-                ski = (-ski[0], -ski[1], -ski[2])
-                _put(Jc, row, 0, bi, (-e[0], -e[1], -e[2]), ski, A, rigid)
-                _put(Jc, row, 1, bj, e, skj, A, rigid)
-                phi[row] = ph
-                gamma[row] = -qd
-            elif k == 3:
-                val, c, quad, _ = _dot1(A, w, bi, bj, v1[row], v2[row])
-                _put(Jc, row, 0, bi, zero, c, A, rigid)
-                _put(Jc, row, 1, bj, zero, _sc(-1.0, c), A, rigid)
-                phi[row] = val
-                gamma[row] = -quad
-            elif k == 4 or k == 6:
-                ai = _mv(A, bi, v1[row])
-                si = _mv(A, bi, v2[row])
-                sj = _mv(A, bj, v3[row])
-                d = _sub(_add((r[bj, 0], r[bj, 1], r[bj, 2]), sj), _add((r[bi, 0], r[bi, 1], r[bi, 2]), si))
-                dd = _sub(_add((rd[bj, 0], rd[bj, 1], rd[bj, 2]), _cr(wj, sj)),
-                          _add((rd[bi, 0], rd[bi, 1], rd[bi, 2]), _cr(wi, si)))
-                wai = _cr(wi, ai)
-                quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
-                        + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
-                _put(Jc, row, 0, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, rigid)
-                _put(Jc, row, 1, bj, ai, _cr(sj, ai), A, rigid)
-                phi[row] = _dt(ai, d)
-                gamma[row] = -quad
-                if k == 6:
-                    n = drv[row]
-                    phi[row] -= f[n]
-                    nu[row] = fd[n]
-                    gamma[row] += fdd[n]
-            else:  # angle driver
-                S, cS, qS, Sd = _dot1(A, w, bi, bj, v2[row], v3[row])
-                C, cC, qC, Cd = _dot1(A, w, bi, bj, v1[row], v3[row])
-                rho2 = S * S + C * C
-                N = C * Sd - S * Cd
-                Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
-                _put(Jc, row, 0, bi, zero, Jp, A, rigid)
-                _put(Jc, row, 1, bj, zero, _sc(-1.0, Jp), A, rigid)
-                quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
+        if k <= 2:
+            si = _mv(A, bi, v1[row])
+            sj = _mv(A, bj, v2[row])
+            ph = (r[bj, k] + sj[k] - r[bi, k] - si[k])
+            qd = _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k]
+            e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
+            # row k of skew(s): (s~)_k. = e_k x ... ; J_pi = s~_i row k, J_pj = -s~_j row k
+            ski = _cr(si, e)
+            skj = _cr(sj, e)
+            ski = (-ski[0], -ski[1], -ski[2])
+            _put(Jc, row, 0, bi, (-e[0], -e[1], -e[2]), ski, A, rigid)
+            _put(Jc, row, 1, bj, e, skj, A, rigid)
+            phi[row] = ph
+            gamma[row] = -qd
+        elif k == 3:
+            val, c, quad, _ = _dot1(A, w, bi, bj, v1[row], v2[row])
+            _put(Jc, row, 0, bi, zero, c, A, rigid)
+            _put(Jc, row, 1, bj, zero, _sc(-1.0, c), A, rigid)
+            phi[row] = val
+            gamma[row] = -quad
+        elif k == 4 or k == 6:
+            ai = _mv(A, bi, v1[row])
+            si = _mv(A, bi, v2[row])
+            sj = _mv(A, bj, v3[row])
+            d = _sub(_add((r[bj, 0], r[bj, 1], r[bj, 2]), sj), _add((r[bi, 0], r[bi, 1], r[bi, 2]), si))
+            dd = _sub(_add((rd[bj, 0], rd[bj, 1], rd[bj, 2]), _cr(wj, sj)),
+                      _add((rd[bi, 0], rd[bi, 1], rd[bi, 2]), _cr(wi, si)))
+            wai = _cr(wi, ai)
+            quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
+                    + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
+            _put(Jc, row, 0, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, rigid)
+            _put(Jc, row, 1, bj, ai, _cr(sj, ai), A, rigid)
+            phi[row] = _dt(ai, d)
+            gamma[row] = -quad
+            if k == 6:
                 n = drv[row]
-                dth = np.arctan2(S, C) - f[n]
-                phi[row] = (dth + np.pi) % (2.0 * np.pi) - np.pi
+                phi[row] -= f[n]
                 nu[row] = fd[n]
-                gamma[row] = -quad + fdd[n]
+                gamma[row] += fdd[n]
+        else:  # angle driver
+            S, cS, qS, Sd = _dot1(A, w, bi, bj, v2[row], v3[row])
+            C, cC, qC, Cd = _dot1(A, w, bi, bj, v1[row], v3[row])
+            rho2 = S * S + C * C
+            N = C * Sd - S * Cd
+            Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
+            _put(Jc, row, 0, bi, zero, Jp, A, rigid)
+            _put(Jc, row, 1, bj, zero, _sc(-1.0, Jp), A, rigid)
+            quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
+            n = drv[row]
+            dth = np.arctan2(S, C) - f[n]
+            phi[row] = (dth + np.pi) % (2.0 * np.pi) - np.pi
+            nu[row] = fd[n]
+            gamma[row] = -quad + fdd[n]
 
 
-if HAVE_NUMBA:
-    @njit(cache=True)
-    def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
-                          phi, J, nu, gamma):
-        """Fill phi, the dense J (nc, nv; zeroed by the caller), nu, gamma for every row."""
-        Jc = np.empty((kind.shape[0], 2, 6))
-        rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma)
-        scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
+@njit(cache=True)
+def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
+                      phi, J, nu, gamma):
+    """Fill phi, the dense J (nc, nv; zeroed by the caller), nu, gamma for every row."""
+    Jc = np.empty((kind.shape[0], 2, 6))
+    rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma)
+    scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
 
 
-if HAVE_NUMBA:
-    @njit(cache=True, _nrt=False)
-    def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
-        """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""
-        nf = r.shape[0]
-        for f in range(nf):
-            for c in range(3):
-                r[f, c] = 0.0
-                rd[f, c] = 0.0
-                w[f, c] = 0.0
-                for d in range(3):
-                    A[f, c, d] = 1.0 if c == d else 0.0
-        for k in range(r_idx.shape[0]):
-            for c in range(3):
-                r[k + 1, c] = q[r_idx[k, c]]
-                rd[k + 1, c] = v[rd_idx[k, c]]
-        for k in range(rigid_fid.shape[0]):
-            f = rigid_fid[k]
-            e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
-            n = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3)
-            e0, e1, e2, e3 = e0 / n, e1 / n, e2 / n, e3 / n
-            A[f, 0, 0] = e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3
-            A[f, 0, 1] = 2 * (e1 * e2 - e0 * e3)
-            A[f, 0, 2] = 2 * (e1 * e3 + e0 * e2)
-            A[f, 1, 0] = 2 * (e1 * e2 + e0 * e3)
-            A[f, 1, 1] = e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3
-            A[f, 1, 2] = 2 * (e2 * e3 - e0 * e1)
-            A[f, 2, 0] = 2 * (e1 * e3 - e0 * e2)
-            A[f, 2, 1] = 2 * (e2 * e3 + e0 * e1)
-            A[f, 2, 2] = e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3
-            for c in range(3):
-                w[f, c] = (A[f, c, 0] * v[w_idx[k, 0]] + A[f, c, 1] * v[w_idx[k, 1]]
-                           + A[f, c, 2] * v[w_idx[k, 2]])
+@njit(cache=True, _nrt=False)
+def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
+    """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""
+    nf = r.shape[0]
+    for f in range(nf):
+        for c in range(3):
+            r[f, c] = 0.0
+            rd[f, c] = 0.0
+            w[f, c] = 0.0
+            for d in range(3):
+                A[f, c, d] = 1.0 if c == d else 0.0
+    for k in range(r_idx.shape[0]):
+        for c in range(3):
+            r[k + 1, c] = q[r_idx[k, c]]
+            rd[k + 1, c] = v[rd_idx[k, c]]
+    for k in range(rigid_fid.shape[0]):
+        f = rigid_fid[k]
+        e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+        n = np.sqrt(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3)
+        e0, e1, e2, e3 = e0 / n, e1 / n, e2 / n, e3 / n
+        A[f, 0, 0] = e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3
+        A[f, 0, 1] = 2 * (e1 * e2 - e0 * e3)
+        A[f, 0, 2] = 2 * (e1 * e3 + e0 * e2)
+        A[f, 1, 0] = 2 * (e1 * e2 + e0 * e3)
+        A[f, 1, 1] = e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3
+        A[f, 1, 2] = 2 * (e2 * e3 - e0 * e1)
+        A[f, 2, 0] = 2 * (e1 * e3 - e0 * e2)
+        A[f, 2, 1] = 2 * (e2 * e3 + e0 * e1)
+        A[f, 2, 2] = e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3
+        for c in range(3):
+            w[f, c] = (A[f, c, 0] * v[w_idx[k, 0]] + A[f, c, 1] * v[w_idx[k, 1]]
+                       + A[f, c, 2] * v[w_idx[k, 2]])
 
-    @njit(cache=True)
-    def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
-        """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
-        r = np.zeros((nf, 3))
-        A = np.zeros((nf, 3, 3))
-        rd = np.zeros((nf, 3))
-        w = np.zeros((nf, 3))
-        frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
-        return r, A, rd, w
-
-
-if HAVE_NUMBA:
-    @njit(cache=True)
-    def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
-        """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) for body-axes rotation vectors."""
-        out = q.copy()
-        for k in range(r_idx.shape[0]):
-            for c in range(3):
-                out[r_idx[k, c]] += dx[rd_idx[k, c]]
-        for k in range(p_idx.shape[0]):
-            x, y, z = dx[w_idx[k, 0]], dx[w_idx[k, 1]], dx[w_idx[k, 2]]
-            ang = np.sqrt(x * x + y * y + z * z)
-            c0 = np.cos(0.5 * ang)
-            s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
-            b0, b1, b2, b3 = c0, s * x, s * y, s * z
-            a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
-            p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
-            p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
-            p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
-            p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
-            n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
-            out[p_idx[k, 0]], out[p_idx[k, 1]], out[p_idx[k, 2]], out[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
-        return out
+@njit(cache=True)
+def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
+    """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
+    r = np.zeros((nf, 3))
+    A = np.zeros((nf, 3, 3))
+    rd = np.zeros((nf, 3))
+    w = np.zeros((nf, 3))
+    frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
+    return r, A, rd, w
 
 
-if HAVE_NUMBA:
-    @njit(cache=True)
-    def qdot_kernel(q, v, r_idx, rd_idx, p_idx, w_idx, nq):
-        """dq/dt: rd for CM positions, pdot = 1/2 p (x) (0, w_B) for Euler parameters."""
-        qd = np.zeros(nq)
-        for k in range(r_idx.shape[0]):
-            for c in range(3):
-                qd[r_idx[k, c]] = v[rd_idx[k, c]]
-        for k in range(p_idx.shape[0]):
-            e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
-            x, y, z = v[w_idx[k, 0]], v[w_idx[k, 1]], v[w_idx[k, 2]]
-            qd[p_idx[k, 0]] = 0.5 * (-e1 * x - e2 * y - e3 * z)
-            qd[p_idx[k, 1]] = 0.5 * (e0 * x + e2 * z - e3 * y)
-            qd[p_idx[k, 2]] = 0.5 * (e0 * y - e1 * z + e3 * x)
-            qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
-        return qd
+@njit(cache=True)
+def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
+    """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) for body-axes rotation vectors."""
+    out = q.copy()
+    for k in range(r_idx.shape[0]):
+        for c in range(3):
+            out[r_idx[k, c]] += dx[rd_idx[k, c]]
+    for k in range(p_idx.shape[0]):
+        x, y, z = dx[w_idx[k, 0]], dx[w_idx[k, 1]], dx[w_idx[k, 2]]
+        ang = np.sqrt(x * x + y * y + z * z)
+        c0 = np.cos(0.5 * ang)
+        s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
+        b0, b1, b2, b3 = c0, s * x, s * y, s * z
+        a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+        p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
+        p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
+        p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
+        p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
+        n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+        out[p_idx[k, 0]], out[p_idx[k, 1]], out[p_idx[k, 2]], out[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
+    return out
 
 
-if HAVE_NUMBA:
-    @njit(cache=True)
-    def inertial_forces_kernel(A, w, mass, inertia_B, rd_idx, w_idx, rigid_fid, g, nv):
-        """Q (nv,) of gravity m g on every CM and the gyroscopic term -w_B x (J w_B) (body axes)."""
-        Q = np.zeros(nv)
-        for k in range(rd_idx.shape[0]):
-            for c in range(3):
-                Q[rd_idx[k, c]] += mass[k + 1] * g[c]
-        for k in range(rigid_fid.shape[0]):
-            f = rigid_fid[k]
-            wb = np.zeros(3)
-            for i in range(3):
-                wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
-            h = inertia_B[f] @ wb
-            Q[w_idx[k, 0]] -= wb[1] * h[2] - wb[2] * h[1]
-            Q[w_idx[k, 1]] -= wb[2] * h[0] - wb[0] * h[2]
-            Q[w_idx[k, 2]] -= wb[0] * h[1] - wb[1] * h[0]
-        return Q
+@njit(cache=True)
+def qdot_kernel(q, v, r_idx, rd_idx, p_idx, w_idx, nq):
+    """dq/dt: rd for CM positions, pdot = 1/2 p (x) (0, w_B) for Euler parameters."""
+    qd = np.zeros(nq)
+    for k in range(r_idx.shape[0]):
+        for c in range(3):
+            qd[r_idx[k, c]] = v[rd_idx[k, c]]
+    for k in range(p_idx.shape[0]):
+        e0, e1, e2, e3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+        x, y, z = v[w_idx[k, 0]], v[w_idx[k, 1]], v[w_idx[k, 2]]
+        qd[p_idx[k, 0]] = 0.5 * (-e1 * x - e2 * y - e3 * z)
+        qd[p_idx[k, 1]] = 0.5 * (e0 * x + e2 * z - e3 * y)
+        qd[p_idx[k, 2]] = 0.5 * (e0 * y - e1 * z + e3 * x)
+        qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
+    return qd
+
+
+@njit(cache=True)
+def inertial_forces_kernel(A, w, mass, inertia_B, rd_idx, w_idx, rigid_fid, g, nv):
+    """Q (nv,) of gravity m g on every CM and the gyroscopic term -w_B x (J w_B) (body axes)."""
+    Q = np.zeros(nv)
+    for k in range(rd_idx.shape[0]):
+        for c in range(3):
+            Q[rd_idx[k, c]] += mass[k + 1] * g[c]
+    for k in range(rigid_fid.shape[0]):
+        f = rigid_fid[k]
+        wb = np.zeros(3)
+        for i in range(3):
+            wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
+        h = inertia_B[f] @ wb
+        Q[w_idx[k, 0]] -= wb[1] * h[2] - wb[2] * h[1]
+        Q[w_idx[k, 1]] -= wb[2] * h[0] - wb[0] * h[2]
+        Q[w_idx[k, 2]] -= wb[0] * h[1] - wb[1] * h[0]
+    return Q
