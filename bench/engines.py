@@ -17,8 +17,26 @@ from problems import G, rz  # noqa: F401
 import mbdsim as mb
 
 
+def _free_slider_crank(p, model):
+    """Crank (revolute to ground), rod, slider (translational along x): a non-redundant joint set
+    (spherical at the crank pin, universal at the slider) so that no engine needs redundancy handling."""
+    (cc, rc, B), ph = p.positions(np.array(p.th0))
+    th, z = p.th0, (0, 0, 1)
+    rod_J = lambda L: (p.m * 0.02 ** 2 / 6, p.m * L * L / 12, p.m * L * L / 12)  # noqa: E731
+    crank = model.add_body("crank", p.m, inertia=rod_J(p.r), position=cc, orientation=rz(th))
+    rod = model.add_body("rod", p.m, inertia=rod_J(p.l), position=rc, orientation=rz(float(ph)))
+    slider = model.add_body("slider", p.m, inertia=(1e-3, 1e-3, 1e-3), position=B)
+    model.add_revolute("O", model.ground, crank, (0, 0, 0), z)
+    model.add_spherical("A", crank, rod, 2 * cc)
+    model.add_universal("B", rod, slider, B, axis_i=z, axis_j=(0, 1, 0))
+    model.add_translational("slide", model.ground, slider, B, (1, 0, 0))
+    return model, [crank, rod, slider]
+
+
 def mbdsim_model(p):
     model = mb.Model(p.key, gravity=(0.0, -G, 0.0))
+    if p.key == "slider_crank_free":
+        return _free_slider_crank(p, model)
     if p.key == "slider_crank":
         th, ph = p.angles(np.array(0.0))
         A = p.r * np.array([np.cos(th), np.sin(th), 0.0])
@@ -47,13 +65,16 @@ def mbdsim_model(p):
 
 
 def run_mbdsim(p, method, tol):
-    """method: 'hht', 'dop853' (tol = rtol, atol = 1e-2 rtol) or 'kinematics'."""
+    """method: 'auto' (the default: only rtol given), 'hht', 'dop853' (tol = rtol, atol = 1e-2 rtol) or
+    'kinematics'."""
     model, bodies = mbdsim_model(p)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         t0 = time.perf_counter()
         if method == "kinematics":
             res = mb.kinematics(model, p.t_end, output_step=p.out_dt)
+        elif method == "auto":
+            res = mb.simulate(model, p.t_end, output_step=p.out_dt, rtol=tol)
         else:
             res = mb.simulate(model, p.t_end, output_step=p.out_dt, method=method, rtol=tol, atol=tol * 1e-2)
         el = time.perf_counter() - t0
@@ -80,8 +101,29 @@ def _quat(R):
     return f"{w:.17g} {x:.17g} {y:.17g} {z:.17g}"
 
 
+def _mujoco_slider_crank_xml(p, dt):
+    """Crank and rod on hinges, slider on a slide joint, the loop closed by an equality `connect`
+    (MuJoCo's loop constraints are soft: solref time constant 2 dt, the stiffest it accepts)."""
+    (cc, rc, B), ph = p.positions(np.array(p.th0))
+    A = 2 * cc
+    Jr = lambda L: f"{p.m * 0.02 ** 2 / 6:.17g} {p.m * L * L / 12:.17g} {p.m * L * L / 12:.17g}"  # noqa: E731
+    return (f'<mujoco><option gravity="0 {-G} 0" integrator="RK4" timestep="{dt:.17g}">'
+            f'<flag contact="disable"/></option><worldbody>'
+            f'<body name="crank" quat="{_quat(rz(p.th0))}"><joint name="O" type="hinge" axis="0 0 1"/>'
+            f'<inertial pos="{p.r / 2:.17g} 0 0" mass="{p.m}" diaginertia="{Jr(p.r)}"/>'
+            f'<body name="rod" pos="{p.r:.17g} 0 0" quat="{_quat(rz(float(ph) - p.th0))}">'
+            f'<joint name="A" type="hinge" axis="0 0 1"/>'
+            f'<inertial pos="{p.l / 2:.17g} 0 0" mass="{p.m}" diaginertia="{Jr(p.l)}"/></body></body>'
+            f'<body name="slider" pos="{B[0]:.17g} 0 0"><joint name="s" type="slide" axis="1 0 0"/>'
+            f'<inertial pos="0 0 0" mass="{p.m}" diaginertia="1e-3 1e-3 1e-3"/></body></worldbody>'
+            f'<equality><connect body1="rod" body2="slider" anchor="{p.l:.17g} 0 0" '
+            f'solref="{2 * dt:.17g} 1"/></equality></mujoco>')
+
+
 def mujoco_xml(p, dt):
     """Same rods, same inertias; hinge (planar) or ball (chain) joints at each rod's start, minimal coords."""
+    if p.key == "slider_crank_free":
+        return _mujoco_slider_crank_xml(p, dt)
     kind = "ball" if p.key == "chain" else "hinge"
     body_xml, close, Rp, op = "", "", np.eye(3), np.zeros(3)
     for k, r in enumerate(p.rods):
@@ -114,7 +156,8 @@ def run_mujoco(p, dt):
     el = time.perf_counter() - t0
     # untimed post-processing: CM positions and energy at the samples
     e = mujoco.MjData(m)
-    cm, E = np.empty((n_out + 1, len(p.rods), 3)), np.empty(n_out + 1)
+    nb = m.nbody - 1
+    cm, E = np.empty((n_out + 1, nb, 3)), np.empty(n_out + 1)
     for k in range(n_out + 1):
         e.qpos[:], e.qvel[:] = qp[k], qv[k]
         mujoco.mj_forward(m, e)

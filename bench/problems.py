@@ -225,4 +225,112 @@ class SphericalChain(Problem):
         return ke + pe, ke
 
 
-PROBLEMS = {p.key: p for p in (RodPendulum(), DoublePendulum(), SliderCrank(), SphericalChain())}
+class PointPendulum(Problem):
+    """Issue 7: point mass 1 kg at 1 m on a massless rod, released horizontally, 10 s. The bob is a body of
+    1 kg with a tiny inertia (1e-6 kg m^2, a ~1.6 mm ball) so every engine can take it; the reference
+    includes that inertia exactly: theta'' = -m g a cos(theta) / (m a^2 + I)."""
+
+    key = "pendulum_point"
+    title = "point-mass pendulum (1 kg at 1 m), released horizontally, 10 s"
+    t_end, out_dt = 10.0, 0.01
+    a, m, I = 1.0, 1.0, 1e-6
+
+    def __init__(self):
+        rod = Rod((0, 0, 0), (1, 0, 0), 2 * self.a, self.m)
+        rod.J = np.array([self.I, self.I, self.I])
+        self.rods = [rod]
+        self.scale = self.a
+
+    def reference(self):
+        k = self.m * G * self.a / (self.m * self.a ** 2 + self.I)
+        s = solve_ivp(lambda t, y: [y[1], -k * np.cos(y[0])], (0, self.t_end), [0.0, 0.0], method="DOP853",
+                      rtol=1e-13, atol=1e-15, t_eval=self.times())
+        th = s.y[0]
+        return {"t": self.times(), "cm": self.a * np.stack([np.cos(th), np.sin(th), 0 * th], -1)[:, None, :]}
+
+
+class PlanarChain(Problem):
+    """Issue 7: N uniform rods (1 kg, 0.1 m) on revolute joints, first to ground, released horizontally, 1 s.
+    Reference: Pinocchio's articulated-body algorithm in joint coordinates (an independent formulation)
+    integrated by scipy's DOP853 at rtol 1e-12."""
+
+    t_end, out_dt = 1.0, 0.01
+    L, m = 0.1, 1.0
+
+    def __init__(self, n):
+        self.n = n
+        self.key = f"chain2d_{n}"
+        self.title = f"planar chain of {n} rods (1 kg, 0.1 m), released horizontally, 1 s"
+        self.rods = [Rod((k * self.L, 0, 0), (1, 0, 0), self.L, self.m) for k in range(n)]
+        self.scale = n * self.L
+
+    def reference(self):
+        import pinocchio as pin
+        model = pin.Model()
+        model.gravity.linear = np.array([0.0, -G, 0.0])
+        parent = 0
+        for k, r in enumerate(self.rods):
+            place = pin.SE3(np.eye(3), np.array([0.0 if k == 0 else self.L, 0.0, 0.0]))
+            parent = model.addJoint(parent, pin.JointModelRZ(), place, f"j{k}")
+            model.appendBodyToJoint(parent, pin.Inertia(r.m, np.array([self.L / 2, 0, 0]), np.diag(r.J)), pin.SE3.Identity())
+        data = model.createData()
+        n = self.n
+
+        def rhs(t, y):
+            return np.concatenate([y[n:], pin.aba(model, data, y[:n], y[n:], np.zeros(n))])
+
+        s = solve_ivp(rhs, (0, self.t_end), np.zeros(2 * n), method="DOP853", rtol=1e-12, atol=1e-12,
+                      t_eval=self.times())
+        cm = np.empty((len(s.t), n, 3))
+        for i in range(len(s.t)):
+            pin.forwardKinematics(model, data, s.y[:n, i])
+            for k in range(n):
+                cm[i, k] = data.oMi[k + 1].act(np.array([self.L / 2, 0, 0]))
+        return {"t": self.times(), "cm": cm}
+
+
+class FreeSliderCrank(Problem):
+    """Issue 7: slider-crank under gravity, free (not driven): crank 0.1 m and rod 0.3 m (uniform, 1 kg
+    each), slider 1 kg, released from rest with the crank at 60 deg, 2 s. Reference: the one-DOF Lagrange
+    equation J(th) th'' + J'(th) th'^2 / 2 + V'(th) = 0 (J' and V' by complex step), scipy DOP853 1e-12."""
+
+    key = "slider_crank_free"
+    title = "slider-crank under gravity, free, released at 60 deg, 2 s"
+    t_end, out_dt = 2.0, 0.01
+    r, l, m = 0.1, 0.3, 1.0
+    th0 = np.pi / 3
+
+    def __init__(self):
+        self.scale = self.r + self.l
+
+    def positions(self, th):
+        """Crank CM, rod CM and slider positions (N, 3, 3) and the rod angle for crank angles th."""
+        r, l = self.r, self.l
+        s = np.sqrt(l * l - (r * np.sin(th)) ** 2)
+        A = np.stack([r * np.cos(th), r * np.sin(th), 0 * th], -1)
+        B = np.stack([r * np.cos(th) + s, 0 * th, 0 * th], -1)
+        return np.stack([A / 2, (A + B) / 2, B], -2), np.arctan2(-r * np.sin(th), s)
+
+    def _J(self, th):
+        r, l, m = self.r, self.l, self.m
+        s = np.sqrt(l * l - (r * np.sin(th)) ** 2)
+        ds = -r * r * np.sin(th) * np.cos(th) / s
+        dx = -r * np.sin(th) + ds
+        dphi = (s * (-r * np.cos(th)) + r * np.sin(th) * ds) / (l * l)
+        gx, gy = 0.5 * (-r * np.sin(th) + dx), 0.5 * r * np.cos(th)
+        return m * r * r / 3 + m * (gx * gx + gy * gy) + m * l * l / 12 * dphi ** 2 + m * dx ** 2
+
+    def reference(self):
+        V = lambda th: G * self.m * self.r * np.sin(th)  # noqa: E731   crank CM and rod CM at r sin(th) / 2
+        cs = lambda f, th: f(th + 1e-30j).imag / 1e-30  # noqa: E731
+
+        def rhs(t, y):
+            return [y[1], -(0.5 * cs(self._J, y[0]) * y[1] ** 2 + cs(V, y[0])) / self._J(y[0])]
+
+        s = solve_ivp(rhs, (0, self.t_end), [self.th0, 0.0], method="DOP853", rtol=1e-12, atol=1e-14,
+                      t_eval=self.times())
+        return {"t": self.times(), "cm": self.positions(s.y[0])[0]}
+
+
+ISSUE7 = (PointPendulum(), FreeSliderCrank(), *(PlanarChain(n) for n in (2, 8, 32, 128)))
+PROBLEMS = {p.key: p for p in (RodPendulum(), DoublePendulum(), SliderCrank(), SphericalChain(), *ISSUE7)}

@@ -32,8 +32,10 @@ import numpy as np  # noqa: E402
 import engines as E  # noqa: E402
 from problems import PROBLEMS  # noqa: E402
 
-TARGETS = (1e-4, 1e-7)
-MBDSIM_DEFAULT = {"hht": 1e-5, "dop853": 1e-10}      # mbdsim's default rtol per method
+TARGETS = (1e-4, 1e-6, 1e-8)
+MBDSIM_DEFAULT = {"hht": 1e-5, "dop853": 1e-10, "auto": 1e-8}      # mbdsim's default rtol per method
+ISSUE7_KEYS = ("pendulum_point", "slider_crank_free", "chain2d_2", "chain2d_8", "chain2d_32", "chain2d_128",
+               "chain")
 
 
 # --------------------------------------------------------------------------- sweeps
@@ -43,6 +45,16 @@ def sweeps(key, quick):
     n_out = int(round(p.t_end / p.out_dt))
     if key == "slider_crank":      # fully driven: the error is the Newton tolerance for every setting
         return {"mbdsim-kinematics": [None], "mbdsim-hht": [1e-3, 1e-5], "mbdsim-dop853": [1e-6, 1e-10]}
+    if key in ISSUE7_KEYS and key != "chain":
+        big = key in ("chain2d_32", "chain2d_128")
+        auto = [1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
+        mj = ([2, 5, 10, 20, 50] if big else [1, 2, 5, 10, 20, 50, 100]) if quick else \
+            ([1, 2, 5, 10, 20, 50, 100] if big else [1, 2, 5, 10, 20, 50, 100, 200, 500])
+        ex = [] if key in ("slider_crank_free", "chain2d_128") else ([1, 2, 5, 10] if quick else [1, 2, 5, 10, 20, 50])
+        return {"mbdsim-auto": auto, "mbdsim-dop853": auto,
+                "mbdsim-hht": [] if big or quick else [1e-4, 1e-5, 1e-6],
+                "mujoco-rk4": [p.out_dt / k for k in mj] if E.mujoco else [],
+                "exudyn-genalpha": [n_out * k for k in ex] if E.exu else []}
     hht = [1e-3, 1e-4, 1e-5, 1e-6] if quick else [1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7]
     dop = [1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
     sub = [1, 2, 5, 10, 20, 50, 100] if quick else [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000]
@@ -121,9 +133,11 @@ def fmt_t(t, how):
 
 
 # --------------------------------------------------------------------------- references
-def prepare_references(quick, log):
+def prepare_references(quick, log, keys=None):
     out = {}
     for key, p in PROBLEMS.items():
+        if keys is not None and key not in keys:
+            continue
         if key == "chain":
             tol = 1e-11 if quick else 1e-12
             el, traj, info = E.run_mbdsim(p, "dop853", tol)
@@ -145,6 +159,13 @@ def prepare_references(quick, log):
         elif key == "pendulum":
             out[key] = {"reference": "scipy solve_ivp DOP853 rtol 1e-13 of theta'' = -(3g/2L) cos theta",
                         **{k: float(v) for k, v in p.ref["check"].items()}}
+        elif key.startswith("chain2d"):
+            p.ref
+            out[key] = {"reference": "Pinocchio ABA (joint coordinates) + scipy DOP853 rtol 1e-12"}
+        elif key == "pendulum_point":
+            out[key] = {"reference": "scipy DOP853 rtol 1e-13 of theta'' = -m g a cos(theta) / (m a^2 + I)"}
+        elif key == "slider_crank_free":
+            out[key] = {"reference": "one-DOF Lagrange equation (complex-step J', V') + scipy DOP853 rtol 1e-12"}
         else:
             out[key] = {"reference": "closed form (loop closure x = r cos th + l cos ph, sin ph = -r sin th / l)"}
         log(f"  reference {key}: " + ", ".join(f"{k}={v:.3g}" if isinstance(v, float) else f"{k}={v}"
@@ -167,10 +188,11 @@ def warm_up():
         try:
             E.run_mbdsim(p, "kinematics" if key == "slider_crank" else "hht", 1e-4)
             if key != "slider_crank":
+                E.run_mbdsim(p, "auto", 1e-6)
                 E.run_mbdsim(p, "dop853", 1e-6)
                 if E.mujoco:
                     E.run_mujoco(p, p.out_dt / 2)
-                if E.exu:
+                if E.exu and key != "slider_crank_free":
                     E.run_exudyn(p, 4)
         finally:
             p.t_end = te
@@ -202,7 +224,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="shorter sweeps (about 1-2 minutes)")
     ap.add_argument("--profile", action="store_true", help="cProfile two mbdsim runs")
-    ap.add_argument("--only", nargs="*", default=None, help="problem keys to run")
+    ap.add_argument("--only", nargs="*", default=None, help="problem keys to run ('scaling': the N table)")
     ap.add_argument("--out", default=os.path.join(HERE, "results.json"))
     args = ap.parse_args()
     warnings.simplefilter("ignore")
@@ -229,10 +251,10 @@ def main():
         f"exudyn {env['exudyn']}, pychrono: {env['pychrono']}")
     warm_up()
     log("references:")
-    refs = prepare_references(args.quick, log)
     keys = args.only or list(PROBLEMS)
+    refs = prepare_references(args.quick, log, keys)
     results = {"environment": env, "targets": list(TARGETS), "problems": {}}
-    for key in keys:
+    for key in [k for k in keys if k in PROBLEMS]:
         p = PROBLEMS[key]
         log(f"\n=== {key}: {p.title}\n    error = {p.measure}")
         rows = {}
@@ -254,6 +276,12 @@ def main():
         print_summary(key, results["problems"][key], log)
     if args.profile:
         results["profile"] = profile(log)
+    if not args.only or "scaling" in args.only:
+        import scaling
+        results["scaling"] = scaling.scaling_table(args.quick, log)
+        results["startup"] = scaling.startup(log)
+    import report
+    report.write(results, HERE, log)
     results["total_runtime_s"] = time.perf_counter() - t_start
     log(f"\ntotal runtime {results['total_runtime_s']:.1f} s")
     with open(args.out, "w") as f:
@@ -321,14 +349,15 @@ def print_summary(key, s, log):
     log(f"\n  {key}: time to reach the error target (interpolated on the Pareto front; <= upper bound; "
         "~* extrapolated)")
     hd = s.get("hht_default_error")
-    head = f"  {'engine':18s} {'default run':>22s} {'t@1e-4':>11s} {'t@1e-7':>11s}"
+    head = f"  {'engine':18s} {'default run':>22s} {'t@1e-4':>11s} {'t@1e-6':>11s} {'t@1e-8':>11s}"
     if hd:
         head += f" {'t@' + format(hd, '.1e'):>12s}"
     log(head)
     for engine, d in s["engines"].items():
         dft = d.get("default")
         dtxt = f"{dft['time_s']:.3g}s/{dft['error']:.1e}" if dft else "-"
-        row = f"  {engine:18s} {dtxt:>22s} {fmt_t(*d['time_at_0.0001']):>11s} {fmt_t(*d['time_at_1e-07']):>11s}"
+        row = (f"  {engine:18s} {dtxt:>22s} {fmt_t(*d['time_at_0.0001']):>11s} {fmt_t(*d['time_at_1e-06']):>11s}"
+               f" {fmt_t(*d['time_at_1e-08']):>11s}")
         if hd:
             row += f" {fmt_t(*d['time_at_hht_default_error']):>12s}"
         log(row)

@@ -1,0 +1,70 @@
+"""Cost against model size (planar chains N = 2..512) and start-up times, measured in this run."""
+from __future__ import annotations
+
+import subprocess
+import sys
+import time
+import warnings
+
+import numpy as np
+
+import engines as E
+from problems import PlanarChain
+
+SIZES = (2, 8, 32, 128, 512)
+RTOL = 1e-6            # mbdsim's default method, only rtol given
+MUJOCO_DT = 1e-3       # MuJoCo RK4, fixed step, for comparison
+
+
+def _best(f, reps):
+    out = [f() for _ in range(reps)]
+    return min(out, key=lambda x: x[0])
+
+
+def scaling_table(quick, log):
+    """Wall time per simulated second of the N-rod chain (1 s, output every 0.01 s)."""
+    log("\nscaling: planar chain of N rods, 1 s simulated, mbdsim default method rtol 1e-6; MuJoCo RK4 dt 1e-3")
+    rows = []
+    for n in (SIZES[:-1] if quick else SIZES):
+        p = PlanarChain(n)
+        reps = 3 if n <= 32 else 1
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            t_mb, _, info = _best(lambda: E.run_mbdsim(p, "auto", RTOL), reps)
+            t_mj = _best(lambda: E.run_mujoco(p, MUJOCO_DT), reps)[0] if E.mujoco else None
+        rows.append({"n": n, "mbdsim_s": t_mb, "mbdsim_steps": info.get("steps"), "mujoco_s": t_mj})
+    base = rows[0]["mbdsim_s"]
+    for r in rows:
+        r["mbdsim_ratio_to_n2"] = r["mbdsim_s"] / base
+        log(f"  N={r['n']:4d}  mbdsim {r['mbdsim_s']:8.4f} s ({r['mbdsim_ratio_to_n2']:7.1f}x N=2, "
+            f"{r['mbdsim_steps']} steps)  mujoco {r['mujoco_s'] if r['mujoco_s'] is None else round(r['mujoco_s'], 4)} s")
+    return rows
+
+
+_FIRST = """
+import time
+t0 = time.perf_counter()
+import mbdsim as mb
+t1 = time.perf_counter()
+m = mb.Model("p", gravity=(0, -9.81, 0))
+b = m.add_body("b", 1.0, inertia=(1e-3, 1 / 12, 1 / 12), position=(0.5, 0, 0))
+m.add_revolute("j", m.ground, b, (0, 0, 0), (0, 0, 1))
+mb.simulate(m, 1.0)
+print(t1 - t0, time.perf_counter() - t1)
+"""
+
+
+def startup(log):
+    """`import mbdsim` and the first simulate of a new model in a fresh process (numba cache warm), best of 3;
+    `mbdsim validate` (all 30 cases) wall time."""
+    runs = []
+    for _ in range(3):
+        out = subprocess.run([sys.executable, "-c", _FIRST], capture_output=True, text=True, check=True)
+        runs.append(tuple(float(x) for x in out.stdout.split()))
+    imp, first = min(r[0] for r in runs), min(r[1] for r in runs)
+    t0 = time.perf_counter()
+    subprocess.run([sys.executable, "-m", "mbdsim", "validate", "--no-report"], capture_output=True, check=False)
+    val = time.perf_counter() - t0
+    log(f"\nstart-up: import mbdsim {imp:.3f} s, first simulate in a fresh process {first:.3f} s, "
+        f"mbdsim validate (30 cases) {val:.1f} s")
+    return {"import_s": imp, "first_simulate_s": first, "validate_s": val}
