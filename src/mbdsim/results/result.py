@@ -13,6 +13,8 @@ import scipy.optimize as so
 from ..errors import ModelError
 from ..model.joints import Joint
 from ..system import measures as ms
+from . import joints as jm
+from . import kinematics as kin
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
 
@@ -75,128 +77,106 @@ class Result:
         return out
 
     # ------------------------------------------------------------ points and bodies
+    # A target or frame is a Body (its CM), a Marker, or the name of one: "rod", "rod.tip".
     def position(self, target, frame=None):
-        """Position [m] of a body's CM or a marker origin (N, 3)."""
+        """Position [m] (N, 3) of a body's CM or a marker origin; in ground, or measured from `frame`'s
+        origin and expressed in its axes."""
         return ms.position(self.system, self.frames, target, frame)
 
-    def velocity(self, target, frame=None):
-        """Absolute velocity [m/s] (N, 3), in ground axes or expressed in `frame` axes."""
-        return ms.express(self.system, self.frames, ms.point_kinematics(self.system, self.frames, target)[1], frame)
+    def velocity(self, target, frame=None, relative_to=None):
+        """Velocity [m/s] (N, 3) of a body's CM or a marker origin, in ground axes or `frame` axes.
 
-    def acceleration(self, target, frame=None):
-        """Absolute acceleration [m/s^2] (N, 3), in ground axes or expressed in `frame` axes."""
+        Absolute by default; with `relative_to=f` the time derivative, taken in frame f, of the position
+        relative to f's origin (Adams VX(i, j, k, l) with j = l = f, k = frame):
+        v = v_rel + v_O + w_f x rho (see mbdsim.results.kinematics)."""
+        if relative_to is None:
+            v = ms.point_kinematics(self.system, self.frames, target)[1]
+        else:
+            v = kin.relative_point_motion(self.system, self.frames, target, relative_to).v_rel
+        return self._express(v, frame)
+
+    def acceleration(self, target, frame=None, relative_to=None):
+        """Acceleration [m/s^2] (N, 3) of a body's CM or a marker origin, in ground axes or `frame` axes.
+
+        Absolute by default; with `relative_to=f` the second derivative taken in frame f, so that
+        a = a_rel + a_transport + 2 w_f x v_rel (Coriolis); see mbdsim.results.kinematics."""
         self._need_acc("acceleration")
-        return ms.express(self.system, self.frames, ms.point_kinematics(self.system, self.frames, target)[2], frame)
+        if relative_to is None:
+            a = ms.point_kinematics(self.system, self.frames, target)[2]
+        else:
+            a = kin.relative_point_motion(self.system, self.frames, target, relative_to).a_rel
+        return self._express(a, frame)
 
-    def orientation(self, body):
-        """Rotation matrices body->ground (N, 3, 3)."""
-        return self.frames.A[:, ms.locate(self.system, body)[0]]
+    def orientation(self, target):
+        """Rotation matrices (N, 3, 3) mapping the axes of `target` to ground: the body's orientation
+        times the marker's (a body name or Body gives the body's own axes)."""
+        return kin.orientation(self.system, self.frames, target)
 
-    def angular_velocity(self, body, frame=None):
-        """Angular velocity [rad/s] (N, 3) of a body, ground axes or `frame` axes."""
-        return ms.express(self.system, self.frames, self.frames.w[:, ms.locate(self.system, body)[0]], frame)
+    def rotation(self, target):
+        """`scipy.spatial.transform.Rotation` stack (N rotations) of `orientation(target)`: use its
+        as_quat() (scalar last), as_euler(seq) (any sequence), as_rotvec(), as_matrix()."""
+        from scipy.spatial.transform import Rotation
+        return Rotation.from_matrix(self.orientation(target))
 
-    def angular_acceleration(self, body, frame=None):
-        """Angular acceleration [rad/s^2] (N, 3), ground axes or `frame` axes."""
+    def angular_velocity(self, target, frame=None, relative_to=None):
+        """Angular velocity [rad/s] (N, 3) of the body of `target` (a marker stands for its body), in
+        ground or `frame` axes; with `relative_to=f`, w - w_f."""
+        if relative_to is None:
+            w = self.frames.w[:, ms.locate(self.system, target)[0]]
+        else:
+            w = kin.relative_angular_motion(self.system, self.frames, target, relative_to)[0]
+        return self._express(w, frame)
+
+    def angular_acceleration(self, target, frame=None, relative_to=None):
+        """Angular acceleration [rad/s^2] (N, 3), in ground or `frame` axes; with `relative_to=f` the
+        derivative, taken in f, of w - w_f: alpha - alpha_f - w_f x (w - w_f)."""
         self._need_acc("angular_acceleration")
-        return ms.express(self.system, self.frames, self.frames.alpha[:, ms.locate(self.system, body)[0]], frame)
+        if relative_to is None:
+            al = self.frames.alpha[:, ms.locate(self.system, target)[0]]
+        else:
+            al = kin.relative_angular_motion(self.system, self.frames, target, relative_to)[1]
+        return self._express(al, frame)
+
+    def _express(self, vec, frame):
+        return ms.express(self.system, self.frames, vec, frame)
 
     def _need_acc(self, what):
         if self.vd is None:
             raise ValueError(f"{what} is not available: this result holds no accelerations")
 
-    # ------------------------------------------------------------ joints
+    # ------------------------------------------------------------ joints (see mbdsim.results.joints)
     def _joint(self, joint) -> Joint:
-        if isinstance(joint, str):
-            joint = self.system.model.joints.get(joint, joint)
-        if not isinstance(joint, Joint) or joint.name not in self.system.geoms:
-            raise ModelError(f"joint {getattr(joint, 'name', joint)!r}", "joint", "is not a joint of the analysed model")
-        return joint
+        return jm.joint_of(self, joint)
 
-    def _coord(self, joint):
-        ang, angd, sl, sld = ms.joint_coordinate(self.system, self.frames, self._joint(joint))
-        if ang is not None:
-            if self._parent is None:
-                ref = _angle_anchor(self.system, self._joint(joint), self.time)
-                if ref is not None:   # a torsion spring / stop on the joint continued the angle in the run
-                    ang = ref + (ang - ref + np.pi) % (2 * np.pi) - np.pi
-                ang = _unwrap_with_rate(self.time, ang, angd)
-            else:  # continue the parent's unwrapped history from its nearest sample
-                p = self._parent
-                p_ang, p_rate = p._coord(joint)[:2]
-                k = np.clip(np.searchsorted(p.time, self.time), 0, len(p.time) - 1)
-                prev = np.maximum(k - 1, 0)
-                k = np.where(np.abs(p.time[prev] - self.time) < np.abs(p.time[k] - self.time), prev, k)
-                ref = p_ang[k] + 0.5 * (p_rate[k] + angd) * (self.time - p.time[k])
-                ang = ref + (ang - ref + np.pi) % (2 * np.pi) - np.pi
-        return ang, angd, sl, sld
+    def joint_coordinate(self, joint, kind=None):
+        """Joint coordinate, zero in the built configuration, continuous in time (N,) or (N, k):
+        revolute angle [rad], translational slide [m], cylindrical [angle, slide], planar [u, v, angle]
+        (u, v [m] along the plane axes of `add_planar`, angle [rad] about the normal); spherical,
+        universal, fixed: rotation vector [rad] (N, 3) of body_j relative to its initial attitude, body_i
+        axes.  `kind="angles"` (universal joints): the yoke angles [angle1, angle2] [rad] (angle1 of the
+        cross about axis_i relative to body_i, angle2 of body_j about axis_j relative to the cross)."""
+        return jm.coordinate(self, joint, kind)
 
-    def joint_coordinate(self, joint):
-        """Relative angle [rad] or displacement [m] of body_j w.r.t. body_i, unwrapped; (N, 2) [angle, slide]
-        for a cylindrical joint; (N, 3) [u, v along the plane axes, angle] for a planar joint; for
-        spherical, universal and fixed joints the rotation vector [rad] (N, 3) of j relative to its initial
-        attitude, in body_i axes."""
-        jt = self._joint(joint)
-        if jt.kind in ROTATION_JOINTS:
-            return ms.relative_rotation_vector(self.system, self.frames, jt)
-        if jt.kind == "planar":
-            return ms.planar_coordinates(self.system, self.frames, jt)[0]
-        ang, _, sl, _ = self._coord(joint)
-        return _pick(ang, sl)
-
-    def joint_velocity(self, joint):
+    def joint_velocity(self, joint, kind=None):
         """Rate of the joint coordinate [rad/s or m/s]; for spherical, universal and fixed joints the
-        angular velocity of j relative to i [rad/s] in body_i axes."""
-        jt = self._joint(joint)
-        if jt.kind in ROTATION_JOINTS:
-            return ms.relative_angular_velocity(self.system, self.frames, jt)[0]
-        if jt.kind == "planar":
-            return ms.planar_coordinates(self.system, self.frames, jt)[1]
-        _, angd, _, sld = self._coord(joint)
-        return _pick(angd, sld)
+        angular velocity of j relative to i [rad/s] in body_i axes; `kind="angles"`: yoke angle rates."""
+        return jm.velocity(self, joint, kind)
 
-    def joint_acceleration(self, joint):
-        """Second derivative of the joint coordinate [rad/s^2 or m/s^2]; for spherical, universal and fixed
-        joints the time derivative, in body_i axes, of the relative angular velocity [rad/s^2]."""
+    def joint_acceleration(self, joint, kind=None):
+        """Second derivative of the joint coordinate [rad/s^2 or m/s^2] (planar: [u'', v'', angle''];
+        spherical, universal, fixed: the derivative, in body_i axes, of the relative angular velocity;
+        `kind="angles"`: yoke angle accelerations)."""
         self._need_acc("joint_acceleration")
-        jt = self._joint(joint)
-        if jt.kind in ROTATION_JOINTS:
-            return ms.relative_angular_velocity(self.system, self.frames, jt)[1]
-        if jt.kind == "planar":
-            raise ModelError(f"joint '{jt.name}'", "joint", "joint_acceleration of a planar joint is not "
-                             "available; use acceleration()/angular_acceleration() of its bodies")
-        g = self.system.geoms[jt.name]
-        fr = self.frames
-        rel_acc_rot = fr.alpha[:, g.bj] - fr.alpha[:, g.bi]
-        h = np.einsum("nij,j->ni", fr.A[:, g.bi], g.h_i)
-        ang = sl = None
-        if jt.kind in ("revolute", "cylindrical") and not g.particle_j:
-            # d/dt (h . (w_j - w_i)) = h . (alpha_j - alpha_i) + (w_i x h) . (w_j - w_i)
-            dw = fr.w[:, g.bj] - fr.w[:, g.bi]
-            ang = np.einsum("ni,ni->n", h, rel_acc_rot) + np.einsum("ni,ni->n", np.cross(fr.w[:, g.bi], h), dw)
-        if jt.kind in ("translational", "cylindrical"):
-            sl = self._slide_acc(g, fr, h)
-        return _pick(ang, sl)
-
-    def _slide_acc(self, g, fr, h):
-        si = np.einsum("nij,j->ni", fr.A[:, g.bi], g.s_i)
-        sj = np.einsum("nij,j->ni", fr.A[:, g.bj], g.s_j)
-        wi, wj = fr.w[:, g.bi], fr.w[:, g.bj]
-        d = fr.r[:, g.bj] + sj - fr.r[:, g.bi] - si
-        dd = fr.rd[:, g.bj] + np.cross(wj, sj) - fr.rd[:, g.bi] - np.cross(wi, si)
-        ddd = (fr.rdd[:, g.bj] + np.cross(fr.alpha[:, g.bj], sj) + np.cross(wj, np.cross(wj, sj))
-               - fr.rdd[:, g.bi] - np.cross(fr.alpha[:, g.bi], si) - np.cross(wi, np.cross(wi, si)))
-        hd = np.cross(wi, h)
-        hdd = np.cross(fr.alpha[:, g.bi], h) + np.cross(wi, hd)
-        dot = lambda a, b: np.einsum("ni,ni->n", a, b)  # noqa: E731
-        return dot(hdd, d) + 2 * dot(hd, dd) + dot(h, ddd)
+        return jm.acceleration(self, joint, kind)
 
     def reaction_force(self, joint, on=None, frame=None):
-        """Force [N] (N, 3) the joint exerts on body `on` (default body_j), ground or `frame` axes."""
+        """Force [N] (N, 3) the joint exerts on body `on` (a body, marker or name; default body_j), in
+        ground or `frame` axes."""
         return self._reaction(joint, on, frame)[0]
 
     def reaction_torque(self, joint, on=None, frame=None):
-        """Torque [N m] (N, 3) the joint exerts on body `on`, reduced to the joint point."""
+        """Torque [N m] (N, 3) the joint exerts on body `on`, reduced to the joint point, in ground or
+        `frame` axes."""
         return self._reaction(joint, on, frame)[1]
 
     def _reaction(self, joint, on, frame):
@@ -204,8 +184,16 @@ class Result:
         if self.lambda_ is None:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
-        F, T = joint_reaction(self.system, self.q, self.lambda_, jt, on)
-        return (ms.express(self.system, self.frames, F, frame), ms.express(self.system, self.frames, T, frame))
+        body = None if on is None else ms.resolve_body(self.system, on)
+        F, T = joint_reaction(self.system, self.q, self.lambda_, jt, body)
+        return self._express(F, frame), self._express(T, frame)
+
+    def driver_effort(self, motion):
+        """Effort [N m for a rotation, N for a translation] (N,) of a motion driver: the torque about /
+        force along the driven joint axis that the driver applies to body_j."""
+        if self.lambda_ is None:
+            raise ValueError("driver efforts are not available: this result holds no multipliers")
+        return jm.driver_effort(self, motion)
 
     # ------------------------------------------------------------ springs and energy
     def _element(self, spring):
@@ -318,36 +306,6 @@ class Result:
         """Tidy pandas DataFrame: time and each body's position/velocity, joint coordinates; units in names."""
         from .export import to_dataframe
         return to_dataframe(self)
-
-
-def _angle_anchor(system, joint, times):
-    """The angle references (N,) recorded during the analysis by a force element on `joint` (torsion
-    spring, rotational stop), or None."""
-    from ..system.force_elements._common import _ref, element_state
-    for e in system.model.forces.values():
-        if getattr(e, "joint", None) is joint and element_state(system, e.name).get("angle_ref"):
-            return _ref(system, e.name, times)
-    return None
-
-
-def _unwrap_with_rate(t, ang, rate):
-    """Continue wrapped angles (N,) beyond +-pi: each increment is the one closest to the trapezoidal
-    prediction from the rates, so more than pi per output step is followed (np.unwrap is not)."""
-    if len(ang) < 2:
-        return ang
-    pred = 0.5 * (rate[1:] + rate[:-1]) * np.diff(t)
-    inc = pred + (np.diff(ang) - pred + np.pi) % (2 * np.pi) - np.pi
-    cont = ang[0] + np.concatenate([[0.0], np.cumsum(inc)])
-    return ang + 2 * np.pi * np.round((cont - ang) / (2 * np.pi))   # the raw values, shifted by whole turns
-
-
-ROTATION_JOINTS = ("spherical", "universal", "fixed")
-
-
-def _pick(ang, sl):
-    if ang is not None and sl is not None:
-        return np.stack([ang, sl], -1)
-    return ang if ang is not None else sl
 
 
 def _dir_ok(y, k, direction):

@@ -14,17 +14,35 @@ from .constraints import primitives as pr
 from .frames import Frames
 
 
+def resolve(sys, target):
+    """The Body or Marker that `target` names: a Body, a Marker, a body name or a "body.marker" name."""
+    if isinstance(target, (Body, Marker)):
+        return target
+    if isinstance(target, str):
+        bodies = sys.model.bodies
+        if target in bodies:
+            return bodies[target]
+        body, dot, marker = target.rpartition(".")
+        if dot and body in bodies and marker in bodies[body].markers:
+            return bodies[body].markers[marker]
+        raise ModelError(f"measure target {target!r}", "target", "no body or \"body.marker\" of this name in "
+                         "the model")
+    raise ModelError(f"measure target {target!r}", "target", "expected a Body, particle or Marker of the model, "
+                     "or the name of one (\"rod\", \"rod.tip\")")
+
+
+def resolve_body(sys, target):
+    """The Body of a Body, Marker or name (a marker stands for the body it is fixed on)."""
+    x = resolve(sys, target)
+    return x.body if isinstance(x, Marker) else x
+
+
 def locate(sys, target):
-    """(frame index, s_B, R_BM) of a Body (its CM) or Marker."""
+    """(frame index, s_B, R_BM) of a Body (its CM) or Marker, or of the body / "body.marker" so named."""
+    target = resolve(sys, target)
     if isinstance(target, Marker):
         return sys.fid[_known(sys, target.body)], target.s_B, target.R_BM
-    if isinstance(target, Body):
-        return sys.fid[_known(sys, target)], np.zeros(3), np.eye(3)
-    if isinstance(target, str):
-        for b in sys.fid:
-            if b.name == target:
-                return sys.fid[b], np.zeros(3), np.eye(3)
-    raise ModelError(f"measure target {target!r}", "target", "expected a Body, particle or Marker of the model")
+    return sys.fid[_known(sys, target)], np.zeros(3), np.eye(3)
 
 
 def _known(sys, body):
