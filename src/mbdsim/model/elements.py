@@ -73,7 +73,8 @@ class ForceElementsMixin:
         lower/upper [m or rad] (None: open), in the coordinates of Result.joint_coordinate (0 at the
         initial configuration); stiffness [N/m^e or N m/rad^e] > 0 (required), exponent e > 0,
         damping c_max [N s/m or N m s/rad] >= 0 reached at `penetration` [m or rad] > 0.
-        `dof` picks "rotation" or "translation" on a cylindrical joint (default "translation")."""
+        `dof` picks "rotation" or "translation" on a cylindrical joint (default "rotation", as for every
+        call that takes `dof=`, see Model.add_cylindrical)."""
         entity = f"stop '{name}'"
         jt = self._element_joint(entity, joint)
         dof = self._stop_dof(entity, jt, dof)
@@ -105,7 +106,7 @@ class ForceElementsMixin:
 
     def _stop_dof(self, entity, jt, dof):
         allowed = {"revolute": ("rotation",), "translational": ("translation",),
-                   "cylindrical": ("translation", "rotation")}
+                   "cylindrical": ("rotation", "translation")}   # the first is the default dof
         if jt.kind not in allowed:
             raise ModelError(entity, "joint", f"needs a translational, revolute or cylindrical joint, "
                              f"{jt.name!r} is {jt.kind}")

@@ -20,7 +20,8 @@ class Joint:
     """A joint between body_i and body_j; `point` [m] and `axis` (unit) in ground at t=0.
 
     body_j moves relative to body_i.  For a universal joint `axis` is the axis fixed on body_i and
-    `axis_j` the one fixed on body_j; for a planar joint `axis` is the plane normal.
+    `axis_j` the one fixed on body_j; for a planar joint `axis` is the plane normal and `u_axis` the
+    in-plane u axis (v = normal x u), fixed on body_i.
     """
 
     name: str
@@ -30,6 +31,7 @@ class Joint:
     point: np.ndarray
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     axis_j: np.ndarray | None = None
+    u_axis: np.ndarray | None = None
 
     @property
     def dof(self) -> int:

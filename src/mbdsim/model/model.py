@@ -62,7 +62,10 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         return self._joint(name, "translational", body_i, body_j, point, axis)
 
     def add_cylindrical(self, name, body_i, body_j, point, axis) -> Joint:
-        """Cylindrical joint: rotation about and sliding along `axis` through `point` (ground, t=0)."""
+        """Cylindrical joint: rotation about and sliding along `axis` through `point` (ground, t=0).
+
+        Its coordinates are (angle [rad], slide [m]); every call that takes `dof=` on it (add_motion,
+        add_stop, ...) picks "rotation" or "translation" and defaults to "rotation"."""
         return self._joint(name, "cylindrical", body_i, body_j, point, axis)
 
     def add_spherical(self, name, body_i, body_j, point) -> Joint:
@@ -79,9 +82,25 @@ class Model(ForceElementsMixin, FrictionPathMixin):
             raise ModelError(f"joint '{name}'", "axis_j", "must be perpendicular to axis_i at t=0")
         return j
 
-    def add_planar(self, name, body_i, body_j, point, normal) -> Joint:
-        """Planar joint: body_j moves in the plane through `point` with `normal` fixed on body_i."""
-        return self._joint(name, "planar", body_i, body_j, point, normal)
+    def add_planar(self, name, body_i, body_j, point, normal, u_axis=None) -> Joint:
+        """Planar joint: body_j moves in the plane through `point` with `normal` fixed on body_i.
+
+        Its coordinates (Result.joint_coordinate) are [u, v, angle]: the joint point of body_j along the
+        in-plane axes u and v = normal x u [m] and the rotation about the normal [rad], all fixed on
+        body_i and zero as built.  `u_axis` (ground, t=0) must be perpendicular to the normal; the
+        default is the ground x axis projected onto the plane, or the ground y axis projected when the
+        normal is within about 26 deg of x (|normal . x| > 0.9): normal +z gives u = +x, v = +y."""
+        j = self._joint(name, "planar", body_i, body_j, point, normal)
+        try:
+            u = None if u_axis is None else vec3(f"joint '{name}'", "u_axis", u_axis, unit=True)
+            if u is not None and abs(float(u @ j.axis)) > 1e-9:
+                raise ModelError(f"joint '{name}'", "u_axis", "must be perpendicular to the normal")
+        except ModelError:
+            del self.joints[name]
+            self._names.discard(name)
+            raise
+        j.u_axis = _default_u_axis(j.axis) if u is None else u
+        return j
 
     def add_fixed(self, name, body_i, body_j, point=None) -> Joint:
         """Fixed joint welding body_j to body_i (at `point`, default body_j's CM)."""
@@ -96,8 +115,8 @@ class Model(ForceElementsMixin, FrictionPathMixin):
 
         Give exactly one of displacement, velocity (with initial_displacement) or acceleration (with
         initial_displacement and initial_velocity): a callable of t, a number or an expression string
-        in t (safe whitelist parser, never eval'd).  `dof` picks "rotation" or "translation" on a
-        cylindrical joint; other one-DOF joints drive their only coordinate.
+        in t (safe whitelist parser, never eval'd).  `dof` picks "rotation" (the default) or "translation"
+        on a cylindrical joint; other one-DOF joints drive their only coordinate.
         """
         from ..expressions import double_integrated, integrated, time_function
 
@@ -265,3 +284,10 @@ class Model(ForceElementsMixin, FrictionPathMixin):
     def __repr__(self) -> str:
         return (f"Model({self.name!r}: {len(self.bodies) - 1} bodies, {len(self.joints)} joints, "
                 f"{len(self.motions)} motions, {len(self.forces)} forces)")
+
+
+def _default_u_axis(normal) -> np.ndarray:
+    """In-plane u axis of a planar joint: ground x projected onto the plane (ground y when |n . x| > 0.9)."""
+    e = np.eye(3)[1 if abs(normal[0]) > 0.9 else 0]
+    u = e - (e @ normal) * normal
+    return u / np.linalg.norm(u)

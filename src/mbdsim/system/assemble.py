@@ -125,6 +125,8 @@ def joint_geometry(joint, fid) -> JointGeom:
     """Joint point and axes expressed on each of its bodies at t=0."""
     bi, bj = joint.body_i, joint.body_j
     f, g, h = perpendicular_frame(joint.axis)
+    if joint.kind == "planar" and joint.u_axis is not None:   # the user's / documented in-plane axes
+        f, g = joint.u_axis, np.cross(joint.axis, joint.u_axis)
     Ai, Aj = bi.orientation, bj.orientation
     loc = lambda A, x: A.T @ x  # noqa: E731
     extra = None if joint.axis_j is None else loc(Aj, joint.axis_j)
