@@ -56,12 +56,13 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
 
 
 @njit(cache=True, _nrt=False)
-def write_output(cm, wk, t, y, yout, vdout, lamout):
-    """Accelerations and multipliers at a consistent state y into the output rows; status."""
+def write_output(cm, wk, t, y, yout, vdout, lamout, refactor=True):
+    """Accelerations and multipliers at a consistent state y into the output rows; status.
+    refactor=False right after `project` at this y (its factorisation is reused)."""
     nq = cm[31][0]
     for i in range(y.shape[0]):
         yout[i] = y[i]
-    return accelerations(cm, wk, t, y[:nq], y[nq:], vdout, lamout)
+    return accelerations(cm, wk, t, y[:nq], y[nq:], vdout, lamout, refactor)
 
 
 @njit(cache=True, _nrt=False)
@@ -195,7 +196,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
                 if s_ != OK:
                     st[0], st[1] = t, h
                     return s_, iout
-                s_ = write_output(cm, wk, to, yo, Y[iout], VD[iout], LAM[iout])
+                s_ = write_output(cm, wk, to, yo, Y[iout], VD[iout], LAM[iout], False)
                 if s_ != OK:
                     st[0], st[1] = t, h
                     return s_, iout
@@ -208,7 +209,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
         if s_ != OK:
             st[0], st[1] = t, h
             return s_, iout
-        s_ = rhs(cm, wk, t_new, y, f)
+        s_ = rhs(cm, wk, t_new, y, f, False)   # the projection's factorisation is at these positions
         stats[2] += 1
         for i in range(n):
             if not np.isfinite(y[i]):

@@ -278,13 +278,15 @@ def _solve(cm, wk, F, c_rows, x6, lam):
 
 
 @njit(cache=True, _nrt=False)
-def accelerations(cm, wk, t, q, v, vd, lam):
-    """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status."""
+def accelerations(cm, wk, t, q, v, vd, lam, refactor=True):
+    """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status.
+    refactor=False reuses the factorisation in wk, valid when it was made at these positions q (the
+    factorisation depends on q only), e.g. right after `project`."""
     _constraints(cm, wk, t, q, v)
     F = wk[8]
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     loads_into(cm, wk, r, A, rd, w, F)
-    if not _factor(cm, wk):
+    if refactor and not _factor(cm, wk):
         return SINGULAR
     x6 = wk[25]
     for i in range(lam.shape[0]):
@@ -342,12 +344,13 @@ def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
 
 
 @njit(cache=True, _nrt=False)
-def rhs(cm, wk, t, y, ydot):
-    """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded)."""
+def rhs(cm, wk, t, y, ydot, refactor=True):
+    """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded). refactor=False:
+    as in `accelerations`."""
     nq = cm[31][0]
     q = y[:nq]
     v = y[nq:]
-    st = accelerations(cm, wk, t, q, v, ydot[nq:], wk[26])
+    st = accelerations(cm, wk, t, q, v, ydot[nq:], wk[26], refactor)
     qdot_into(cm, q, v, ydot[:nq])
     return st
 
@@ -399,18 +402,17 @@ def normalize_kernel(p_idx, q):
 
 @njit(cache=True, _nrt=False)
 def project(cm, wk, t, q, v, tol):
-    """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu."""
+    """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu.
+    Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`)."""
     active = cm[32]
-    x6, zero6, vz, lam, c = wk[25], wk[27], wk[28], wk[26], wk[29]
+    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
     normalize_into(cm, q)
-    for i in range(vz.shape[0]):
-        vz[i] = 0.0
     for f in range(zero6.shape[0]):
         for k in range(6):
             zero6[f, k] = 0.0
     ok = False
     for it in range(12):
-        _constraints(cm, wk, t, q, vz)
+        _constraints(cm, wk, t, q, v)   # phi and the Jacobian do not depend on v; nu, gamma are at (q, v)
         res = 0.0
         for i in range(active.shape[0]):
             res = max(res, abs(wk[4][active[i]]))
@@ -425,8 +427,7 @@ def project(cm, wk, t, q, v, tol):
         increment_into(cm, q, x6)
     if not ok:
         return PROJECTION
-    # velocities: v <- v + dv with M dv + J^T mu = 0, J dv = nu - J v (same factorisation: q unchanged)
-    _constraints(cm, wk, t, q, v)
+    # velocities: v <- v + dv with M dv + J^T mu = 0, J dv = nu - J v, at the rows just evaluated
     if not _factor(cm, wk):
         return SINGULAR
     v6 = wk[30]
