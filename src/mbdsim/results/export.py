@@ -1,53 +1,154 @@
-"""Export of a Result to a pandas DataFrame: one row per output time, SI units in the column names.
+"""Export of a Result to a pandas DataFrame (and .parquet / .csv): one row per output time.
 
-Columns: "time [s]"; per body or particle (ground axes) "<body>.x [m]", ".y", ".z", "<body>.vx [m/s]",
-".vy", ".vz", and for rigid bodies "<body>.wx [rad/s]", ".wy", ".wz"; per joint with a coordinate
-"<joint>.angle [rad]" (revolute, cylindrical) and/or "<joint>.displacement [m]" (translational,
-cylindrical), each with its rate "<joint>.angle_rate [rad/s]" / "<joint>.displacement_rate [m/s]".
+Column names are "<entity>.<quantity> [<SI unit>]" (ground axes unless stated), "[-]" for pure numbers:
+
+time            "time [s]"
+bodies          "<body>.x [m]" .y .z (centre of mass); rigid bodies "<body>.qw [-]" .qx .qy .qz (Euler
+                parameters, body -> ground, scalar first, qw >= 0 at the first sample and continuous in
+                time); with `euler="ZYX"` (any scipy sequence, upper case intrinsic, lower case extrinsic)
+                "<body>.ZYX_1 [rad]" _2 _3 (continuous in time); "<body>.vx [m/s]" .vy .vz; rigid
+                "<body>.wx [rad/s]" .wy .wz; with accelerations "<body>.ax [m/s^2]" .ay .az and rigid
+                "<body>.alphax [rad/s^2]" .alphay .alphaz
+markers         with `markers=True`, for every marker of every body, "<body>.<marker>.x [m]" .y .z,
+                rigid "<body>.<marker>.qw [-]" .qx .qy .qz, "<body>.<marker>.vx [m/s]" ..., and
+                "<body>.<marker>.ax [m/s^2]" ... (its angular motion is its body's)
+joints          coordinates and rates as Result.joint_coordinate / joint_velocity:
+                revolute "<joint>.angle [rad]", "<joint>.angle_rate [rad/s]";
+                translational "<joint>.displacement [m]", "<joint>.displacement_rate [m/s]";
+                cylindrical both; planar "<joint>.u [m]" .v .angle with "_rate" columns;
+                spherical, universal, fixed "<joint>.rx [rad]" .ry .rz (rotation vector, body_i axes) and
+                "<joint>.wx [rad/s]" .wy .wz (relative angular velocity, body_i axes); universal also
+                "<joint>.angle1 [rad]" .angle2 (yoke angles) and their "_rate" columns.  Angles of a
+                particle body_j (which has none) are left out.  With multipliers, the reaction on body_j
+                "<joint>.Fx [N]" .Fy .Fz and "<joint>.Tx [N m]" .Ty .Tz (about the joint point).
+drivers         "<motion>.effort [N m]" (rotation) or "[N]" (translation), Result.driver_effort
+force elements  "<element>.force [N]" (spring-damper, translational stop, contact: Result.spring_force;
+                translational joint friction) or "<element>.torque [N m]" (torsion spring, rotational
+                stop, revolute joint friction); bushings "<element>.Fx [N]" ... "<element>.Tz [N m]", the
+                load on marker_j's body in marker_i axes.  Applied forces and torques are inputs and
+                are not repeated.
 """
 from __future__ import annotations
 
 import numpy as np
 
+from ..model.body import Marker
 
-def _body_columns(res, body):
+_XYZ = "xyz"
+
+
+def _vec(cols, prefix, data, unit):
+    for k, axis in enumerate(_XYZ):
+        cols[f"{prefix}{axis} [{unit}]"] = data[:, k]
+
+
+def _quaternions(R):
+    """Euler parameters (N, 4), scalar first, continuous in time (sign of the first sample: qw >= 0)."""
+    from scipy.spatial.transform import Rotation
+    x = Rotation.from_matrix(R).as_quat()
+    q = np.concatenate([x[:, 3:], x[:, :3]], axis=1)
+    flip = np.concatenate([[q[0, 0] < 0], np.einsum("ni,ni->n", q[1:], q[:-1]) < 0])
+    return q * np.where(np.logical_xor.accumulate(flip), -1.0, 1.0)[:, None]
+
+
+def _frame_columns(res, target, name, rigid, euler):
     cols = {}
-    for key, data, unit in (("", res.position(body), "m"), ("v", res.velocity(body), "m/s")):
-        for k, axis in enumerate("xyz"):
-            cols[f"{body.name}.{key}{axis} [{unit}]"] = data[:, k]
-    if not body.is_particle:
-        w = res.angular_velocity(body)
-        for k, axis in enumerate("xyz"):
-            cols[f"{body.name}.w{axis} [rad/s]"] = w[:, k]
+    _vec(cols, f"{name}.", res.position(target), "m")
+    if rigid:
+        R = res.orientation(target)
+        q = _quaternions(R)
+        for k, c in enumerate("wxyz"):
+            cols[f"{name}.q{c} [-]"] = q[:, k]
+        if euler:
+            ang = np.unwrap(res.rotation(target).as_euler(euler), axis=0)
+            for k in range(3):
+                cols[f"{name}.{euler}_{k + 1} [rad]"] = ang[:, k]
+    _vec(cols, f"{name}.v", res.velocity(target), "m/s")
+    if rigid and not isinstance(target, Marker):
+        _vec(cols, f"{name}.w", res.angular_velocity(target), "rad/s")
+    if res.vd is not None:
+        _vec(cols, f"{name}.a", res.acceleration(target), "m/s^2")
+        if rigid and not isinstance(target, Marker):
+            _vec(cols, f"{name}.alpha", res.angular_acceleration(target), "rad/s^2")
     return cols
+
+
+_ONE_AXIS = {"revolute": (("angle", "rad"),), "translational": (("displacement", "m"),),
+             "cylindrical": (("angle", "rad"), ("displacement", "m")),
+             "planar": (("u", "m"), ("v", "m"), ("angle", "rad"))}
 
 
 def _joint_columns(res, joint):
-    kinds = {"revolute": ("angle",), "translational": ("displacement",),
-             "cylindrical": ("angle", "displacement")}.get(joint.kind, ())
-    if joint.body_j.is_particle:
-        kinds = tuple(k for k in kinds if k != "angle")
-    if not kinds:
-        return {}
-    x, xd = np.asarray(res.joint_coordinate(joint)), np.asarray(res.joint_velocity(joint))
-    if len(kinds) == 1 and x.ndim == 2:        # cylindrical joint on a particle: keep the slide column
-        x, xd = x[:, 1], xd[:, 1]
-    x, xd = x.reshape(len(res.time), -1), xd.reshape(len(res.time), -1)
-    units = {"angle": "rad", "displacement": "m"}
     cols = {}
-    for k, name in enumerate(kinds):
-        cols[f"{joint.name}.{name} [{units[name]}]"] = x[:, k]
-        cols[f"{joint.name}.{name}_rate [{units[name]}/s]"] = xd[:, k]
+    particle_j = joint.body_j.is_particle
+    if joint.kind in _ONE_AXIS:
+        names = _ONE_AXIS[joint.kind]
+        x = np.asarray(res.joint_coordinate(joint)).reshape(len(res.time), -1)
+        xd = np.asarray(res.joint_velocity(joint)).reshape(len(res.time), -1)
+        for k, (q, unit) in enumerate(names):
+            if particle_j and unit == "rad":
+                continue
+            kk = min(k, x.shape[1] - 1)          # a cylindrical joint on a particle has its slide only
+            cols[f"{joint.name}.{q} [{unit}]"] = x[:, kk]
+            cols[f"{joint.name}.{q}_rate [{unit}/s]"] = xd[:, kk]
+    elif not particle_j:                        # spherical, universal, fixed
+        _vec(cols, f"{joint.name}.r", res.joint_coordinate(joint), "rad")
+        _vec(cols, f"{joint.name}.w", res.joint_velocity(joint), "rad/s")
+        if joint.kind == "universal":
+            ang, rate = res.joint_coordinate(joint, kind="angles"), res.joint_velocity(joint, kind="angles")
+            for k in range(2):
+                cols[f"{joint.name}.angle{k + 1} [rad]"] = ang[:, k]
+                cols[f"{joint.name}.angle{k + 1}_rate [rad/s]"] = rate[:, k]
+    if res.lambda_ is not None:
+        _vec(cols, f"{joint.name}.F", res.reaction_force(joint), "N")
+        _vec(cols, f"{joint.name}.T", res.reaction_torque(joint), "N m")
     return cols
 
 
-def to_dataframe(res):
-    """Tidy (wide) pandas DataFrame of a Result: time, body positions/velocities, joint coordinates."""
+def _element_columns(res, el):
+    from ..model.element_specs import Bushing, Stop, TorsionSpring
+    from ..model.friction_path import JointFriction
+    from ..system.force_elements import evaluator
+    name = el.name
+    if isinstance(el, Bushing):
+        from ..system.force_elements.bushing import bushing_loads, bushing_state
+        F, T = bushing_loads(el, *bushing_state(res.system, res.frames, el)[:4])
+        cols = {}
+        _vec(cols, f"{name}.F", F, "N")
+        _vec(cols, f"{name}.T", T, "N m")
+        return cols
+    if isinstance(el, JointFriction):
+        if res.lambda_ is None:
+            return {}
+        torque = el.joint.kind == "revolute"
+        return {f"{name}.{'torque [N m]' if torque else 'force [N]'}": res.friction_force(el)}
+    try:
+        ev = evaluator(el)
+    except TypeError:
+        return {}
+    if not hasattr(ev, "tension"):
+        return {}
+    torque = isinstance(el, TorsionSpring) or (isinstance(el, Stop) and el.dof == "rotation")
+    return {f"{name}.{'torque [N m]' if torque else 'force [N]'}": res.spring_force(el)}
+
+
+def to_dataframe(res, markers=False, euler=None):
+    """Wide pandas DataFrame of a Result (columns: see the module docstring), SI units in the names."""
     import pandas as pd
 
     cols = {"time [s]": np.asarray(res.time, dtype=float)}
     for body in res.system.bodies:
-        cols.update(_body_columns(res, body))
-    for joint in res.system.model.joints.values():
+        cols.update(_frame_columns(res, body, body.name, not body.is_particle, euler))
+    if markers:
+        for body in res.system.bodies:
+            for mk in body.markers.values():
+                cols.update(_frame_columns(res, mk, f"{body.name}.{mk.name}", not body.is_particle, euler))
+    model = res.system.model
+    for joint in model.joints.values():
         cols.update(_joint_columns(res, joint))
+    if res.lambda_ is not None:
+        for m in model.motions.values():
+            cols[f"{m.name}.effort [{'N m' if m.dof == 'rotation' else 'N'}]"] = res.driver_effort(m)
+    for el in model.forces.values():
+        cols.update(_element_columns(res, el))
     return pd.DataFrame(cols)

@@ -256,18 +256,24 @@ class Result:
 
     # ------------------------------------------------------------ events and extrema
     def crossings(self, signal, value, direction=0):
-        """Times [s] where signal(res) crosses value (direction +1 rising, -1 falling, 0 both), refined with at()."""
+        """Times [s] where signal(res) (N,) reaches `value`: direction +1 rising, -1 falling, 0 both.
+
+        A sign change between two samples is refined on the dense output (brentq on `at()`); a sample
+        exactly at the level counts when the signal arrives there (the first sample of a run at the
+        level, the last sample of the result included), the direction being that of the values around
+        the run.  Convention at the start: a signal that starts at the level has not crossed it, so
+        t = res.time[0] is never a crossing (note that scipy's solve_ivp events do report t0 then)."""
         y = np.asarray(signal(self), dtype=float) - value
         out = []
         for k in range(len(y) - 1):
             a, b = y[k], y[k + 1]
-            if a == 0.0 and (k == 0 or y[k - 1] != 0.0) and _dir_ok(y, k, direction):
+            if a == 0.0 and k > 0 and y[k - 1] != 0.0 and _dir_ok(y, k, direction):
                 out.append(self.time[k])
                 continue
             if a * b < 0 and (direction == 0 or np.sign(b - a) == np.sign(direction)):
                 f = lambda t: float(np.asarray(signal(self.at(t)))[0]) - value  # noqa: E731
                 out.append(so.brentq(f, self.time[k], self.time[k + 1], xtol=1e-14, rtol=1e-15, maxiter=200))
-        if len(y) and y[-1] == 0.0:
+        if len(y) > 1 and y[-1] == 0.0 and y[-2] != 0.0 and (direction == 0 or np.sign(-y[-2]) == np.sign(direction)):
             out.append(self.time[-1])
         return np.array(sorted(set(out)))
 
@@ -302,18 +308,32 @@ class Result:
         return (t, val) if better else (float(self.time[k]), float(sign * y[k]))
 
     # ------------------------------------------------------------ export
-    def to_dataframe(self):
-        """Tidy pandas DataFrame: time and each body's position/velocity, joint coordinates; units in names."""
+    def to_dataframe(self, markers=False, euler=None):
+        """Wide pandas DataFrame, one row per output time, SI units in the column names
+        ("crank.x [m]", "pin.angle [rad]", "pin.Fx [N]"): body positions, orientations (Euler parameters
+        "<body>.qw [-]" ..., and Euler angles "<body>.ZYX_1 [rad]" ... when `euler` names a scipy
+        sequence), velocities, accelerations; every joint's coordinates, rates and reactions; driver
+        efforts; force-element forces; marker columns when `markers=True`.  The naming is listed in
+        full in `mbdsim.results.export`."""
         from .export import to_dataframe
-        return to_dataframe(self)
+        return to_dataframe(self, markers=markers, euler=euler)
+
+    def to_parquet(self, path, markers=False, euler=None):
+        """Write `to_dataframe(markers, euler)` to a Parquet file (pyarrow); read back with pandas."""
+        self.to_dataframe(markers=markers, euler=euler).to_parquet(path, index=False)
+
+    def to_csv(self, path, markers=False, euler=None):
+        """Write `to_dataframe(markers, euler)` to a CSV file (header = column names, no index)."""
+        self.to_dataframe(markers=markers, euler=euler).to_csv(path, index=False)
 
 
 def _dir_ok(y, k, direction):
+    """Whether the run at the level starting at sample k (k > 0) goes in `direction`."""
     if direction == 0:
         return True
-    prev = y[k - 1] if k > 0 else 0.0
-    nxt = y[k + 1]
-    return np.sign(nxt - prev) == np.sign(direction)
+    nz = np.flatnonzero(y[k + 1:])
+    nxt = y[k + 1 + nz[0]] if len(nz) else 0.0
+    return np.sign(nxt - y[k - 1]) == np.sign(direction) or (nxt == 0.0 and np.sign(-y[k - 1]) == np.sign(direction))
 
 
 def _spring(res, el):
