@@ -100,8 +100,9 @@ def _joint_columns(res, joint):
                 cols[f"{joint.name}.angle{k + 1} [rad]"] = ang[:, k]
                 cols[f"{joint.name}.angle{k + 1}_rate [rad/s]"] = rate[:, k]
     if res.lambda_ is not None:
-        _vec(cols, f"{joint.name}.F", res.reaction_force(joint), "N")
-        _vec(cols, f"{joint.name}.T", res.reaction_torque(joint), "N m")
+        F, T = res._reaction(joint, None, None)   # noqa: SLF001 - force and torque in one pass
+        _vec(cols, f"{joint.name}.F", F, "N")
+        _vec(cols, f"{joint.name}.T", T, "N m")
     return cols
 
 

@@ -14,8 +14,9 @@ from .constraints import primitives as pr
 from .frames import Frames
 
 
-def resolve(sys, target):
-    """The Body or Marker that `target` names: a Body, a Marker, a body name or a "body.marker" name."""
+def resolve(sys, target, field="target"):
+    """The Body or Marker that `target` names: a Body, a Marker, a body name or a "body.marker" name
+    (else ModelError naming the argument `field`)."""
     if isinstance(target, (Body, Marker)):
         return target
     if isinstance(target, str):
@@ -25,21 +26,21 @@ def resolve(sys, target):
         body, dot, marker = target.rpartition(".")
         if dot and body in bodies and marker in bodies[body].markers:
             return bodies[body].markers[marker]
-        raise ModelError(f"measure target {target!r}", "target", "no body or \"body.marker\" of this name in "
+        raise ModelError(f"measure target {target!r}", field, "no body or \"body.marker\" of this name in "
                          "the model")
-    raise ModelError(f"measure target {target!r}", "target", "expected a Body, particle or Marker of the model, "
+    raise ModelError(f"measure target {target!r}", field, "expected a Body, particle or Marker of the model, "
                      "or the name of one (\"rod\", \"rod.tip\")")
 
 
-def resolve_body(sys, target):
+def resolve_body(sys, target, field="target"):
     """The Body of a Body, Marker or name (a marker stands for the body it is fixed on)."""
-    x = resolve(sys, target)
+    x = resolve(sys, target, field)
     return x.body if isinstance(x, Marker) else x
 
 
-def locate(sys, target):
+def locate(sys, target, field="target"):
     """(frame index, s_B, R_BM) of a Body (its CM) or Marker, or of the body / "body.marker" so named."""
-    target = resolve(sys, target)
+    target = resolve(sys, target, field)
     if isinstance(target, Marker):
         return sys.fid[_known(sys, target.body)], target.s_B, target.R_BM
     return sys.fid[_known(sys, target)], np.zeros(3), np.eye(3)
@@ -55,7 +56,7 @@ def frame_rotation(sys, fr: Frames, frame):
     """Rotation (N, 3, 3) frame->ground of a Body/Marker (identity for None)."""
     if frame is None:
         return None
-    fid, _, R_BM = locate(sys, frame)
+    fid, _, R_BM = locate(sys, frame, "frame")
     return fr.A[:, fid] @ R_BM
 
 
