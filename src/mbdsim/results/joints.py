@@ -53,32 +53,26 @@ def _check_kind(jt, kind):
 # ----------------------------------------------------------------------------- public entry points
 def coordinate(res, joint, kind=None):
     """Joint coordinate(s), see the module docstring: (N,) or (N, k)."""
-    jt = joint_of(res, joint)
-    _check_kind(jt, kind)
-    if kind == "angles":
-        return yoke_angles(res, jt)[0]
-    if jt.kind in ROTATION_JOINTS:
-        psi, axis, _ = rotation_coordinate(res, jt)
-        return psi[:, None] * axis
-    if jt.kind == "planar":
-        x, _ = planar(res, jt)
-        return x
-    ang, _, sl, _ = one_axis(res, jt)
-    return _pick(ang, sl)
+    return _values(res, joint, kind)[0]
 
 
 def velocity(res, joint, kind=None):
     """Rate(s) of the joint coordinate(s) [rad/s, m/s]; relative angular velocity for rotation joints."""
+    return _values(res, joint, kind)[1]
+
+
+def _values(res, joint, kind):
     jt = joint_of(res, joint)
     _check_kind(jt, kind)
     if kind == "angles":
-        return yoke_angles(res, jt)[1]
+        return yoke_angles(res, jt)
     if jt.kind in ROTATION_JOINTS:
-        return ms.relative_angular_velocity(res.system, res.frames, jt)[0]
+        psi, axis, _ = rotation_coordinate(res, jt)
+        return psi[:, None] * axis, ms.relative_angular_velocity(res.system, res.frames, jt)[0]
     if jt.kind == "planar":
-        return ms.planar_coordinates(res.system, res.frames, jt)[1]
-    _, angd, _, sld = ms.joint_coordinate(res.system, res.frames, jt)
-    return _pick(angd, sld)
+        return planar(res, jt)
+    ang, angd, sl, sld = one_axis(res, jt)
+    return _pick(ang, sl), _pick(angd, sld)
 
 
 def acceleration(res, joint, kind=None):
