@@ -188,6 +188,18 @@ def test_spherical_joint_spinning_past_pi_has_a_continuous_coordinate():
     np.testing.assert_allclose(sub.joint_coordinate(s), 50.0 * sub.time[:, None] * n, atol=1e-8)
 
 
+def test_universal_joint_spinning_about_its_second_axis_is_continuous():
+    """A free body on a universal joint spinning about axis_j (z) at 50 rad/s, sampled every 0.1 s."""
+    m = mb.Model("spinner")
+    b = m.add_body("b", 1.0, (0.2, 0.2, 0.1), angular_velocity=(0, 0, 50.0))
+    u = m.add_universal("u", m.ground, b, (0, 0, 0), (1, 0, 0), (0, 0, 1))
+    res = mb.simulate(m, 1.0, 0.1, **TIGHT)
+    t = res.time
+    np.testing.assert_allclose(res.joint_coordinate(u), np.outer(50 * t, (0, 0, 1)), atol=1e-8)
+    np.testing.assert_allclose(res.joint_coordinate(u, kind="angles"), np.stack([0 * t, 50 * t], -1), atol=1e-8)
+    np.testing.assert_allclose(res.joint_velocity(u, kind="angles")[-1], (0, 50), atol=1e-8)
+
+
 def tumbling_top():
     m = mb.Model("tumble")
     b = m.add_body("body", 1.0, (1.0, 2.0, 3.0), angular_velocity=(4.0, 0.3, 2.0))   # torque-free tumbling
@@ -230,6 +242,7 @@ def test_universal_joint_yoke_angles_decompose_the_relative_rotation():
     R_rel = np.einsum("nji,njk->nik", Ri, Rj)                # initial relative attitude is the identity
     np.testing.assert_allclose(rot((0, 1, 0), ang[:, 0]) @ rot((0, 0, 1), ang[:, 1]), R_rel, atol=1e-10)
     assert np.ptp(ang[:, 0]) > 0.5                            # the cross swings in the input yoke
+    np.testing.assert_allclose(Rotation.from_rotvec(res.joint_coordinate(u)).as_matrix(), R_rel, atol=1e-10)
     # rates and accelerations against the dense output (central differences)
     h = 1e-5
     for tk in (0.7, 2.3):
