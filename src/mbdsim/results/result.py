@@ -153,7 +153,7 @@ class Result:
         revolute angle [rad], translational slide [m], cylindrical [angle, slide], planar [u, v, angle]
         (u, v [m] along the plane axes of `add_planar`, angle [rad] about the normal); spherical,
         universal, fixed: rotation vector [rad] (N, 3) of body_j relative to its initial attitude, body_i
-        axes.  `kind="angles"` (universal joints): the yoke angles [angle1, angle2] [rad] (angle1 of the
+        axes.  `kind="angles"` (universal joints): the yoke angles (angle1, angle2) [rad] (angle1 of the
         cross about axis_i relative to body_i, angle2 of body_j about axis_j relative to the cross)."""
         return jm.coordinate(self, joint, kind)
 
