@@ -1,10 +1,30 @@
-"""Static equilibrium: Q(q) - phi_q^T lambda_ = 0 with phi(q) = 0 and zero velocities.
+"""Static equilibrium and quasi-static analysis: Q(q, t) - phi_q^T lambda_ = 0 with phi(q, t) = 0, v = 0.
 
-Newton iteration on (dx, lambda_) with the stiffness d(Q)/dx by central differences on the
-configuration manifold (dx: CM translations [m] and body-axes rotations [rad]); a backtracking line
-search on the residual norm keeps it robust from far-off starts.
+The equilibrium is sought in independent coordinates z of the constraint manifold (`reduced.Chart`,
+translations scaled by the model's length L so that z is dimensionless). The unbalanced load is the
+reduced force f(z) = N^T (Q - phi_q^T lambda_) (least-squares multipliers), which equals -dV/dz when the
+loads have a potential V; K = -df/dz is the reduced tangent stiffness (central differences, step 1e-6).
+
+Globalisation: a trust-region Newton method on V. Each step minimises the quadratic model
+-f.dz + dz.K_s.dz/2 (K_s: symmetric part of K) within |dz| <= Delta (Levenberg-Marquardt shift
+mu >= max(0, -lambda_min(K_s)), Moré-Sorensen hard case along the most negative curvature), so it moves
+downhill even where K is singular (a pendulum started horizontal) or indefinite (near the top).
+The decrease of V is measured without V itself, as the work of the loads along the step (Simpson's rule
+on f at dz/2 and dz), so follower loads and constant torques are handled too; the ratio of actual to
+predicted decrease sets Delta (0.25 / 0.75 rule, Delta <= 1). Should the radius collapse (loads without a
+potential that fool the work measure) the iteration continues as pseudo-transient continuation, the
+implicit Euler steps (K + I / tau) dz = f of the overdamped flow dz/dtau = f with tau growing as the
+residual falls (switched evolution relaxation).
+
+Stability: at the solution the eigenvalues of K_s classify it: all positive, stable; a negative one,
+unstable; zeros, neutral (indeterminate along those directions). A start that is already an unstable
+equilibrium (the pendulum exactly upright) is returned as it is, flagged unstable, with an
+`UnstableEquilibriumWarning` naming the directions; any other start descends to a stable one.
 """
 from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -15,77 +35,272 @@ from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .assembly import assemble_state
-from .common import increment
+from .common import project_positions
+from .reduced import Chart, describe_direction, length_scale, tangent_basis, tangent_residual, velocity_scale
 from .state import state_factory
+
+DELTA_MAX = 1.0     # largest trust radius: 1 rad of rotation or L of translation per step
+FD_STEP = 1e-6      # central-difference step of the reduced stiffness (dimensionless z)
+
+
+class UnstableEquilibriumWarning(UserWarning):
+    """The equilibrium found is unstable (a direction of negative stiffness)."""
+
+
+@dataclass
+class StaticSolution:
+    """One equilibrium: coordinates, multipliers (all nc rows), iterations and stability."""
+
+    t: float
+    q: np.ndarray
+    lam: np.ndarray
+    iterations: int
+    method: str
+    stiffness: np.ndarray               # eigenvalues of K_s [N m per unit z^2], ascending
+    unstable: list = field(default_factory=list)   # descriptions of the negative-stiffness directions
+    neutral: list = field(default_factory=list)    # descriptions of the zero-stiffness directions
+
+    @property
+    def stable(self) -> bool:
+        return not self.unstable
 
 
 def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
-    """Static equilibrium at time t [s]: a single-time Result (velocities and accelerations zero)."""
+    """Static equilibrium at time t [s] (motions at their value at t, velocities zero).
+
+    Starts from the assembled initial configuration and descends to a stable equilibrium (see the module
+    docstring). Returns a single-sample Result with zero velocities and accelerations and the multipliers,
+    so reactions are as in dynamics; `res.stats` has "iterations", "method", "stable",
+    "unstable_directions", "neutral_directions" and "stiffness_eigenvalues". Raises `SolverError` naming
+    the unbalanced directions when no equilibrium is found within maxit iterations."""
     from .kinematic import check_model
     check_model(model)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), t)
-    rows, sf = rep.rows, state_factory(sys)
+    sol = solve_static(sys, rep.q, t, rep.rows, state_factory(sys), tol, maxit)
+    _warn_unstable([sol])
+    return _result(sys, [sol], None, True, _summary(sol))
+
+
+def quasi_static(model, end_time, output_step=None, start_time=0.0, tol=1e-10, maxit=100) -> Result:
+    """Quasi-static analysis: the static equilibrium at each output time from start_time to end_time [s]
+    (every output_step [s]) of a mechanism whose motions move it; each solve starts from the previous one.
+
+    Inertia and velocity-dependent forces are neglected: velocities and accelerations are reported zero,
+    reactions and driver efforts are those that hold the mechanism in equilibrium at each time.
+    `res.stats["stable"]` is a bool array per sample. A failure stops the run: the Result keeps every
+    sample before it (`success` False, `message`, `error`)."""
+    from .kinematic import check_model, time_grid
+    check_model(model)
+    sys = assemble_system(model)
+    rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), start_time)
+    times, sf = time_grid(start_time, end_time, output_step), state_factory(sys)
+    sols, q, error = [], rep.q, None
+    for t in times:
+        try:
+            q = _onto(sys, q, t, rep.rows)
+            sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit))
+        except SolverError as exc:
+            error = exc
+            break
+        q = sols[-1].q
+    _warn_unstable(sols)
+
+    def evaluate(ts):
+        near = [sols[int(np.argmin([abs(s.t - x) for s in sols]))] for x in ts]
+        out = [solve_static(sys, _onto(sys, s.q, x, rep.rows), x, rep.rows, sf, tol, maxit) for s, x in zip(near, ts)]
+        return _arrays(sys, out)[1:]
+    ok = error is None
+    msg = f"quasi-static equilibrium at {len(sols)} times" if ok else \
+        f"{error}; last equilibrium at t = {sols[-1].t if sols else start_time:.9g} s"
+    res = _result(sys, sols, evaluate if sols else None, ok, msg)
+    res.error = error
+    return res
+
+
+def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSolution:
+    """Equilibrium of an assembled System from configuration q (on the constraints) at time t [s]."""
+    L = length_scale(sys, q)
+    scale = velocity_scale(sys, L)
     zero = np.zeros(sys.nv)
 
-    def residual(q, lam):
-        Q = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
-        phi, J, _, _ = constraint_terms(sys, q, zero, t)
-        return np.concatenate([Q - J[rows].T @ lam, phi[rows]]), J[rows]
+    def reduced(qq, N):
+        Q = applied_forces(sys, body_frames(sys, qq, zero), t, sf(t, qq, zero) if sf else None)
+        r = tangent_residual(sys, qq, t, rows, Q)[0]
+        return N.T @ r, r
 
-    q, lam = rep.q, np.zeros(len(rows))
-    r, J = residual(q, lam)
-    scale = max(1.0, float(np.max(np.abs(sys.M))) * 10)
-    for it in range(maxit):
-        if np.max(np.abs(r)) < tol * scale:
+    Q0 = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
+    force_scale = max(1.0, float(np.max(np.abs(Q0), initial=0.0)), 10 * float(np.max(np.abs(sys.M), initial=0.0)))
+    delta, tau, mode = 0.5, None, "trust-region Newton"
+    f_prev = None
+    for it in range(maxit + 1):
+        _follow_angles(sys, q, zero, t)
+        chart = Chart(sys, q, t, rows, tangent_basis(sys, q, t, rows, scale))
+        f, r = reduced(q, chart.N)
+        if np.max(np.abs(r), initial=0.0) <= tol * force_scale:
+            return _classify(sys, chart, it, mode, reduced, force_scale * L, L, sf)
+        if it == maxit:
             break
-        K = _stiffness(sys, q, lam, t, residual)
-        n = sys.nv
-        A = np.zeros((n + len(rows), n + len(rows)))
-        A[:n, :n] = K
-        A[:n, n:] = -J.T
-        A[n:, :n] = J
-        step = np.linalg.lstsq(A, -r, rcond=None)[0]
-        alpha, r_norm = 1.0, np.linalg.norm(r)
-        while alpha > 1e-4:
-            _follow_angles(sys, q, alpha * step[:n], t)
-            q_try, lam_try = increment(sys, q, alpha * step[:n]), lam + alpha * step[n:]
-            r_try, J_try = residual(q_try, lam_try)
-            if np.linalg.norm(r_try) < r_norm * (1 - 1e-4 * alpha) or alpha <= 1.5e-4:
-                break
-            alpha *= 0.5
-        q, lam, r, J = q_try, lam_try, r_try, J_try
+        K = _stiffness(chart, lambda qq: reduced(qq, chart.N)[0])
+        if mode.startswith("trust"):
+            dz, pred = _trust_step(K, f, delta)
+            try:
+                _follow_angles(sys, q, chart.N @ dz, t)
+                f_half, f_new = reduced(chart.q(dz / 2), chart.N)[0], reduced(q_new := chart.q(dz), chart.N)[0]
+            except SolverError:
+                delta *= 0.25
+                continue
+            actual = float((f + 4 * f_half + f_new) @ dz) / 6   # work of the loads = decrease of V
+            rho = actual / pred if pred > 0 else -np.inf
+            n = float(np.linalg.norm(dz))
+            if rho < 0.25:
+                delta = 0.25 * n
+            elif rho > 0.75 and n > 0.99 * delta:
+                delta = min(2 * delta, DELTA_MAX)
+            if rho > 0.1:
+                q = q_new
+            elif delta < 1e-9:                       # the work measure cannot guide: relax instead
+                mode, tau = "pseudo-transient continuation", 1.0 / max(np.max(np.abs(K), initial=0.0), 1e-12 * force_scale)
+        else:
+            dz = np.linalg.lstsq(K + np.eye(len(f)) / tau, f, rcond=None)[0]
+            dz *= min(1.0, DELTA_MAX / max(float(np.linalg.norm(dz)), 1e-300))
+            try:
+                _follow_angles(sys, q, chart.N @ dz, t)
+                q = chart.q(dz)
+            except SolverError:
+                tau *= 0.25
+                continue
+            f_prev = np.linalg.norm(f) if f_prev is None else f_prev
+            tau *= min(10.0, f_prev / max(np.linalg.norm(reduced(q, chart.N)[0]), 1e-300))
+            f_prev = np.linalg.norm(reduced(q, chart.N)[0])
+    where = describe_direction(sys, q, chart.N @ f, L, t)
+    raise SolverError(f"no static equilibrium: the loads along [{where}] are not balanced by any stiffness "
+                      f"(indeterminate or unbounded direction); static equilibrium not found in {maxit} "
+                      f"iterations (residual {np.max(np.abs(r)):.3g})", time=t, state=q)
+
+
+def _trust_step(K, f, delta):
+    """dz minimising -f.dz + dz.K_s.dz/2 within |dz| <= delta (Newton with the full K when it is
+    inside and K_s is positive definite); returns (dz, predicted decrease)."""
+    Ks = 0.5 * (K + K.T)
+    lam, V = np.linalg.eigh(Ks)
+    g = V.T @ f
+    top = max(float(np.max(np.abs(lam), initial=0.0)), 1e-300)
+    if lam[0] > 1e-10 * top:
+        dz = np.linalg.solve(K, f)
+        if np.linalg.norm(dz) <= delta:
+            return dz, float(f @ dz - 0.5 * dz @ Ks @ dz)
+    lo = max(0.0, -lam[0]) + 1e-12 * top
+
+    def step(mu):
+        with np.errstate(all="ignore"):
+            return V @ (g / (lam + mu))
+    if _norm(step(lo)) <= delta:     # hard case: go to the boundary along the least curvature
+        dz = step(lo) if lam[0] > 0 else V[:, 1:] @ (g[1:] / (lam[1:] + lo))
+        if lam[0] <= 0:
+            s = 1.0 if g[0] >= 0 else -1.0
+            dz = dz + s * np.sqrt(max(delta ** 2 - dz @ dz, 0.0)) * V[:, 0]
     else:
-        raise SolverError(f"static equilibrium not found in {maxit} iterations (residual {np.max(np.abs(r)):.3g})",
-                          time=t, state=q)
-    lam_full = np.zeros(sys.nc)
-    lam_full[rows] = lam
-    return Result(sys, [t], q[None], zero[None], zero[None], lam_full[None], None, True, 0,
-                  f"equilibrium in {it} iterations")
+        hi = lo + np.linalg.norm(g) / delta + top
+        for _ in range(100):                  # |step(mu)| decreases with mu: bisection in log space
+            mid = np.sqrt(lo * hi) if lo > 0 else 0.5 * hi
+            lo, hi = (mid, hi) if _norm(step(mid)) > delta else (lo, mid)
+            if hi - lo <= 1e-12 * hi:
+                break
+        dz = step(hi)
+    return dz, float(f @ dz - 0.5 * dz @ Ks @ dz)
+
+
+def _norm(x) -> float:
+    """Euclidean norm without overflow (inf stays inf)."""
+    m = float(np.max(np.abs(x), initial=0.0))
+    return m * float(np.linalg.norm(x / m)) if 0.0 < m < np.inf else m
+
+
+def _stiffness(chart, force, h=FD_STEP):
+    """K = -d f / d z by central differences along the chart, shape (d, d)."""
+    d = chart.dim
+    K = np.zeros((d, d))
+    for k in range(d):
+        e = np.zeros(d)
+        e[k] = h
+        K[:, k] = -(force(chart.q(e)) - force(chart.q(-e))) / (2 * h)
+    return K
+
+
+def _classify(sys, chart, it, method, reduced, energy_scale, L, sf):
+    """StaticSolution at the converged configuration with the stiffness eigenvalues and directions."""
+    q, t = chart.q0, chart.t
+    K = _stiffness(chart, lambda qq: reduced(qq, chart.N)[0]) if chart.dim else np.zeros((0, 0))
+    lam, V = np.linalg.eigh(0.5 * (K + K.T)) if chart.dim else (np.zeros(0), np.zeros((0, 0)))
+    thr = 1e-7 * max(float(np.max(np.abs(lam), initial=0.0)), energy_scale)
+    unstable = [describe_direction(sys, q, chart.N @ V[:, k], L, t) for k in range(len(lam)) if lam[k] < -thr]
+    neutral = [describe_direction(sys, q, chart.N @ V[:, k], L, t) for k in range(len(lam)) if abs(lam[k]) <= thr]
+    zero = np.zeros(sys.nv)
+    Q = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
+    J = constraint_terms(sys, q, zero, t)[1][sys.fixed_rows]
+    lam_all = np.zeros(sys.nc)
+    if J.shape[0]:
+        lam_all[sys.fixed_rows] = np.linalg.lstsq(J.T, Q, rcond=None)[0]   # minimum norm, as in dynamics
+    return StaticSolution(t, q, lam_all, it, method, lam, unstable, neutral)
+
+
+def _onto(sys, q, t, rows):
+    """q projected onto the constraints at time t (motions moved on); SolverError when impossible."""
+    q, res, _ = project_positions(sys, q, t, rows, tol=1e-13, maxit=50)
+    if res > 1e-9:
+        raise SolverError(f"the motions cannot be satisfied (constraint residual {res:.3g})", time=t, state=q)
+    return q
+
+
+def _summary(sol) -> str:
+    text = f"equilibrium in {sol.iterations} iterations ({sol.method}): "
+    if sol.unstable:
+        text += "UNSTABLE along " + " | ".join(sol.unstable)
+    else:
+        text += "stable"
+    if sol.neutral:
+        text += "; neutral (indeterminate) along " + " | ".join(sol.neutral)
+    return text
+
+
+def _warn_unstable(sols):
+    bad = [s for s in sols if s.unstable]
+    if bad:
+        warnings.warn(f"unstable static equilibrium at t = {bad[0].t:.9g} s"
+                      f"{f' (and {len(bad) - 1} more times)' if len(bad) > 1 else ''}: negative stiffness along "
+                      + " | ".join(bad[0].unstable) + ". Start from a perturbed configuration to reach a stable one.",
+                      UnstableEquilibriumWarning, stacklevel=3)
+
+
+def _arrays(sys, sols):
+    n = len(sols)
+    zeros = np.zeros((n, sys.nv))
+    return (np.array([s.t for s in sols]), np.array([s.q for s in sols]).reshape(n, sys.nq), zeros, zeros.copy(),
+            np.array([s.lam for s in sols]).reshape(n, sys.nc))
+
+
+def _result(sys, sols, evaluate, success, message):
+    stats = {"iterations": [s.iterations for s in sols], "method": sols[0].method if sols else "",
+             "stable": np.array([s.stable for s in sols]), "unstable_directions": [s.unstable for s in sols],
+             "neutral_directions": [s.neutral for s in sols],
+             "stiffness_eigenvalues": [s.stiffness for s in sols]}
+    if len(sols) == 1:
+        stats = {k: (v[0] if isinstance(v, (list, np.ndarray)) else v) for k, v in stats.items()}
+        stats["stable"] = bool(stats["stable"])
+    return Result(sys, *_arrays(sys, sols), evaluate=evaluate, success=success, status=0 if success else -1,
+                  message=message, stats=stats)
 
 
 def _follow_angles(sys, q, dx, t):
     """Anchor the continued joint angles of torsion springs and rotational stops at their linear prediction
-    for the Newton update q (+) dx, so that equilibria beyond +-pi (a wound-up spring) are found."""
+    for the update q (+) dx, so that equilibria beyond +-pi (a wound-up spring) are found."""
     from ..model.element_specs import Stop, TorsionSpring
     from ..system.force_elements._common import element_state, joint_coordinate, load_from_rows
     fr = None
     for e in sys.model.forces.values():
         if isinstance(e, TorsionSpring) or (isinstance(e, Stop) and e.dof == "rotation"):
             fr = body_frames(sys, q, np.zeros(sys.nv)) if fr is None else fr
-            x, _, rows = joint_coordinate(sys, fr, e.joint, "rotation", e.name, t)
-            pred = float(x[0] + load_from_rows(sys, fr, rows, 1.0) @ dx)
+            x, _, rws = joint_coordinate(sys, fr, e.joint, "rotation", e.name, t)
+            pred = float(x[0] + load_from_rows(sys, fr, rws, 1.0) @ dx)
             element_state(sys, e.name)["angle_ref"] = [(float(t), pred)]
-
-
-def _stiffness(sys, q, lam, t, residual, h=1e-7):
-    """d(Q - J^T lambda)/dx by central differences, shape (nv, nv)."""
-    n = sys.nv
-    K = np.zeros((n, n))
-    for k in range(n):
-        e = np.zeros(n)
-        e[k] = h
-        rp = residual(increment(sys, q, e), lam)[0][:n]
-        rm = residual(increment(sys, q, -e), lam)[0][:n]
-        K[:, k] = (rp - rm) / (2 * h)
-    return K
