@@ -23,7 +23,9 @@ _LAZY = {
     "Result": ".results",
     "AssemblyReport": ".solvers.assembly", "RedundantConstraintWarning": ".solvers.assembly",
     "assemble": ".solvers.assembly", "simulate": ".solvers.dynamic", "kinematics": ".solvers.kinematic",
-    "equilibrium": ".solvers.static", "plot": ".plotting", "animate": ".viewer",
+    "equilibrium": ".solvers.static", "quasi_static": ".solvers.static",
+    "UnstableEquilibriumWarning": ".solvers.static", "linearize": ".solvers.linear",
+    "Linearization": ".solvers.linear", "plot": ".plotting", "animate": ".viewer",
 }
 
 
@@ -46,6 +48,7 @@ __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
     "Curve", "Spline", "Sphere", "Plane",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
+    "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
     "expressions", "functions", "parse",
     "plot", "animate",
