@@ -118,8 +118,9 @@ def quasi_static(model, end_time, output_step=None, start_time=0.0, tol=1e-10, m
     return res
 
 
-def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSolution:
-    """Equilibrium of an assembled System from configuration q (on the constraints) at time t [s]."""
+def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100, relax=False) -> StaticSolution:
+    """Equilibrium of an assembled System from configuration q (on the constraints) at time t [s];
+    relax=True starts with the pseudo-transient continuation (the fallback) instead of the trust region."""
     L = length_scale(sys, q)
     scale = velocity_scale(sys, L)
     zero = np.zeros(sys.nv)
@@ -132,7 +133,8 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSoluti
     Q0 = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
     force_scale = max(1.0, float(np.max(np.abs(Q0), initial=0.0)), 10 * float(np.max(np.abs(sys.M), initial=0.0)))
     delta, tau, mode = 0.5, None, "trust-region Newton"
-    f_prev = None
+    if relax:
+        mode = "pseudo-transient continuation"
     for it in range(maxit + 1):
         _follow_angles(sys, q, zero, t)
         chart = Chart(sys, q, t, rows, tangent_basis(sys, q, t, rows, scale))
@@ -142,6 +144,8 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSoluti
         if it == maxit:
             break
         K = _stiffness(chart, lambda qq: reduced(qq, chart.N)[0])
+        if mode.startswith("pseudo") and tau is None:
+            tau = 1.0 / max(float(np.max(np.abs(K), initial=0.0)), 1e-12 * force_scale)
         if mode.startswith("trust"):
             dz, pred = _trust_step(K, f, delta)
             try:
@@ -160,9 +164,10 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSoluti
             if rho > 0.1:
                 q = q_new
             elif delta < 1e-9:                       # the work measure cannot guide: relax instead
-                mode, tau = "pseudo-transient continuation", 1.0 / max(np.max(np.abs(K), initial=0.0), 1e-12 * force_scale)
-        else:
-            dz = np.linalg.lstsq(K + np.eye(len(f)) / tau, f, rcond=None)[0]
+                mode = "pseudo-transient continuation"
+        else:   # implicit Euler on dz/dtau = f, kept downhill: K_s + I / tau positive definite
+            neg = max(0.0, -float(np.linalg.eigvalsh(0.5 * (K + K.T))[0])) if len(f) else 0.0
+            dz = np.linalg.lstsq(K + np.eye(len(f)) * max(1.0 / tau, 1.5 * neg), f, rcond=None)[0]
             dz *= min(1.0, DELTA_MAX / max(float(np.linalg.norm(dz)), 1e-300))
             try:
                 _follow_angles(sys, q, chart.N @ dz, t)
@@ -170,9 +175,8 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100) -> StaticSoluti
             except SolverError:
                 tau *= 0.25
                 continue
-            f_prev = np.linalg.norm(f) if f_prev is None else f_prev
-            tau *= min(10.0, f_prev / max(np.linalg.norm(reduced(q, chart.N)[0]), 1e-300))
-            f_prev = np.linalg.norm(reduced(q, chart.N)[0])
+            f_new = float(np.linalg.norm(reduced(q, chart.N)[0]))
+            tau *= min(10.0, float(np.linalg.norm(f)) / max(f_new, 1e-300))   # switched evolution relaxation
     where = describe_direction(sys, q, chart.N @ f, L, t)
     raise SolverError(f"no static equilibrium: the loads along [{where}] are not balanced by any stiffness "
                       f"(indeterminate or unbounded direction); static equilibrium not found in {maxit} "
