@@ -7,7 +7,7 @@ with the safe expression parser `parse`.
 """
 from importlib import import_module
 
-from .errors import AssemblyError, MbdsimError, ModelError, SolverError
+from .errors import AssemblyError, MbdsimError, ModelError, ModelFileError, SolverError
 
 # Public names load their module on first use (PEP 562), so `import mbdsim` stays fast and the solvers,
 # scipy and numba load with the first analysis. One line per name: where it lives.
@@ -20,6 +20,7 @@ _LAZY = {
     "Body": ".model", "Force": ".model", "Joint": ".model", "Marker": ".model", "Model": ".model",
     "Motion": ".model", "SpringDamper": ".model", "Torque": ".model",
     "Curve": ".model.curves", "Spline": ".model.curves", "Plane": ".model.shapes", "Sphere": ".model.shapes",
+    "Box": ".model.shapes", "Cylinder": ".model.shapes", "load_model": ".io", "save_model": ".io",
     "Result": ".results",
     "AssemblyReport": ".solvers.assembly", "RedundantConstraintWarning": ".solvers.assembly",
     "assemble": ".solvers.assembly", "simulate": ".solvers.dynamic", "kinematics": ".solvers.kinematic",
@@ -46,10 +47,10 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
-    "Curve", "Spline", "Sphere", "Plane",
+    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
-    "MbdsimError", "ModelError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
+    "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
     "expressions", "functions", "parse",
     "plot", "animate",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",

@@ -14,6 +14,16 @@ class ModelError(MbdsimError, ValueError):
         super().__init__(f"{entity}.{field}: {message}")
 
 
+class ModelFileError(ModelError):
+    """An error in a model file (YAML/JSON): names the file, the line where known, the entity and the field."""
+
+    def __init__(self, entity: str, field: str, message: str, file: str | None = None, line: int | None = None):
+        self.file, self.line, self.message = file, line, message
+        super().__init__(entity, field, message)
+        where = ", ".join(p for p in (file, None if line is None else f"line {line}") if p)
+        self.args = (f"{where}: {self.args[0]}" if where else self.args[0],)
+
+
 class _TimedError(MbdsimError):
     """An analysis failure at a time, naming the joints involved and keeping the last state."""
 

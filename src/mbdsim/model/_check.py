@@ -6,8 +6,19 @@ import numpy as np
 from ..errors import ModelError
 
 
+def _has_bool(value) -> bool:
+    """True when value is a boolean or a (nested) sequence holding one: True is not the number 1 here."""
+    if isinstance(value, (bool, np.bool_)):
+        return True
+    if isinstance(value, np.ndarray):
+        return value.dtype == bool or (value.dtype == object and any(_has_bool(x) for x in value.ravel()))
+    return isinstance(value, (list, tuple)) and any(_has_bool(x) for x in value)
+
+
 def vector(entity: str, field: str, value, n: int = 3, what: str = "") -> np.ndarray:
     """A finite n-vector, else ModelError (`what` names the components in the message)."""
+    if _has_bool(value):
+        raise ModelError(entity, field, f"expected {n} numbers, got a boolean in {value!r}")
     try:
         v = np.asarray(value, dtype=float).reshape(-1)
     except (TypeError, ValueError):
@@ -31,7 +42,9 @@ def vec3(entity: str, field: str, value, unit: bool = False) -> np.ndarray:
 
 
 def scalar(entity: str, field: str, value, minimum: float | None = None, strict: bool = False) -> float:
-    """A finite float, optionally bounded below, else ModelError."""
+    """A finite float, optionally bounded below, else ModelError (a boolean is not a number)."""
+    if _has_bool(value):
+        raise ModelError(entity, field, f"expected a number, got the boolean {value!r}")
     try:
         x = float(value)
     except (TypeError, ValueError):
@@ -45,7 +58,13 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
 
 
 def inertia_matrix(entity: str, value) -> np.ndarray:
-    """Inertia about the centre of mass in body axes: (ixx, iyy, izz) or a symmetric 3x3 [kg m^2]."""
+    """Inertia about the centre of mass in body axes: (ixx, iyy, izz) or a symmetric 3x3 [kg m^2].
+
+    Checked: finite, symmetric, positive semi-definite (a slender rod may have a zero axial moment)
+    and the triangle inequality of the principal moments (I1 + I2 >= I3, relative tolerance 1e-6),
+    which every real mass distribution satisfies."""
+    if _has_bool(value):
+        raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got a boolean in {value!r}")
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
@@ -58,4 +77,7 @@ def inertia_matrix(entity: str, value) -> np.ndarray:
     ev = np.linalg.eigvalsh(J)
     if ev.min() < -1e-12 * max(1.0, ev.max()):
         raise ModelError(entity, "inertia", f"must be positive semi-definite, eigenvalues {ev}")
+    if ev[0] + ev[1] < ev[2] - 1e-6 * ev[2]:
+        raise ModelError(entity, "inertia", f"principal moments {ev[0]:.6g}, {ev[1]:.6g}, {ev[2]:.6g} kg m^2 "
+                         "violate the triangle inequality (I1 + I2 >= I3): no mass distribution has them")
     return J

@@ -71,9 +71,35 @@ class Body:
         return f"{kind}({self.name!r})"
 
 
+def shape_mass_properties(entity: str, shape, density, mass, inertia):
+    """(mass, inertia) from a mb.Box / mb.Cylinder / mb.Sphere and a density [kg/m^3] (then mass and
+    inertia must not be given), else the given mass and inertia unchanged."""
+    from .shapes import MASS_SHAPES
+    if shape is None:
+        if density is not None:
+            raise ModelError(entity, "density", "needs a shape (mb.Box, mb.Cylinder or mb.Sphere)")
+        return mass, inertia
+    if not isinstance(shape, MASS_SHAPES):
+        raise ModelError(entity, "shape", f"expected mb.Box, mb.Cylinder or mb.Sphere, got {shape!r}")
+    if density is None:
+        raise ModelError(entity, "density", "a shape needs a density [kg/m^3]")
+    if mass is not None or inertia is not None:
+        raise ModelError(entity, "mass" if mass is not None else "inertia",
+                         "give either mass and inertia, or a shape and a density")
+    try:
+        return shape.mass_properties(density)
+    except ModelError as exc:
+        raise ModelError(entity, exc.field, str(exc).split(": ", 1)[-1]) from None
+
+
 def make_body(name, mass, inertia, position, orientation, velocity, angular_velocity, particle=False) -> Body:
-    """Validate user input and build a Body (or a particle when particle=True)."""
+    """Validate user input and build a Body (or a particle when particle=True).
+
+    mass [kg] must be finite and >= 0 (> 0 for a particle; 0 is a massless link); booleans are refused."""
     entity = f"{'particle' if particle else 'body'} '{name}'"
+    if mass is None:
+        raise ModelError(entity, "mass", "is required (or give a shape and a density)")
+    inertia = (0.0, 0.0, 0.0) if inertia is None else inertia
     m = scalar(entity, "mass", mass, minimum=0.0, strict=particle)
     J = np.zeros((3, 3)) if particle else inertia_matrix(entity, inertia)
     try:

@@ -7,7 +7,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ._check import scalar, vec3
-from .body import Body, Marker, make_body
+from .body import Body, Marker, make_body, shape_mass_properties
 from .forces import Force, SpringDamper, Torque
 from .elements import ForceElementsMixin
 from .friction_path import FrictionPathMixin
@@ -28,12 +28,16 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         self._names: set[str] = {"ground"}
 
     # ----------------------------------------------------------------- bodies
-    def add_body(self, name, mass, inertia=(0.0, 0.0, 0.0), position=(0, 0, 0), orientation=None,
-                 velocity=(0, 0, 0), angular_velocity=(0, 0, 0)) -> Body:
-        """Add a rigid body: mass [kg], inertia about the CM in body axes [kg m^2] (3 values or 3x3),
-        CM position [m], orientation (body->ground), CM velocity [m/s] and angular velocity [rad/s] in ground."""
+    def add_body(self, name, mass=None, inertia=None, position=(0, 0, 0), orientation=None,
+                 velocity=(0, 0, 0), angular_velocity=(0, 0, 0), shape=None, density=None) -> Body:
+        """Add a rigid body: mass [kg], inertia about the CM in body axes [kg m^2] (3 values or 3x3, default 0),
+        CM position [m], orientation (body->ground), CM velocity [m/s] and angular velocity [rad/s] in ground.
+
+        Instead of mass and inertia: `shape` (mb.Box, mb.Cylinder or mb.Sphere, centred on the CM, in body
+        axes) and `density` [kg/m^3]."""
         self._claim(name, "body")
         try:
+            mass, inertia = shape_mass_properties(f"body '{name}'", shape, density, mass, inertia)
             b = make_body(name, mass, inertia, position, orientation, velocity, angular_velocity)
         except ModelError:
             self._names.discard(name)   # a failed add must not claim the name

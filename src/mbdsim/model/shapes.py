@@ -29,8 +29,68 @@ class Sphere:
         self.radius = scalar(entity, "radius", radius, minimum=0.0, strict=True)
         self.center = None if center is None else vec3(entity, "center", center)
 
+    def mass_properties(self, density):
+        """(mass [kg], inertia about the centre 3x3 [kg m^2]) of a solid sphere of `density` [kg/m^3]."""
+        m = _density(self, density) * 4.0 / 3.0 * np.pi * self.radius ** 3
+        return float(m), np.eye(3) * (0.4 * m * self.radius ** 2)
+
     def __repr__(self) -> str:
         return f"Sphere({getattr(self.body, 'name', self.body)!r}, r={self.radius:g})"
+
+
+@dataclass(eq=False, init=False)
+class Box:
+    """A solid box with edge lengths `size` = (a, b, c) [m] along the body x, y, z axes (for mass properties)."""
+
+    size: np.ndarray
+
+    def __init__(self, size):
+        self.size = vec3("box", "size", size)
+        if np.any(self.size <= 0):
+            raise ModelError("box", "size", f"edge lengths must be > 0, got {tuple(self.size)}")
+
+    def mass_properties(self, density):
+        """(mass [kg], inertia about the centre in body axes 3x3 [kg m^2]) for `density` [kg/m^3]."""
+        a, b, c = self.size
+        m = _density(self, density) * a * b * c
+        return float(m), np.diag([b * b + c * c, a * a + c * c, a * a + b * b]) * (m / 12.0)
+
+    def __repr__(self) -> str:
+        return f"Box(size={tuple(float(x) for x in self.size)})"
+
+
+@dataclass(eq=False, init=False)
+class Cylinder:
+    """A solid cylinder of `radius` and `length` [m] along the body `axis` ("x", "y" or "z")."""
+
+    radius: float
+    length: float
+    axis: str
+
+    def __init__(self, radius, length, axis="z"):
+        self.radius = scalar("cylinder", "radius", radius, minimum=0.0, strict=True)
+        self.length = scalar("cylinder", "length", length, minimum=0.0, strict=True)
+        if axis not in ("x", "y", "z"):
+            raise ModelError("cylinder", "axis", f"must be 'x', 'y' or 'z', got {axis!r}")
+        self.axis = axis
+
+    def mass_properties(self, density):
+        """(mass [kg], inertia about the centre in body axes 3x3 [kg m^2]) for `density` [kg/m^3]."""
+        r, L = self.radius, self.length
+        m = _density(self, density) * np.pi * r * r * L
+        d = np.full(3, m * (3 * r * r + L * L) / 12.0)
+        d["xyz".index(self.axis)] = 0.5 * m * r * r
+        return float(m), np.diag(d)
+
+    def __repr__(self) -> str:
+        return f"Cylinder(radius={self.radius:g}, length={self.length:g}, axis={self.axis!r})"
+
+
+def _density(shape, density) -> float:
+    return scalar(type(shape).__name__.lower(), "density", density, minimum=0.0, strict=True)
+
+
+MASS_SHAPES = (Box, Cylinder, Sphere)
 
 
 @dataclass(eq=False, init=False)

@@ -1,0 +1,274 @@
+"""Build an mbdsim Model from a validated model-file spec (mbdsim.io.schema) through the public API.
+
+Every reference (body, joint, marker, frame) is checked here first, so that a misspelt name gives a
+message listing the valid choices; the API's own checks (ModelError) are reported against the item
+being built.  Values whose unit depends on the joint (motions, stops, friction preload) are converted
+to SI here.  Expression strings go to the whitelist parser `mbdsim.parse`: nothing is evaluated as code.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..errors import ModelError
+from .schema import AxisAngleSpec, EulerSpec, ModelSpec
+from .units import UnitError, to_si
+
+JOINT_METHODS = {"revolute": "add_revolute", "translational": "add_translational", "cylindrical": "add_cylindrical",
+                 "spherical": "add_spherical", "universal": "add_universal", "planar": "add_planar",
+                 "fixed": "add_fixed"}
+JOINT_FIELDS = {"revolute": ("point", "axis"), "translational": ("point", "axis"), "cylindrical": ("point", "axis"),
+                "spherical": ("point",), "universal": ("point", "axis_i", "axis_j"),
+                "planar": ("point", "normal", "u_axis"), "fixed": ("point",)}
+PER = {"displacement": "", "velocity": "/s", "acceleration": "/s**2"}
+
+
+class ItemError(ModelError):
+    """A ModelError attributed to the item at `path` in the model data (section, index[, field...])."""
+
+    def __init__(self, entity, field, message, path):
+        super().__init__(entity, field, message)
+        self.path, self.message = tuple(path), message
+
+
+@dataclass(frozen=True)
+class ExprCurve:
+    """C(s) [m] from three expression strings of s (whitelist parser); exact derivatives by differentiation."""
+
+    texts: tuple
+
+    def __post_init__(self):
+        from ..expressions import parse
+        exprs = tuple(parse(str(t), variables=("s",)) for t in self.texts)
+        object.__setattr__(self, "_e", (exprs, tuple(e.derivative("s") for e in exprs)))
+
+    def _stack(self, exprs, s):
+        return np.array([np.asarray(e(s)) + 0 * np.asarray(s) for e in exprs])
+
+    def __call__(self, s):
+        return self._stack(self._e[0], s)
+
+    def d1(self, s):
+        return self._stack(self._e[1], s)
+
+    def d2(self, s):
+        return self._stack(tuple(e.derivative("s") for e in self._e[1]), s)
+
+
+def rotation_matrix(entity: str, field: str, spec) -> np.ndarray | None:
+    """3x3 body->ground matrix from a matrix, {euler, sequence} or {axis, angle} spec (None stays None)."""
+    from scipy.spatial.transform import Rotation
+    if spec is None:
+        return None
+    if isinstance(spec, EulerSpec):
+        return Rotation.from_euler(spec.sequence, spec.euler).as_matrix()
+    if isinstance(spec, AxisAngleSpec):
+        axis = np.asarray(spec.axis, dtype=float)
+        n = np.linalg.norm(axis)
+        if n < 1e-12:
+            raise ModelError(entity, field, "axis-angle axis must be non-zero")
+        return Rotation.from_rotvec(axis / n * spec.angle).as_matrix()
+    return np.asarray(spec, dtype=float)
+
+
+class Builder:
+    """Turns a ModelSpec into a Model; `path` is the item being built (for error locations)."""
+
+    def __init__(self, spec: ModelSpec):
+        import mbdsim as mb
+        self.spec, self.mb = spec, mb
+        self.model = mb.Model(spec.name, gravity=spec.gravity)
+        self.path: tuple = ()
+
+    # ------------------------------------------------------------------ references
+    def fail(self, entity, field, message):
+        raise ItemError(entity, field, message, self.path + (field,))
+
+    def body(self, entity, field, name):
+        bodies = self.model.bodies
+        if name not in bodies:
+            self.fail(entity, field, f"body {name!r} not found; bodies are: {', '.join(bodies)}")
+        return bodies[name]
+
+    def joint(self, entity, field, name):
+        joints = self.model.joints
+        if name not in joints:
+            listed = ", ".join(joints) or "(none)"
+            self.fail(entity, field, f"joint {name!r} not found; joints are: {listed}")
+        return joints[name]
+
+    def frame(self, entity, field, ref):
+        """A Body ("body") or Marker ("body.marker") by name."""
+        if ref is None:
+            return None
+        body_name, _, marker = ref.partition(".")
+        b = self.body(entity, field, body_name)
+        if not marker:
+            return b
+        if marker not in b.markers:
+            listed = ", ".join(f"{body_name}.{m}" for m in b.markers) or "(none)"
+            self.fail(entity, field, f"marker {ref!r} not found; markers of {body_name!r} are: {listed}")
+        return b.markers[marker]
+
+    def location(self, entity, field, loc):
+        """'body.marker' -> Marker, 'body' -> Body (its CM), {body, point} -> (Body, point)."""
+        if isinstance(loc, str):
+            return self.frame(entity, field, loc)
+        return self.body(entity, field, loc.body), loc.point
+
+    def si(self, entity, field, value, unit):
+        if value is None:
+            return None
+        try:
+            return to_si(value, unit)
+        except UnitError as exc:
+            self.fail(entity, field, str(exc))
+
+    # ------------------------------------------------------------------ items
+    def build(self):
+        s = self.spec
+        for section, items, fn in (("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
+                                   ("joints", s.joints, self.add_joint), ("motions", s.motions, self.add_motion),
+                                   ("forces", s.forces, self.add_element)):
+            for k, item in enumerate(items):
+                self.path = (section, k)
+                try:
+                    fn(item)
+                except ItemError:
+                    raise
+                except ModelError as exc:
+                    msg = str(exc)[len(f"{exc.entity}.{exc.field}: "):]
+                    raise ItemError(exc.entity, exc.field, msg, self.path + (exc.field.split("[")[0],)) from None
+        return self.model
+
+    def add_markers(self, body, markers):
+        for k, m in enumerate(markers):
+            entity = f"marker '{body.name}.{m.name}'"
+            self.path = self.path[:2] + ("markers", k)
+            body.add_marker(m.name, m.point, rotation_matrix(entity, "orientation", m.orientation))
+        self.path = self.path[:2]
+
+    def add_body(self, b):
+        entity = f"body '{b.name}'"
+        shape = None
+        if b.shape is not None:
+            mb = self.mb
+            shape = {"box": lambda x: mb.Box(x.size), "cylinder": lambda x: mb.Cylinder(x.radius, x.length, x.axis),
+                     "sphere": lambda x: mb.Sphere(None, x.radius)}[b.shape.type](b.shape)
+        body = self.model.add_body(b.name, b.mass, b.inertia, b.position,
+                                   rotation_matrix(entity, "orientation", b.orientation), b.velocity,
+                                   b.angular_velocity, shape=shape, density=b.density)
+        self.add_markers(body, b.markers)
+
+    def add_particle(self, p):
+        self.add_markers(self.model.add_particle(p.name, p.mass, p.position, p.velocity), p.markers)
+
+    def add_joint(self, j):
+        entity = f"joint '{j.name}'"
+        if j.type == "point_on_curve":
+            return self.add_point_on_curve(entity, j)
+        bi, bj = self.body(entity, "body_i", j.body_i), self.body(entity, "body_j", j.body_j)
+        args = [getattr(j, f) for f in JOINT_FIELDS[j.type]]
+        getattr(self.model, JOINT_METHODS[j.type])(j.name, bi, bj, *args)
+
+    def add_point_on_curve(self, entity, j):
+        mb, c = self.mb, j.curve
+        if c.type == "spline":
+            curve = mb.Spline(c.points, closed=c.closed)
+        else:
+            try:
+                fn = ExprCurve((c.x, c.y, c.z))
+            except ValueError as exc:   # ExpressionError is a ValueError
+                self.fail(entity, "curve", str(exc))
+            curve = mb.Curve(fn, c.s_range, d1=fn.d1, d2=fn.d2, closed=c.closed)
+        self.model.add_point_on_curve(j.name, self.location(entity, "marker", j.marker),
+                                      self.body(entity, "body", j.body), curve)
+
+    def coordinate_unit(self, entity, joint, dof):
+        """'rad' or 'm' for the driven/stopped coordinate of `joint` (API errors for other kinds)."""
+        if joint.kind == "translational" or (joint.kind == "cylindrical" and dof == "translation"):
+            return "m"
+        return "rad"
+
+    def motion_value(self, entity, field, value, unit):
+        if value is None or not isinstance(value, str):
+            return value
+        from ..expressions import ExpressionError, parse
+        try:
+            parse(value)
+            return value
+        except ExpressionError as exc:
+            try:
+                return to_si(value, unit)   # a constant with units, e.g. "60 deg/s"
+            except UnitError:
+                self.fail(entity, field, str(exc))
+
+    def add_motion(self, m):
+        entity = f"motion '{m.name}'"
+        jt = self.joint(entity, "joint", m.joint)
+        unit = self.coordinate_unit(entity, jt, m.dof)
+        values = {k: self.motion_value(entity, k, getattr(m, k), unit + PER[k])
+                  for k in ("displacement", "velocity", "acceleration")}
+        self.model.add_motion(m.name, jt, **values,
+                              initial_displacement=self.si(entity, "initial_displacement", m.initial_displacement, unit),
+                              initial_velocity=self.si(entity, "initial_velocity", m.initial_velocity, unit + "/s"),
+                              dof=m.dof)
+
+    def add_element(self, e):
+        entity = f"{e.type.replace('_', ' ')} '{e.name}'"
+        getattr(self, "add_" + e.type)(entity, e)
+
+    def add_force(self, entity, e):
+        self.model.add_force(e.name, self.location(entity, "at", e.at), e.force, self.frame(entity, "frame", e.frame))
+
+    def add_torque(self, entity, e):
+        self.model.add_torque(e.name, self.body(entity, "body", e.body), e.torque,
+                              self.frame(entity, "frame", e.frame))
+
+    def add_spring_damper(self, entity, e):
+        self.model.add_spring_damper(e.name, self.location(entity, "at_i", e.at_i), self.location(entity, "at_j", e.at_j),
+                                     e.stiffness, e.damping, e.free_length, e.preload)
+
+    def add_torsion_spring(self, entity, e):
+        self.model.add_torsion_spring(e.name, self.joint(entity, "joint", e.joint), e.stiffness, e.damping,
+                                      e.free_angle, e.preload)
+
+    def six(self, entity, field, values, units):
+        return [self.si(entity, field, v, u) for v, u in zip(values, units)]
+
+    def add_bushing(self, entity, e):
+        k = self.six(entity, "stiffness", e.stiffness, ["N/m"] * 3 + ["N*m/rad"] * 3)
+        c = self.six(entity, "damping", e.damping, ["N*s/m"] * 3 + ["N*m*s/rad"] * 3)
+        f0 = self.six(entity, "preload", e.preload, ["N"] * 3 + ["N*m"] * 3)
+        self.model.add_bushing(e.name, self.location(entity, "marker_i", e.marker_i),
+                               self.location(entity, "marker_j", e.marker_j), k, c, f0)
+
+    def contact_shape(self, entity, field, s):
+        body = self.body(entity, field, s.body)
+        if s.type == "sphere":
+            return self.mb.Sphere(body, s.radius, s.center)
+        return self.mb.Plane(body, s.point, s.normal)
+
+    def add_contact(self, entity, e):
+        k = self.si(entity, "stiffness", e.stiffness, f"N/m**{e.exponent!r}")
+        self.model.add_contact(e.name, self.contact_shape(entity, "shape_i", e.shape_i),
+                               self.contact_shape(entity, "shape_j", e.shape_j), k, e.exponent, e.damping,
+                               e.penetration, e.mu, e.friction_velocity)
+
+    def add_stop(self, entity, e):
+        jt = self.joint(entity, "joint", e.joint)
+        u = self.coordinate_unit(entity, jt, e.dof)
+        load = "N*m" if u == "rad" else "N"
+        self.model.add_stop(e.name, jt, self.si(entity, "lower", e.lower, u), self.si(entity, "upper", e.upper, u),
+                            self.si(entity, "stiffness", e.stiffness, f"{load}/{u}**{e.exponent!r}"), e.exponent,
+                            self.si(entity, "damping", e.damping, f"{load}*s/{u}"),
+                            self.si(entity, "penetration", e.penetration, u), dof=e.dof)
+
+    def add_friction(self, entity, e):
+        jt = self.joint(entity, "joint", e.joint)
+        params = {k: getattr(e, k) for k in ("pin_radius", "friction_arm", "bending_arm", "effective_length",
+                                             "reaction_arm") if getattr(e, k) is not None}
+        if e.preload is not None:
+            params["preload"] = self.si(entity, "preload", e.preload, "N*m" if jt.kind == "revolute" else "N")
+        self.model.add_friction(e.name, jt, e.mu_static, e.mu_dynamic, **params)

@@ -1,0 +1,231 @@
+"""Model -> plain data in the model-file schema (SI numbers only), the inverse of mbdsim.io.build.
+
+Callables cannot be stored: a motion, load or curve given as a Python function raises ModelError
+naming the element.  The output is canonical: building it and dumping again gives the same dict.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..errors import ModelError
+
+ZERO3 = [0.0, 0.0, 0.0]
+
+
+def _vec(v) -> list:
+    return [float(x) for x in np.asarray(v, dtype=float).reshape(-1)]
+
+
+def _unit(v) -> list:
+    """A vector whose normalisation (as the API does it) gives exactly the stored unit vector `v`."""
+    v = np.asarray(v, dtype=float)
+    for k in (0, 1, -1, 2, -2, 3, -3, 4, -4):   # scaling by 1 + k ulp; the first whose normalisation is v
+        c = v * (1.0 + k * 2.0 ** -53)
+        if np.array_equal(c / np.linalg.norm(c), v):
+            return _vec(c)
+    for i in range(3):       # one component nudged by one ulp
+        for d in (-1, 1):
+            c = v.copy()
+            c[i] = np.nextafter(c[i], d * np.inf)
+            if np.array_equal(c / np.linalg.norm(c), v):
+                return _vec(c)
+    return _vec(v)
+
+
+def _rounded(x: float, scale: float) -> float:
+    """x rounded to 13 significant digits of `scale` (undoes the rounding of a body-axes round trip)."""
+    digits = 13 - int(math.floor(math.log10(max(abs(scale), 1e-300))))
+    return float(round(x, digits)) + 0.0
+
+
+def _matrix(R) -> list | None:
+    return None if np.array_equal(R, np.eye(3)) else [_vec(row) for row in R]
+
+
+def _inertia(J):
+    return _vec(np.diag(J)) if np.array_equal(J, np.diag(np.diag(J))) else [_vec(row) for row in J]
+
+
+def _put(d: dict, key, value, default=None):
+    if value is not None and value != default:
+        d[key] = value
+    return d
+
+
+def _marker_ref(m):
+    """'body.marker' for a marker registered on its body, else {body, point}."""
+    if m.body.markers.get(m.name) is m:
+        return f"{m.body.name}.{m.name}"
+    return {"body": m.body.name, "point": _vec(m.point)}
+
+
+def _frame_ref(entity, frame):
+    if frame is None:
+        return None
+    if hasattr(frame, "markers"):   # a Body
+        return frame.name
+    if frame.body.markers.get(frame.name) is frame:
+        return f"{frame.body.name}.{frame.name}"
+    raise ModelError(entity, "frame", "only a body or one of its named markers can be stored as a frame")
+
+
+def _markers(body) -> list:
+    out = []
+    for m in body.markers.values():
+        out.append(_put({"name": m.name, "point": _vec(m.point)}, "orientation", _matrix(m.orientation)))
+    return out
+
+
+def _body(b) -> dict:
+    if b.is_particle:
+        d = {"name": b.name, "mass": float(b.mass), "position": _vec(b.position)}
+        _put(d, "velocity", _vec(b.velocity), ZERO3)
+    else:
+        d = {"name": b.name, "mass": float(b.mass), "inertia": _inertia(b.inertia), "position": _vec(b.position)}
+        _put(d, "orientation", _matrix(b.orientation))
+        _put(d, "velocity", _vec(b.velocity), ZERO3)
+        _put(d, "angular_velocity", _vec(b.angular_velocity), ZERO3)
+    return _put(d, "markers", _markers(b), [])
+
+
+def _joint(j) -> dict:
+    d = {"name": j.name, "type": j.kind, "body_i": j.body_i.name, "body_j": j.body_j.name, "point": _vec(j.point)}
+    if j.kind in ("revolute", "translational", "cylindrical"):
+        d["axis"] = _unit(j.axis)
+    elif j.kind == "universal":
+        d.update(axis_i=_unit(j.axis), axis_j=_unit(j.axis_j))
+    elif j.kind == "planar":
+        d.update(normal=_unit(j.axis), u_axis=_unit(j.u_axis))
+    return d
+
+
+def _curve(entity, curve) -> dict:
+    from ..model.curves import Spline
+    from .build import ExprCurve
+    if isinstance(curve, Spline):
+        pts = curve.points[:-1] if curve.closed else curve.points
+        return {"type": "spline", "points": [_vec(p) for p in pts], "closed": curve.closed}
+    if isinstance(curve._f, ExprCurve):
+        x, y, z = (str(t) for t in curve._f.texts)
+        return {"type": "curve", "x": x, "y": y, "z": z, "s_range": _vec(curve.s_range), "closed": curve.closed}
+    raise ModelError(entity, "curve", "a curve given as a Python callable cannot be stored in a model file; "
+                     "use mb.Spline or expression strings of s in the file")
+
+
+def _path(pc) -> dict:
+    entity = f"joint '{pc.name}'"
+    return {"name": pc.name, "type": "point_on_curve", "marker": _marker_ref(pc.marker), "body": pc.body.name,
+            "curve": _curve(entity, pc.curve)}
+
+
+def _source(entity, field, tf):
+    """The number or expression text a TimeFunction was made from, else ModelError (a callable)."""
+    from ..timefunctions import _Constant
+    if tf.expr is not None:
+        return tf.expr.text
+    if isinstance(tf.f, _Constant):
+        return tf.f.c
+    raise ModelError(entity, field, "a Python callable cannot be stored in a model file; "
+                     "use a number or an expression string in t")
+
+
+def _motion(m) -> dict:
+    entity, tf = f"motion '{m.name}'", m.function
+    d = {"name": m.name, "joint": m.joint.name}
+    if m.kind == "displacement":
+        d["displacement"] = _source(entity, "displacement", tf)
+    else:
+        src = tf.f_d1 if m.kind == "velocity" else tf.f_d2
+        inner = getattr(src, "__self__", None)
+        if inner is None or not hasattr(tf.f, "a"):
+            raise ModelError(entity, m.kind, "a Python callable cannot be stored in a model file")
+        d[m.kind] = _source(entity, m.kind, inner)
+        d["initial_displacement"] = float(tf.f.a)
+        if m.kind == "acceleration":
+            d["initial_velocity"] = float(tf.f.b)
+    return _put(d, "dof", m.dof if m.joint.kind == "cylindrical" else None)
+
+
+def _constant(entity, field, value):
+    if callable(value):
+        raise ModelError(entity, field, "a Python callable cannot be stored in a model file; "
+                         "use a constant vector")
+    return _vec(value)
+
+
+def _force(f) -> dict:
+    entity = f"force '{f.name}'"
+    b = f.body
+    at = next((f"{b.name}.{m.name}" for m in b.markers.values() if np.array_equal(m.s_B, f.s_B)), None)
+    if at is None:
+        p = b.position + b.orientation @ f.s_B
+        scale = max(1.0, float(np.abs(b.position).max()), float(np.abs(p).max()))
+        at = {"body": b.name, "point": [_rounded(x, scale) for x in p]}
+    d = {"name": f.name, "type": "force", "at": at, "force": _constant(entity, "force", f.force)}
+    return _put(d, "frame", _frame_ref(entity, f.frame))
+
+
+def _torque(t) -> dict:
+    entity = f"torque '{t.name}'"
+    d = {"name": t.name, "type": "torque", "body": t.body.name, "torque": _constant(entity, "torque", t.torque)}
+    return _put(d, "frame", _frame_ref(entity, t.frame))
+
+
+def _shape(s) -> dict:
+    src, body = s.source, s.body.name
+    if s.kind == "sphere":
+        d = {"type": "sphere", "body": body, "radius": float(src.radius)}
+        return _put(d, "center", None if src.center is None else _vec(src.center))
+    return {"type": "plane", "body": body, "point": _vec(src.point), "normal": _unit(src.normal)}
+
+
+def _element(e) -> dict:
+    from ..model.element_specs import Bushing, Contact, Stop, TorsionSpring
+    from ..model.forces import Force, SpringDamper, Torque
+    from ..model.friction_path import JointFriction
+    if isinstance(e, Force):
+        return _force(e)
+    if isinstance(e, Torque):
+        return _torque(e)
+    head = {"name": e.name}
+    if isinstance(e, SpringDamper):
+        return {**head, "type": "spring_damper", "at_i": _marker_ref(e.marker_i), "at_j": _marker_ref(e.marker_j),
+                "stiffness": e.stiffness, "damping": e.damping, "free_length": e.free_length, "preload": e.preload}
+    if isinstance(e, TorsionSpring):
+        return {**head, "type": "torsion_spring", "joint": e.joint.name, "stiffness": e.stiffness,
+                "damping": e.damping, "free_angle": e.free_angle, "preload": e.preload}
+    if isinstance(e, Bushing):
+        return {**head, "type": "bushing", "marker_i": _marker_ref(e.marker_i), "marker_j": _marker_ref(e.marker_j),
+                "stiffness": _vec(e.stiffness), "damping": _vec(e.damping), "preload": _vec(e.preload)}
+    if isinstance(e, Contact):
+        return {**head, "type": "contact", "shape_i": _shape(e.shape_i), "shape_j": _shape(e.shape_j),
+                "stiffness": e.stiffness, "exponent": e.exponent, "damping": e.damping,
+                "penetration": e.penetration, "mu": e.mu, "friction_velocity": e.friction_velocity}
+    if isinstance(e, Stop):
+        d = {**head, "type": "stop", "joint": e.joint.name}
+        _put(d, "lower", e.lower)
+        _put(d, "upper", e.upper)
+        d.update(stiffness=e.stiffness, exponent=e.exponent, damping=e.damping, penetration=e.penetration)
+        return _put(d, "dof", e.dof if e.joint.kind == "cylindrical" else None)
+    if isinstance(e, JointFriction):
+        d = {**head, "type": "friction", "joint": e.joint.name, "mu_static": e.mu_static, "mu_dynamic": e.mu_dynamic,
+             "preload": e.preload}
+        for k in ("pin_radius", "friction_arm", "bending_arm", "effective_length", "reaction_arm"):
+            _put(d, k, getattr(e, k))
+        return d
+    raise ModelError(f"element '{e.name}'", "type", f"{type(e).__name__} cannot be stored in a model file")
+
+
+def model_to_dict(model) -> dict:
+    """Plain data (SI numbers, expression strings) describing `model` in the model-file schema."""
+    bodies = [b for b in model.bodies.values() if not b.is_ground]
+    d = {"name": model.name, "gravity": _vec(model.gravity),
+         "bodies": [_body(b) for b in bodies if not b.is_particle],
+         "particles": [_body(b) for b in bodies if b.is_particle],
+         "joints": [_joint(j) for j in model.joints.values()]
+         + [_path(p) for p in getattr(model, "path_constraints", {}).values()],
+         "motions": [_motion(m) for m in model.motions.values()],
+         "forces": [_element(e) for e in model.forces.values()]}
+    return {k: v for k, v in d.items() if v != [] or k == "bodies"}

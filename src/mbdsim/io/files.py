@@ -1,0 +1,113 @@
+"""Reading and writing model files: YAML (safe loader only, no tags) and JSON, chosen by extension.
+
+YAML is composed into a node tree first: every key's line is recorded (for error messages), any tag
+other than the plain YAML types (``!!python/object``, ``!custom``...) and duplicate keys are refused,
+and only then is the tree turned into plain data by the safe constructor.  Nothing in a model file
+can run code.
+"""
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from ..errors import ModelFileError
+
+PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "map", "seq")}
+YAML_SUFFIXES, JSON_SUFFIXES = (".yaml", ".yml"), (".json",)
+
+
+def file_kind(path: Path, entity: str = "file") -> str:
+    """'yaml' or 'json' from the extension, else ModelFileError."""
+    suffix = path.suffix.lower()
+    if suffix in YAML_SUFFIXES:
+        return "yaml"
+    if suffix in JSON_SUFFIXES:
+        return "json"
+    raise ModelFileError(entity, "path", f"unknown model file extension {suffix!r}; use .yaml, .yml or .json",
+                         str(path))
+
+
+def _walk(node, path, marks, source):
+    """Record the line of every key/item under `node` and refuse tags and duplicate keys."""
+    import yaml
+    if node.tag not in PLAIN_TAGS:
+        raise ModelFileError("file", "/".join(map(str, path)) or "(top level)",
+                             f"YAML tag {node.tag!r} is not allowed in a model file (plain data only)",
+                             source, node.start_mark.line + 1)
+    if isinstance(node, yaml.MappingNode):
+        seen = set()
+        for key, value in node.value:
+            if not isinstance(key, yaml.ScalarNode):
+                raise ModelFileError("file", "/".join(map(str, path)) or "(top level)", "keys must be plain names",
+                                     source, key.start_mark.line + 1)
+            if key.value in seen:
+                raise ModelFileError("file", key.value, f"duplicate key {key.value!r}", source,
+                                     key.start_mark.line + 1)
+            seen.add(key.value)
+            sub = path + (key.value,)
+            marks[sub] = key.start_mark.line + 1
+            _walk(key, sub, {}, source)
+            _walk(value, sub, marks, source)
+    elif isinstance(node, yaml.SequenceNode):
+        for k, item in enumerate(node.value):
+            marks[path + (k,)] = item.start_mark.line + 1
+            _walk(item, path + (k,), marks, source)
+
+
+def parse_yaml(text: str, source: str):
+    """(data, marks) from YAML text: marks maps a key path ('joints', 2, 'body_i') to its line."""
+    import yaml
+    loader = yaml.SafeLoader(text)
+    try:
+        node = loader.get_single_node()
+        marks: dict = {}
+        if node is None:
+            raise ModelFileError("file", "(top level)", "the file is empty", source)
+        _walk(node, (), marks, source)
+        data = loader.construct_document(node)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        problem = getattr(exc, "problem", None) or str(exc)
+        raise ModelFileError("file", "(syntax)", f"YAML syntax error: {problem}", source,
+                             None if mark is None else mark.line + 1) from None
+    finally:
+        loader.dispose()
+    return data, marks
+
+
+def parse_json(text: str, source: str):
+    """(data, marks) from JSON text; line marks come from reading the same text as YAML where it can."""
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ModelFileError("file", "(syntax)", f"JSON syntax error: {exc.msg}", source, exc.lineno) from None
+    try:
+        _, marks = parse_yaml(text, source)
+    except ModelFileError:
+        marks = {}
+    return data, marks
+
+
+def read(path) -> tuple:
+    """(data, marks, source) of a model file; source is the file name used in messages."""
+    path = Path(path)
+    kind = file_kind(path)
+    source = path.name
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: {exc}", source) from None
+    data, marks = (parse_yaml if kind == "yaml" else parse_json)(text, source)
+    return data, marks, source
+
+
+def write(data: dict, path) -> Path:
+    """Write model data as YAML or JSON (by extension); returns the path."""
+    path = Path(path)
+    if file_kind(path) == "json":
+        text = json.dumps(data, indent=2, allow_nan=False) + "\n"
+    else:
+        import yaml
+        text = yaml.safe_dump(data, sort_keys=False, default_flow_style=None, width=110, allow_unicode=True)
+    path.write_text(text, encoding="utf-8")
+    return path

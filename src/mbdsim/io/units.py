@@ -1,0 +1,86 @@
+"""Quantities with units at the edge of mbdsim: strings such as "500 mm", "60 deg/s", "3 kN/m" -> SI floats.
+
+One pint ``UnitRegistry`` is created on first use (pint is imported only when a string needs it).  A
+bare number is taken as SI already.  Every conversion checks the dimension against the field's SI
+unit, so "2 kg" for a length is an error naming the field.  Angles are dimensionless in pint:
+"30 deg" converts to 0.5236 rad, a bare number is in radians.
+"""
+from __future__ import annotations
+
+import math
+import numbers
+from functools import lru_cache
+
+__all__ = ["UnitError", "registry", "to_si", "dimension_name"]
+
+# SI units of the fields of a model file and the words used for them in messages.
+DIMENSION_NAMES = {
+    "m": "a length", "kg": "a mass", "kg*m**2": "an inertia", "rad": "an angle", "m/s": "a velocity",
+    "rad/s": "an angular velocity", "m/s**2": "an acceleration", "N": "a force", "N*m": "a torque",
+    "N/m": "a stiffness", "N*s/m": "a damping", "N*m/rad": "a rotational stiffness",
+    "N*m*s/rad": "a rotational damping", "kg/m**3": "a density", "s": "a time", "": "a pure number",
+    "rad/s**2": "an angular acceleration",
+}
+
+
+class UnitError(ValueError):
+    """A value that is not a number or a quantity of the expected dimension (message names the value)."""
+
+
+@lru_cache(maxsize=1)
+def registry():
+    """The one pint UnitRegistry of mbdsim (created lazily; 'rpm' is revolutions per minute)."""
+    import pint
+    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
+    return ureg
+
+
+def dimension_name(unit: str) -> str:
+    """'a length [m]' for unit 'm' (used in error messages)."""
+    what = DIMENSION_NAMES.get(unit, "a quantity")
+    return f"{what} [{unit}]" if unit else what
+
+
+@lru_cache(maxsize=256)
+def _convert(text: str, unit: str) -> float:
+    ureg = registry()
+    import pint
+    try:
+        q = ureg.Quantity(text)
+    except Exception as exc:  # noqa: BLE001 - pint's own parser (never eval) fails in many ways on garbage
+        raise UnitError(f"cannot read {text!r} as a number with units ({type(exc).__name__}: {exc})") from None
+    if not isinstance(q, ureg.Quantity):   # a plain number written as a string
+        q = ureg.Quantity(float(q))
+    target = ureg.Quantity(1.0, unit) if unit else ureg.Quantity(1.0)
+    if q.dimensionality != target.dimensionality:
+        got = "dimensionless" if q.dimensionless else str(q.dimensionality)
+        raise UnitError(f"{text!r} is not {dimension_name(unit)}: its dimension is {got}")
+    try:
+        x = float(q.to(target.units).magnitude)
+    except pint.errors.PintError as exc:
+        raise UnitError(f"cannot convert {text!r} to {unit or 'a pure number'}: {exc}") from None
+    if not math.isfinite(x):
+        raise UnitError(f"{text!r} is not finite")
+    return x
+
+
+def to_si(value, unit: str) -> float:
+    """A number (taken as SI) or a string with units -> float in `unit` (an SI unit such as "m", "N*m/rad").
+
+    Raises UnitError for booleans, non-numbers, non-finite values and wrong dimensions."""
+    if isinstance(value, bool):
+        raise UnitError(f"expected {dimension_name(unit)}, got the boolean {value!r}")
+    if isinstance(value, numbers.Real):
+        x = float(value)
+        if not math.isfinite(x):
+            raise UnitError(f"must be finite, got {value!r}")
+        return x
+    if isinstance(value, str):
+        if len(value) > 200:
+            raise UnitError(f"a quantity string is at most 200 characters, got {len(value)}")
+        try:
+            x = float(value)   # a bare number written as a string is SI too
+        except ValueError:
+            return _convert(value.strip(), unit)
+        return to_si(x, unit)
+    raise UnitError(f"expected {dimension_name(unit)} (a number in SI or a string with units), got {value!r}")
