@@ -253,6 +253,10 @@ from mbdsim.cli import view_cmds as _view_cmds  # noqa: E402 - plot, animate
 
 _view_cmds.register(app)
 
+from mbdsim.cli import run_cmds as _run_cmds  # noqa: E402 - run, info, schema (model files)
+
+_run_cmds.register(app)
+
 
 def main(argv: Optional[List[str]] = None) -> None:
     """Console-script entry point (``mbdsim = "mbdsim.cli.app:main"``)."""

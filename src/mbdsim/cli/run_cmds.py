@@ -1,0 +1,207 @@
+"""``mbdsim run``, ``mbdsim info`` and ``mbdsim schema``: model files from the shell.
+
+Commands::
+
+    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--debug]
+    mbdsim info MODEL [--debug]
+    mbdsim schema [--out schema.json]
+
+Exit status: 0 success; 1 the analysis failed (assembly, lock-up, solver) or an output file could not be
+written; 2 bad input (arguments, unreadable or invalid model file); 130 interrupted (Ctrl-C).  Errors
+are one line on stderr; ``--debug`` shows the traceback.  Only typer is imported here: the engine,
+rich, pydantic and pandas load when a command runs, so ``mbdsim --help`` stays fast.
+"""
+from __future__ import annotations
+
+import sys
+import time
+import warnings
+from pathlib import Path
+from typing import Optional
+
+import typer
+
+EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
+OUT_SUFFIXES = (".parquet", ".csv")
+
+MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml or .json).")
+DEBUG_OPT = typer.Option(False, "--debug", help="Show the Python traceback of an error.")
+
+
+def _console():
+    from rich.console import Console
+    return Console(stderr=True, highlight=False, width=None if sys.stderr.isatty() else 120)
+
+
+def _fail(message: str, code: int) -> None:
+    from rich.markup import escape
+    _console().print(f"[bold red]error:[/] {escape(message)}")
+    raise typer.Exit(code)
+
+
+def _guard(fn, debug: bool):
+    """Run fn() mapping errors to exit codes: bad input 2, analysis failure 1, Ctrl-C 130."""
+    from mbdsim.errors import AssemblyError, ModelError, SolverError
+    try:
+        return fn()
+    except typer.Exit:
+        raise
+    except KeyboardInterrupt:
+        if debug:
+            raise
+        _fail("interrupted", EXIT_INTERRUPTED)
+    except ModelError as exc:
+        if debug:
+            raise
+        _fail(str(exc), EXIT_BAD_INPUT)
+    except (AssemblyError, SolverError) as exc:
+        if debug:
+            raise
+        _fail(f"analysis failed: {exc}", EXIT_FAILED)
+    except Exception as exc:  # noqa: BLE001 - one line instead of a bare traceback
+        if debug:
+            raise
+        _fail(f"{type(exc).__name__}: {exc} (run with --debug for the traceback)", EXIT_FAILED)
+
+
+def _load(path: Path):
+    import mbdsim as mb
+    if not path.is_file():
+        _fail(f"model file {str(path)!r} does not exist", EXIT_BAD_INPUT)
+    return mb.load_model(path)
+
+
+def _rank_dof(model):
+    """(DOF by the rank of the constraint Jacobian, independent rows dropped, joints in redundant rows)."""
+    import mbdsim as mb
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
+        rep = mb.assemble(model)
+    return rep.dof, rep.system.nc - len(rep.rows), list(rep.redundant)
+
+
+def run_cmd(
+    model: Path = MODEL_ARG,
+    end: float = typer.Option(..., "--end", "-e", metavar="T", help="End time in s."),
+    step: Optional[float] = typer.Option(None, "--step", "-s", metavar="DT", help="Output step in s (default: end/500)."),
+    method: Optional[str] = typer.Option(None, "--method", "-m", metavar="M",
+                                         help="auto (default), dop853, hht, rk45, radau or bdf."),
+    rtol: Optional[float] = typer.Option(None, "--rtol", metavar="R", help="Relative tolerance (default 1e-8)."),
+    out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
+                                       help="Write the results table (res.to_dataframe()) to .parquet or .csv."),
+    debug: bool = DEBUG_OPT,
+) -> None:
+    """Simulate a model file and print a summary; optionally write the results table.
+
+    Example: mbdsim run examples/slider_crank.yaml --end 2 --step 0.01 --out results.parquet
+
+    Exit status: 0 ok, 1 analysis failed, 2 bad input or model file, 130 interrupted."""
+    if out is not None and out.suffix.lower() not in OUT_SUFFIXES:
+        _fail(f"--out {str(out)!r}: expected a .parquet or .csv file", EXIT_BAD_INPUT)
+    if not end > 0:
+        _fail(f"--end must be > 0, got {end!r}", EXIT_BAD_INPUT)
+    _guard(lambda: _run(model, end, step, method, rtol, out), debug)
+
+
+def _run(path, end, step, method, rtol, out):
+    import mbdsim as mb
+    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from mbdsim.io.summary import summarize
+    m = _load(path)
+    summary = summarize(m)
+    dof, n_redundant, redundant = _rank_dof(m)
+    console = _console()
+    t0 = time.perf_counter()
+    with warnings.catch_warnings(), Progress(TextColumn(f"simulating {m.name}"), BarColumn(), TextColumn("t = {task.completed:.4g} s"),
+                  TimeElapsedColumn(), console=console, transient=True) as bar:
+        warnings.simplefilter("ignore", mb.RedundantConstraintWarning)   # reported in the summary
+        task = bar.add_task("run", total=end)
+        res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol,
+                          progress=lambda t: bar.update(task, completed=min(float(t), end)))
+        bar.update(task, completed=float(res.time[-1]))
+    wall = time.perf_counter() - t0
+    stats = res.stats or {}
+    rows = [("model", f"{m.name} ({path})"), ("DOF (Gruebler)", str(summary.gruebler_dof)),
+            ("DOF (rank)", str(dof)),
+            ("redundant constraints", f"{n_redundant}" + (f" among {', '.join(redundant)}" if redundant else "")),
+            ("method", str(stats.get("method", method or "auto"))), ("steps", str(stats.get("steps", "?"))),
+            ("simulated", f"{res.time[0]:.6g} .. {res.time[-1]:.6g} s, {len(res.time)} samples"),
+            ("wall time", f"{wall:.3f} s"), ("success", f"{res.success} ({res.message})")]
+    _print_table(f"mbdsim run: {m.name}", rows)
+    if out is not None:
+        _write(res, out)
+    if not res.success:
+        raise typer.Exit(EXIT_FAILED)
+
+
+def _write(res, out: Path) -> None:
+    df = res.to_dataframe()
+    try:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        df.to_parquet(out) if out.suffix.lower() == ".parquet" else df.to_csv(out, index=False)
+    except OSError as exc:
+        _fail(f"cannot write {str(out)!r}: {exc}", EXIT_FAILED)
+    _console().print(f"results: {out} ({len(df)} rows, {len(df.columns)} columns)")
+
+
+def _print_table(title, rows, headers=("", "")):
+    from rich.console import Console
+    from rich.table import Table
+    t = Table(title=title, show_header=any(headers), header_style="bold")
+    for h in headers:
+        t.add_column(h)
+    for r in rows:
+        t.add_row(*r)
+    Console(highlight=False, width=None if sys.stdout.isatty() else 120).print(t)
+
+
+def info_cmd(model: Path = MODEL_ARG, debug: bool = DEBUG_OPT) -> None:
+    """Describe a model file: bodies, joints, degrees of freedom, drivers and force elements.
+
+    Example: mbdsim info examples/four_bar.yaml
+
+    Exit status: 0 ok, 1 the model does not assemble, 2 bad input or model file."""
+    _guard(lambda: _info(model), debug)
+
+
+def _info(path):
+    from mbdsim.io.summary import summarize
+    m = _load(path)
+    s = summarize(m)
+    dof, n_redundant, redundant = _rank_dof(m)
+    _print_table(f"{m.name}: bodies", [(n, k, f"{mass:.6g} kg") for n, k, mass in s.bodies], ("name", "kind", "mass"))
+    _print_table("joints", [(n, k, f"{bi} -> {bj}", str(nc)) for n, k, bi, bj, nc in s.joints],
+                 ("name", "type", "bodies", "constraints"))
+    if s.drivers:
+        _print_table("drivers", [(n, j, k, d) for n, j, k, d in s.drivers], ("name", "joint", "kind", "function"))
+    if s.elements:
+        _print_table("force elements", s.elements, ("name", "kind"))
+    _print_table("mobility", [("DOF (Gruebler)", str(s.gruebler_dof)), ("DOF (rank)", str(dof)),
+                              ("redundant constraints", str(n_redundant) + (f" among {', '.join(redundant)}"
+                                                                            if redundant else ""))])
+
+
+def schema_cmd(out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
+                                                  help="Write the schema to FILE instead of printing it.")) -> None:
+    """Print the JSON Schema of model files (for editors and validators).
+
+    Example: mbdsim schema --out mbdsim-model.schema.json"""
+    import json
+
+    from mbdsim.io import json_schema
+    text = json.dumps(json_schema(), indent=2)
+    if out is None:
+        typer.echo(text)
+        return
+    try:
+        out.write_text(text + "\n", encoding="utf-8")
+    except OSError as exc:
+        _fail(f"cannot write {str(out)!r}: {exc}", EXIT_FAILED)
+
+
+def register(app: typer.Typer) -> None:
+    """Add run, info and schema to the mbdsim Typer app."""
+    app.command("run")(run_cmd)
+    app.command("info")(info_cmd)
+    app.command("schema")(schema_cmd)

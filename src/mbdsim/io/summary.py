@@ -1,0 +1,51 @@
+"""Counts of a model for `mbdsim info` / `mbdsim run`: entities, drivers and the Gruebler mobility."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+# constraints a joint removes between two rigid bodies, and its translational part (what a particle feels)
+TRANSLATION_CONSTRAINTS = {"revolute": 3, "translational": 2, "cylindrical": 2, "spherical": 3, "universal": 3,
+                           "planar": 1, "fixed": 3}
+
+
+@dataclass
+class ModelSummary:
+    """Entity counts and Gruebler's (Kutzbach's) mobility 6 n_rigid + 3 n_particles - constraints."""
+
+    name: str
+    bodies: list = field(default_factory=list)       # (name, kind, mass [kg])
+    joints: list = field(default_factory=list)       # (name, kind, body_i, body_j, constraints)
+    drivers: list = field(default_factory=list)      # (name, joint, kind, expression text)
+    elements: list = field(default_factory=list)     # (name, kind)
+    gruebler_dof: int = 0
+
+
+def joint_constraints(kind: str, particle: bool) -> int:
+    """Equations a joint of `kind` removes (only the translational ones when a particle is involved)."""
+    from ..model.joints import JOINT_DOF
+    return TRANSLATION_CONSTRAINTS[kind] if particle else 6 - JOINT_DOF[kind]
+
+
+def summarize(model) -> ModelSummary:
+    """The ModelSummary of `model` (no analysis run)."""
+    s = ModelSummary(model.name)
+    mobility = 0
+    for b in model.bodies.values():
+        if b.is_ground:
+            continue
+        s.bodies.append((b.name, "particle" if b.is_particle else "body", float(b.mass)))
+        mobility += 3 if b.is_particle else 6
+    for j in model.joints.values():
+        nc = joint_constraints(j.kind, j.body_i.is_particle or j.body_j.is_particle)
+        s.joints.append((j.name, j.kind, j.body_i.name, j.body_j.name, nc))
+        mobility -= nc
+    for p in getattr(model, "path_constraints", {}).values():
+        s.joints.append((p.name, "point_on_curve", p.marker.body.name, p.body.name, 2))   # 3 rows, 1 new coordinate
+        mobility -= 2
+    for m in model.motions.values():
+        s.drivers.append((m.name, m.joint.name, m.kind, m.function.description))
+        mobility -= 1
+    for e in model.forces.values():
+        s.elements.append((e.name, type(e).__name__))
+    s.gruebler_dof = mobility
+    return s
