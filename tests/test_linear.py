@@ -267,3 +267,27 @@ def test_bad_arguments_name_the_field():
     with pytest.raises(mb.ModelError) as err:
         lin.mode_shape(5)
     assert err.value.field == "i"
+
+
+def test_motion_input_is_the_base_acceleration_of_a_shaken_oscillator():
+    """Base driven along x (motion input: its acceleration), mass on a spring-damper to the base:
+    X / U = (c s + k) / (s^2 (m s^2 + c s + k)); the base itself 1 / s^2."""
+    m, k, c = 0.5, 200.0, 3.0
+    model = mb.Model("shaker", gravity=(0.0, -G, 0.0))
+    base = model.add_body("base", 4.0, inertia=(0.1, 0.1, 0.1))
+    rail = model.add_translational("rail", model.ground, base, (0, 0, 0), (1, 0, 0))
+    model.add_motion("shake", rail, displacement=0.0)
+    p = model.add_particle("mass", m, position=(0.5, 0, 0))
+    model.add_translational("slide", model.ground, p, (0.5, 0, 0), (1, 0, 0))
+    model.add_spring_damper("kc", base, p, k, damping=c)
+    lin = mb.linearize(model, inputs=["shake"], outputs={"x": lambda r: r.position(p)[:, 0],
+                                                          "b": lambda r: r.position(base)[:, 0],
+                                                          "b_acc": lambda r: r.acceleration(base)[:, 0]})
+    assert lin.A.shape == (4, 4) and lin.input_names == ["shake [m/s^2]"]
+    row = lin.modes().iloc[0]
+    assert len(lin.modes()) == 1 and row["damping ratio"] == pytest.approx(c / (2 * np.sqrt(k * m)), rel=1e-7)
+    for s in (3j, 25j, 0.5 + 8j):
+        H = lin.C @ np.linalg.solve(s * np.eye(4) - lin.A, lin.B) + lin.D
+        assert H[0, 0] == pytest.approx((c * s + k) / (s**2 * (m * s**2 + c * s + k)), rel=1e-6)
+        assert H[1, 0] == pytest.approx(1 / s**2, rel=1e-8)
+        assert H[2, 0] == pytest.approx(1.0, rel=1e-8)

@@ -21,11 +21,15 @@ differentiated by central differences, steps h_z = 1e-5 min(L, 1) and h_y = 1e-5
 (L: the model's length scale), error about 1e-10 relative. The basis is frozen at t0: a reference
 motion whose tangent space turns (a driven mechanism moving) is linearized at that instant.
 
-Inputs (B, D) are loads: the three components, in the element's axes (ground when it has no frame), of
-an extra force [N] or torque [N m] added to an `add_force` / `add_torque` element ("push" gives
-"push.x", "push.y", "push.z"; "push.y" that one alone); B is exact (the load enters the KKT solve
-linearly). Outputs (C, D) are callables of a Result evaluated on one-sample Results (central
-differences, the same steps; inputs step 1e-4 max(1, |load|)).
+Inputs (B, D) are loads or motions. A load input is one component, in the element's axes (ground when
+it has no frame), of an extra force [N] or torque [N m] on an `add_force` / `add_torque` element ("push"
+gives "push.x", "push.y", "push.z"; "push.y" that one alone). A motion input is the acceleration
+[rad/s^2 or m/s^2] added to the driven coordinate: the driver row becomes phi = delta_m, phi_q v = nu +
+delta_m', gamma + u, and the state gains (delta_m, delta_m') after the mechanical states (so the model is
+proper; a displacement transfer function is the acceleration one times s^2). Both enter linearly;
+B and D by central differences (steps 1e-4 max(1, |load|), 1 for accelerations), exact up to round-off.
+Outputs (C, D) are callables of a Result evaluated on one-sample Results (central differences, the
+steps above). `eigenvalues` and `modes()` use the mechanical block (motion inputs only add zeros).
 """
 from __future__ import annotations
 
@@ -43,7 +47,7 @@ from ..system.equations import constraint_terms
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
 from .assembly import assemble_state
-from .common import independent_rows, project_velocities
+from .common import independent_rows, min_norm_solve
 from .linear_modes import mode_shape_table, modes_table
 from .reduced import Chart, length_scale, tangent_basis
 from .state import state_factory
@@ -77,9 +81,17 @@ class Linearization:
         return self.basis.shape[1]
 
     @property
+    def A_mechanical(self) -> np.ndarray:
+        """The block of A on the 2 d mechanical states (without the states of motion inputs)."""
+        n = 2 * self.dof
+        return self.A[:n, :n]
+
+    @property
     def eigenvalues(self) -> np.ndarray:
-        """Eigenvalues of A [rad/s], complex, ordered by magnitude."""
-        lam = np.linalg.eigvals(self.A) if self.A.size else np.zeros(0, complex)
+        """Eigenvalues [rad/s] of the mechanical block of A (motion inputs only add zeros), complex,
+        ordered by magnitude."""
+        A = self.A_mechanical
+        lam = np.linalg.eigvals(A) if A.size else np.zeros(0, complex)
         return lam[np.argsort(np.abs(lam), kind="stable")]
 
     def modes(self, zero_tol=None):
@@ -110,52 +122,88 @@ def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
     at: None (the assembled initial state at t = 0), "equilibrium" (static equilibrium first,
     `mb.equilibrium`), a Result (its last sample) or (result, t) (the result at time t [s], dense output).
     inputs: names of `add_force` / `add_torque` elements ("f" for its three components, "f.x" for one; in
-    the element's axes, ground when it has none) [N, N m]. outputs: callables of a Result returning one
-    sample (e.g. `lambda r: r.position(tip)[:, 1]`), or a dict name -> callable. See the module docstring
-    for the coordinates and the finite-difference steps."""
+    the element's axes, ground when it has none) [N, N m], or of motions (the acceleration [rad/s^2 or
+    m/s^2] added to the driven coordinate; each adds two states, the displacement and rate offsets, after
+    the mechanical ones). outputs: callables of a Result returning one sample (e.g.
+    `lambda r: r.position(tip)[:, 1]`), or a dict name -> callable. See the module docstring for the
+    coordinates and the finite-difference steps."""
     sys, q0, v0, t0 = _operating_point(model, at)
     _, J, _, _ = constraint_terms(sys, q0, v0, t0)
     rows = independent_rows(J[sys.fixed_rows], sys=sys)
-    sf = state_factory(sys)
+    ins = _inputs(model, sys, inputs, rows)
     N = tangent_basis(sys, q0, t0, rows)
-    d = N.shape[1]
-    chart = Chart(sys, q0, t0, rows, N)
-    G = _to_ground(sys, q0, N)
-    u0 = _to_ground(sys, q0, v0)
+    d, nm, nu = N.shape[1], sum(i.row >= 0 for i in ins), len(ins)
+    nx = 2 * d + 2 * nm
+    G, u0 = _to_ground(sys, q0, N), _to_ground(sys, q0, v0)
     L = min(length_scale(sys, q0), 1.0)
     hz, hy = FD_REL * L, FD_REL * max(L, float(np.max(np.abs(u0), initial=0.0)))
-    loads, in_names = _inputs(model, inputs)
-    out_fns, out_names = _outputs(outputs)
+    state = _StateMap(sys, Chart(sys, q0, t0, rows, N), G, u0, state_factory(sys), ins, d)
+    a0 = _to_ground(sys, q0, state(np.zeros(nx))[2])
 
-    def state(x, du=None):
-        q = chart.q(x[:d]) if d else q0
-        v = project_velocities(sys, q, _to_body(sys, q, u0 + G @ x[d:]), t0, rows)
-        Qx = _input_load(sys, q, v, t0, loads, du)
-        vd, lam = _kkt(sys, q, v, t0, rows, sf, Qx)
-        return q, v, vd, lam
-
-    def rate(x):
-        q, v, vd, _ = state(x)
+    def rate(x, du=None):
+        q, _, vd, _ = state(x, du)
         return G.T @ (_to_ground(sys, q, vd) - a0)
 
-    a0 = _to_ground(sys, q0, state(np.zeros(2 * d))[2])
-    A = np.zeros((2 * d, 2 * d))
-    A[:d, d:] = np.eye(d)
+    steps = np.r_[np.full(d, hz), np.full(d, hy), np.full(nm, hz), np.full(nm, hy)]
+    A = np.zeros((nx, nx))
+    A[:d, d:2 * d] = np.eye(d)
     A[:d, :d] = G.T @ _spin_matrix(sys, q0, v0) @ G
-    for k in range(2 * d):
-        h = hz if k < d else hy
-        e = np.zeros(2 * d)
-        e[k] = h
-        A[d:, k] = (rate(e) - rate(-e)) / (2 * h)
-    B = np.zeros((2 * d, len(loads)))
-    fr0 = body_frames(sys, q0, v0)
-    for k, ld in enumerate(loads):
-        J0 = constraint_terms(sys, q0, v0, t0)[1][rows]
-        vd = solve_kkt(sys.M, J0, _unit_load(sys, fr0, t0, ld), np.zeros(len(rows)))[0]
-        B[d:, k] = G.T @ _to_ground(sys, q0, vd)
-    C, D, y0, sizes = _output_matrices(sys, t0, state, out_fns, 2 * d, len(loads), hz, hy, d, loads)
-    names = [nm if n == 1 else f"{nm}[{i}]" for nm, n in zip(out_names, sizes) for i in range(n)]
-    return Linearization(A, B, C, D, t0, q0, v0, G, sys, in_names, names, y0)
+    A[2 * d:2 * d + nm, 2 * d + nm:] = np.eye(nm)
+    A[d:2 * d] = _central(rate, nx, steps, d)
+    B = np.zeros((nx, nu))
+    for k, m in enumerate(i for i in range(nu) if ins[i].row >= 0):
+        B[2 * d + nm + k, m] = 1.0
+    isteps = np.array([i.step for i in ins])
+    B[d:2 * d] = _central(lambda e: rate(np.zeros(nx), e), nu, isteps, d)
+    fns, names = _outputs(outputs)
+    y0, sizes = _measure(sys, t0, fns, state(np.zeros(nx)))
+    C = _central(lambda e: _measure(sys, t0, fns, state(e))[0], nx, steps, len(y0))
+    D = _central(lambda e: _measure(sys, t0, fns, state(np.zeros(nx), e))[0], nu, isteps, len(y0))
+    out_names = [nm_ if n == 1 else f"{nm_}[{i}]" for nm_, n in zip(names, sizes) for i in range(n)]
+    return Linearization(A, B, C, D, t0, q0, v0, G, sys, [i.name for i in ins], out_names, y0)
+
+
+def _central(fn, n, steps, rows):
+    """(rows, n) matrix of columns (fn(h e_k) - fn(-h e_k)) / 2 h."""
+    cols = []
+    for k in range(n):
+        e = np.zeros(n)
+        e[k] = steps[k]
+        cols.append((np.asarray(fn(e)) - np.asarray(fn(-e))) / (2 * steps[k]))
+    return np.array(cols).T if cols else np.zeros((rows, 0))
+
+
+@dataclass
+class _Input:
+    name: str
+    elem: object = None        # Force or Torque (loads)
+    comp: int = 0              # load component 0..2
+    row: int = -1              # constraint row of a motion input (-1 for loads)
+    step: float = 1.0          # finite-difference step [N, N m, rad/s^2, m/s^2]
+
+
+class _StateMap:
+    """x = (z, y, motion offsets, their rates), du (inputs) -> (q, v, vd, lambda_) at the operating time."""
+
+    def __init__(self, sys, chart, G, u0, sf, ins, d):
+        self.sys, self.chart, self.G, self.u0, self.sf, self.ins, self.d = sys, chart, G, u0, sf, ins, d
+        self.mrows = np.array([i.row for i in ins if i.row >= 0], dtype=int)
+
+    def __call__(self, x, du=None):
+        sys, d, c, nm = self.sys, self.d, self.chart, len(self.mrows)
+        du = np.zeros(len(self.ins)) if du is None else du
+        off = np.zeros((3, sys.nc))
+        off[0, self.mrows], off[1, self.mrows] = x[2 * d:2 * d + nm], x[2 * d + nm:]
+        off[2, self.mrows] = [s for s, i in zip(du, self.ins) if i.row >= 0]
+        q = c.q(x[:d], offset=off[0] if nm else None) if d or nm else c.q0
+        v = _project_velocities(sys, q, _to_body(sys, q, self.u0 + self.G @ x[d:2 * d]), c.t, c.rows, off[1])
+        Qx = np.zeros(sys.nv)
+        if np.any(du):
+            fr = body_frames(sys, q, v)
+            for s, i in zip(du, self.ins):
+                if s and i.row < 0:
+                    Qx += _unit_load(sys, fr, c.t, i, float(s))
+        return (q, v) + _kkt(sys, q, v, c.t, c.rows, self.sf, Qx, off[2])
 
 
 # ----------------------------------------------------------------------------- operating point
@@ -212,13 +260,14 @@ def _spin_matrix(sys, q, v):
 
 
 # ----------------------------------------------------------------------------- equations of motion
-def _kkt(sys, q, v, t, rows, sf, Qx):
-    """vd (body-axes angular parts) and multipliers of all rows (minimum norm), with extra load Qx."""
+def _kkt(sys, q, v, t, rows, sf, Qx, dgamma):
+    """vd (body-axes angular parts) and multipliers of all rows (minimum norm), with extra load Qx and
+    extra acceleration right-hand side dgamma (nc) of the motion inputs."""
     fr = body_frames(sys, q, v)
     Q = applied_forces(sys, fr, t, sf(t, q, v) if sf else None) + Qx
     _, J, _, gamma = constraint_terms(sys, q, v, t)
     try:
-        vd = solve_kkt(sys.M, J[rows], Q, gamma[rows])[0]
+        vd = solve_kkt(sys.M, J[rows], Q, (gamma + dgamma)[rows])[0]
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise SolverError(f"linearize: singular equations of motion ({exc}); massless bodies need a mass "
                           "matrix positive on the free motions", time=t) from None
@@ -229,50 +278,51 @@ def _kkt(sys, q, v, t, rows, sf, Qx):
     return vd, lam
 
 
+def _project_velocities(sys, q, v, t, rows, dnu):
+    """Minimum-norm correction of v so that phi_q v = nu + dnu on the rows (dnu: motion-input rates)."""
+    _, J, nu, _ = constraint_terms(sys, q, v, t)
+    J, nu = J[rows], (nu + dnu)[rows]
+    return v - min_norm_solve(J, J @ v - nu) if len(nu) else v
+
+
 # ----------------------------------------------------------------------------- inputs
-def _inputs(model, inputs):
-    """[(element, component 0..2)], names."""
+def _inputs(model, sys, inputs, rows):
+    """[_Input] for load components and motions, in the order given."""
     if isinstance(inputs, str):
         inputs = (inputs,)
-    loads, names = [], []
+    out = []
     for spec in inputs:
         if not isinstance(spec, str):
-            raise ModelError("linearize", "inputs", f"expected load names (str), got {spec!r}")
+            raise ModelError("linearize", "inputs", f"expected load or motion names (str), got {spec!r}")
+        if spec in model.motions:
+            mo = model.motions[spec]
+            row = sys.owner_rows[spec][0]
+            if row not in rows:
+                raise ModelError("linearize", "inputs", f"motion {spec!r} is redundant with the joints here")
+            unit = "rad/s^2" if mo.dof == "rotation" else "m/s^2"
+            out.append(_Input(f"{spec} [{unit}]", row=row, step=1.0))
+            continue
         name, _, comp = spec.partition(".")
         elem = model.forces.get(name)
         if not isinstance(elem, (Force, Torque)):
-            raise ModelError("linearize", "inputs", f"{name!r} is not a force or torque of model "
-                             f"'{model.name}' (add_force / add_torque); motions cannot be inputs yet")
+            raise ModelError("linearize", "inputs", f"{name!r} is neither a force or torque (add_force / "
+                             f"add_torque) nor a motion of model '{model.name}'")
         if comp and comp not in "xyz" or len(comp) > 1:
             raise ModelError("linearize", "inputs", f"{spec!r}: the component must be x, y or z")
         unit = "N" if isinstance(elem, Force) else "N m"
+        val = elem.force if isinstance(elem, Force) else elem.torque
+        step = 1e-4 * max(1.0, float(np.max(np.abs(val))) if not callable(val) else 1.0)
         for c in ("xyz".index(comp),) if comp else range(3):
-            loads.append((elem, c))
-            names.append(f"{name}.{'xyz'[c]} [{unit}]")
-    return loads, names
+            out.append(_Input(f"{name}.{'xyz'[c]} [{unit}]", elem, c, -1, step))
+    return out
 
 
-def _unit_load(sys, fr, t, load, size=1.0):
-    """Generalized force Q (nv) of `size` along component c of element `elem` (its axes)."""
-    elem, c = load
+def _unit_load(sys, fr, t, inp, size=1.0):
+    """Generalized force Q (nv) of `size` along component inp.comp of element inp.elem (its axes)."""
     e = np.zeros(3)
-    e[c] = size
-    tmp = dataclasses.replace(elem, **{"force" if isinstance(elem, Force) else "torque": e})
+    e[inp.comp] = size
+    tmp = dataclasses.replace(inp.elem, **{"force" if isinstance(inp.elem, Force) else "torque": e})
     return evaluator(tmp).generalized(sys, fr, tmp, t, None)
-
-
-def _input_load(sys, q, v, t, loads, du):
-    if du is None or not np.any(du):
-        return np.zeros(sys.nv)
-    fr = body_frames(sys, q, v)
-    return sum(_unit_load(sys, fr, t, ld, float(s)) for ld, s in zip(loads, du) if s)
-
-
-def _input_step(load, t):
-    elem, _ = load
-    val = elem.force if isinstance(elem, Force) else elem.torque
-    mag = float(np.max(np.abs(val))) if not callable(val) else 1.0
-    return 1e-4 * max(1.0, mag)
 
 
 # ----------------------------------------------------------------------------- outputs
@@ -290,30 +340,8 @@ def _outputs(outputs):
 
 
 def _measure(sys, t, fns, st):
+    """(outputs concatenated, size of each) on the one-sample Result of state st = (q, v, vd, lambda_)."""
     q, v, vd, lam = st
     res = Result(sys, [t], q[None], v[None], vd[None], lam[None])
-    vals = []
-    for f in fns:
-        vals.append(np.ravel(np.asarray(f(res), dtype=float)))
-    return vals
-
-
-def _output_matrices(sys, t, state, fns, nx, nu, hz, hy, d, loads):
-    if not fns:
-        return np.zeros((0, nx)), np.zeros((0, nu)), np.zeros(0), []
-    vals = _measure(sys, t, fns, state(np.zeros(nx)))
-    y0 = np.concatenate(vals)
-    C, D = np.zeros((len(y0), nx)), np.zeros((len(y0), nu))
-    for k in range(nx):
-        h = hz if k < d else hy
-        e = np.zeros(nx)
-        e[k] = h
-        C[:, k] = (np.concatenate(_measure(sys, t, fns, state(e))) -
-                   np.concatenate(_measure(sys, t, fns, state(-e)))) / (2 * h)
-    for k in range(nu):
-        h = _input_step(loads[k], t)
-        du = np.zeros(nu)
-        du[k] = h
-        D[:, k] = (np.concatenate(_measure(sys, t, fns, state(np.zeros(nx), du))) -
-                   np.concatenate(_measure(sys, t, fns, state(np.zeros(nx), -du)))) / (2 * h)
-    return C, D, y0, [len(v) for v in vals]
+    vals = [np.ravel(np.asarray(f(res), dtype=float)) for f in fns]
+    return (np.concatenate(vals) if vals else np.zeros(0)), [len(x) for x in vals]

@@ -55,7 +55,7 @@ def _kernel_shapes(A, d, ztol):
 def modes_table(lin, zero_tol=None):
     """(DataFrame of the modes, mode list)."""
     import pandas as pd
-    ml = mode_list(lin.A, lin.dof, zero_tol)
+    ml = mode_list(lin.A_mechanical, lin.dof, zero_tol)
     rows = []
     for lam, _ in ml:
         wn = abs(lam)
@@ -72,7 +72,7 @@ def mode_shape_table(lin, i, zero_tol=None):
     the largest entry (rotations weighted by the model's length) scaled to 1."""
     import pandas as pd
     from .reduced import length_scale
-    ml = mode_list(lin.A, lin.dof, zero_tol)
+    ml = mode_list(lin.A_mechanical, lin.dof, zero_tol)
     if not isinstance(i, (int, np.integer)) or not 0 <= i < len(ml):
         from ..errors import ModelError
         raise ModelError("mode_shape", "i", f"expected a mode number 0..{len(ml) - 1}, got {i!r}")

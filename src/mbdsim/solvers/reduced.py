@@ -17,7 +17,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..system.equations import constraint_terms
-from .common import increment, project_positions
+from .common import increment, min_norm_solve, project_positions
 
 
 def length_scale(sys, q) -> float:
@@ -60,14 +60,32 @@ class Chart:
     def dim(self) -> int:
         return self.N.shape[1]
 
-    def q(self, z, tol=1e-13) -> np.ndarray:
-        """Configuration at independent coordinates z; SolverError when the projection fails."""
-        q, res, _ = project_positions(self.sys, increment(self.sys, self.q0, self.N @ z), self.t, self.rows,
-                                      tol=tol, maxit=30)
+    def q(self, z, tol=1e-13, offset=None) -> np.ndarray:
+        """Configuration at independent coordinates z (on phi = offset, nc, when given: motion inputs);
+        SolverError when the projection fails."""
+        x = increment(self.sys, self.q0, self.N @ z) if len(z) else self.q0.copy()
+        if offset is None:
+            q, res, _ = project_positions(self.sys, x, self.t, self.rows, tol=tol, maxit=30)
+        else:
+            q, res = _project_offset(self.sys, x, self.t, self.rows, offset, tol)
         if res > 1e-9:
             raise SolverError(f"the constraints cannot be satisfied at this configuration (residual {res:.3g})",
                               time=self.t, state=q)
         return q
+
+
+def _project_offset(sys, q, t, rows, offset, tol, maxit=30):
+    """Newton (minimum-norm steps) onto phi(q, t) = offset on the rows; returns (q, residual)."""
+    zero = np.zeros(sys.nv)
+    res = np.inf
+    for _ in range(maxit):
+        phi, J, _, _ = constraint_terms(sys, q, zero, t)
+        r = (phi - offset)[rows]
+        res = float(np.max(np.abs(r), initial=0.0))
+        if res <= tol:
+            break
+        q = increment(sys, q, -min_norm_solve(J[rows], r))
+    return q, res
 
 
 def tangent_residual(sys, q, t, rows, Q):
