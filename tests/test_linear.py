@@ -291,3 +291,29 @@ def test_motion_input_is_the_base_acceleration_of_a_shaken_oscillator():
         assert H[0, 0] == pytest.approx((c * s + k) / (s**2 * (m * s**2 + c * s + k)), rel=1e-6)
         assert H[1, 0] == pytest.approx(1 / s**2, rel=1e-8)
         assert H[2, 0] == pytest.approx(1.0, rel=1e-8)
+
+
+def governor(W, l=0.5):
+    """Point mass on a hinge (axis z) carried round a vertical shaft driven at W [rad/s]."""
+    model = mb.Model("governor", gravity=(0.0, -G, 0.0))
+    shaft = model.add_body("shaft", 1.0, inertia=(0.1, 0.1, 0.1), angular_velocity=(0, W, 0))
+    bob = model.add_body("bob", 1.0, inertia=(0.0, 0.0, 0.0), position=(0, -l, 0), angular_velocity=(0, W, 0))
+    axle = model.add_revolute("axle", model.ground, shaft, (0, 0, 0), (0, 1, 0))
+    model.add_motion("spin", axle, displacement=f"{W}*t")
+    model.add_revolute("hinge", shaft, bob, (0, 0, 0), (0, 0, 1))
+    return model
+
+
+def test_pendulum_carried_round_by_a_driven_shaft():
+    """theta'' + (g/l - W^2) theta = 0 about the hanging position: the hinge axis turns with the shaft (the
+    basis is transported along the reference motion); above W^2 = g/l the hanging position is unstable."""
+    l, W = 0.5, 2.0
+    model = governor(W, l)
+    lin = mb.linearize(model)
+    assert lin.dof == 1
+    assert np.allclose(np.sort(lin.eigenvalues.imag), [-np.sqrt(G / l - W**2), np.sqrt(G / l - W**2)], rtol=1e-7)
+    res = mb.simulate(model, 0.5, 0.1)
+    lin2 = mb.linearize(model, at=(res, 0.35))          # the shaft has turned 0.7 rad: the same mode
+    assert lin2.modes()["frequency [Hz]"].iloc[0] == pytest.approx(hz(np.sqrt(G / l - W**2)), rel=1e-7)
+    fast = mb.linearize(governor(5.0, l))
+    assert np.max(fast.eigenvalues.real) == pytest.approx(np.sqrt(25.0 - G / l), rel=1e-6)

@@ -11,15 +11,18 @@ body). The state is x = (z, y) (2d):
 
 and the perturbation dynamics about the reference motion through (q0, u0) are
 
-    dz/dt = y + G^T W G z,   W = diag(0, [w0]x) per rigid body (w0: reference angular velocity, ground)
-    dy/dt = G^T (a(q, u) - a0)                  a: accelerations with angular parts in ground axes
+    dz/dt = y + G^T (W G - G') z,   W = diag(0, [w0]x) per rigid body (w0: reference angular velocity)
+    dy/dt = G^T (a(q, u) - a0) + G'^T (u - u0)     a: accelerations, angular parts in ground axes
 
-(the term W comes from perturbing the attitude in ground axes, A = exp([dtheta]) A_ref(t), so that a
-spinning body's gyroscopic modes appear at the frequencies seen in ground, as in rotordynamics). The
-accelerations come from the equations of motion (KKT solve, the same as dynamics); dy/dt is
-differentiated by central differences, steps h_z = 1e-5 min(L, 1) and h_y = 1e-5 max(min(L, 1), |u0|)
-(L: the model's length scale), error about 1e-10 relative. The basis is frozen at t0: a reference
-motion whose tangent space turns (a driven mechanism moving) is linearized at that instant.
+The term W comes from perturbing the attitude in ground axes, A = exp([dtheta]) A_ref(t), so that a
+spinning body's gyroscopic modes appear at the frequencies seen in ground, as in rotordynamics. G' is the
+rate of the basis carried along the reference motion (the tangent space of a joint on a driven shaft
+turns with it): bases at t0 +- h on the reference path q0 (+) (h v0 + h^2/2 vd0), projected with the
+motions at t0 +- h, turned onto G by orthogonal Procrustes (so G^T G' = 0), central difference with
+h = 1e-5 / (fastest rate of the reference); zero at rest. The accelerations come from the equations of
+motion (KKT solve, the same as dynamics); dy/dt is differentiated by central differences, steps
+h_z = 1e-5 min(L, 1) and h_y = 1e-5 max(min(L, 1), |u0|) (L: the model's length scale), error about
+1e-10 relative.
 
 Inputs (B, D) are loads or motions. A load input is one component, in the element's axes (ground when
 it has no frame), of an extra force [N] or torque [N m] on an `add_force` / `add_torque` element ("push"
@@ -47,9 +50,9 @@ from ..system.equations import constraint_terms
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
 from .assembly import assemble_state
-from .common import independent_rows, min_norm_solve
+from .common import increment, independent_rows, min_norm_solve, project_positions
 from .linear_modes import mode_shape_table, modes_table
-from .reduced import Chart, length_scale, tangent_basis
+from .reduced import Chart, length_scale, tangent_basis, velocity_scale
 from .state import state_factory
 
 FD_REL = 1e-5
@@ -138,16 +141,18 @@ def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
     L = min(length_scale(sys, q0), 1.0)
     hz, hy = FD_REL * L, FD_REL * max(L, float(np.max(np.abs(u0), initial=0.0)))
     state = _StateMap(sys, Chart(sys, q0, t0, rows, N), G, u0, state_factory(sys), ins, d)
-    a0 = _to_ground(sys, q0, state(np.zeros(nx))[2])
+    vd0 = state(np.zeros(nx))[2]
+    a0 = _to_ground(sys, q0, vd0)
+    Gd = _basis_rate(sys, q0, v0, vd0, t0, rows, G)
 
-    def rate(x, du=None):
-        q, _, vd, _ = state(x, du)
-        return G.T @ (_to_ground(sys, q, vd) - a0)
+    def rate(x, du=None):   # dy/dt = d(G^T du)/dt
+        q, v, vd, _ = state(x, du)
+        return G.T @ (_to_ground(sys, q, vd) - a0) + Gd.T @ (_to_ground(sys, q, v) - u0)
 
     steps = np.r_[np.full(d, hz), np.full(d, hy), np.full(nm, hz), np.full(nm, hy)]
     A = np.zeros((nx, nx))
     A[:d, d:2 * d] = np.eye(d)
-    A[:d, :d] = G.T @ _spin_matrix(sys, q0, v0) @ G
+    A[:d, :d] = G.T @ (_spin_matrix(sys, q0, v0) @ G - Gd)
     A[2 * d:2 * d + nm, 2 * d + nm:] = np.eye(nm)
     A[d:2 * d] = _central(rate, nx, steps, d)
     B = np.zeros((nx, nu))
@@ -161,6 +166,23 @@ def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
     D = _central(lambda e: _measure(sys, t0, fns, state(np.zeros(nx), e))[0], nu, isteps, len(y0))
     out_names = [nm_ if n == 1 else f"{nm_}[{i}]" for nm_, n in zip(names, sizes) for i in range(n)]
     return Linearization(A, B, C, D, t0, q0, v0, G, sys, [i.name for i in ins], out_names, y0)
+
+
+def _basis_rate(sys, q0, v0, vd0, t0, rows, G):
+    """dG/dt along the reference motion (central differences over +-h, h = 1e-5 / its fastest rate), the
+    basis at each time turned onto G by orthogonal Procrustes (so G^T dG/dt = 0); zero at rest."""
+    rate = max(float(np.max(np.abs(_to_ground(sys, q0, v0) / velocity_scale(sys, length_scale(sys, q0))),
+                            initial=0.0)), 0.0)
+    if rate == 0.0 or G.shape[1] == 0:
+        return np.zeros_like(G)
+    h = 1e-5 / rate
+    out = []
+    for s in (h, -h):
+        q, res, _ = project_positions(sys, increment(sys, q0, s * v0 + 0.5 * s * s * vd0), t0 + s, rows, tol=1e-14)
+        Gs = _to_ground(sys, q, tangent_basis(sys, q, t0 + s, rows))
+        u, _, vt = np.linalg.svd(Gs.T @ G)
+        out.append(Gs @ u @ vt)
+    return (out[0] - out[1]) / (2 * h)
 
 
 def _central(fn, n, steps, rows):
