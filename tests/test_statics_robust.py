@@ -167,3 +167,29 @@ def test_quasi_static_stops_with_a_partial_result_when_the_motion_is_impossible(
     assert "last equilibrium at t = 0.5 s" in res.message
     x = np.cos(res.time) + np.sqrt(0.25 - np.sin(res.time) ** 2)
     assert np.allclose(res.position(slider)[:, 0], x, atol=1e-9)
+
+
+def test_ball_dropped_from_high_above_a_contact_floor():
+    """Adams IMPACT floor (k = 1e6 N/m^1.5): the resting penetration (m g / k)^(1/e) from 3 m above it."""
+    m_, R, k, e = 2.0, 0.1, 1e6, 1.5
+    for z0 in (3.0, 0.1):
+        model = mb.Model("ball", gravity=(0.0, 0.0, -G))
+        ball = model.add_particle("ball", m_, position=(0, 0, z0))
+        model.add_contact("floor", mb.Plane(model.ground, (0, 0, 0), (0, 0, 1)), mb.Sphere(ball, R), k, e, 10.0, 1e-3)
+        res = mb.equilibrium(model)
+        assert R - res.position(ball)[0, 2] == pytest.approx((m_ * G / k) ** (1 / e), rel=1e-9)
+        assert res.stats["stable"]
+
+
+def test_circulatory_follower_load_without_a_potential():
+    """A particle on a plane held by a spring (k) under a curl force c (-y, x) and a constant load f0: no
+    potential exists; equilibrium (k I - c J) x = f0 with J the quarter turn."""
+    k, c, f0 = 50.0, 30.0, np.array([4.0, -3.0])
+    model = mb.Model("curl")
+    p = model.add_particle("p", 1.0, position=(0.8, 0.6, 0.0))
+    model.add_planar("table", model.ground, p, (0, 0, 0), (0, 0, 1))
+    model.add_spring_damper("spring", (model.ground, (0, 0, 0)), p, k, free_length=0.0)
+    model.add_force("curl", p, lambda t, s: (-c * s.position(p)[1] + f0[0], c * s.position(p)[0] + f0[1], 0.0))
+    res = mb.equilibrium(model)
+    x = np.linalg.solve(k * np.eye(2) - c * np.array([[0, -1], [1, 0]]), f0)
+    assert np.allclose(res.position(p)[0, :2], x, atol=1e-10)
