@@ -58,7 +58,7 @@ from .state import state_factory
 FD_REL = 1e-5
 
 
-@dataclass
+@dataclass(repr=False)
 class Linearization:
     """dx/dt = A x + B u, y = C x + D u about an operating point (x = (z, z_dot), see module docstring).
 
@@ -77,6 +77,10 @@ class Linearization:
     input_names: list = field(default_factory=list)
     output_names: list = field(default_factory=list)
     y0: np.ndarray = field(default_factory=lambda: np.zeros(0))   # outputs at the operating point
+
+    def __repr__(self) -> str:
+        return (f"Linearization(t={self.t:g} s, {self.dof} independent coordinates, {self.A.shape[0]} states, "
+                f"inputs={self.input_names}, outputs={self.output_names})")
 
     @property
     def dof(self) -> int:

@@ -61,10 +61,15 @@ def modes_table(lin, zero_tol=None):
         wn = abs(lam)
         rows.append({"eigenvalue": lam, "frequency [Hz]": wn / (2 * np.pi),
                      "damped frequency [Hz]": abs(lam.imag) / (2 * np.pi),
-                     "damping ratio": -lam.real / wn if wn > 0 else np.nan})
+                     "damping ratio": _clean(-lam.real / wn) if wn > 0 else np.nan})
     df = pd.DataFrame(rows, columns=["eigenvalue", "frequency [Hz]", "damped frequency [Hz]", "damping ratio"])
     df.index.name = "mode"
     return df, ml
+
+
+def _clean(zeta):
+    """0.0 for a damping ratio at round-off level (an undamped mode), else zeta."""
+    return 0.0 if abs(zeta) < 1e-12 else float(zeta)
 
 
 def mode_shape_table(lin, i, zero_tol=None):
