@@ -193,3 +193,22 @@ def test_circulatory_follower_load_without_a_potential():
     res = mb.equilibrium(model)
     x = np.linalg.solve(k * np.eye(2) - c * np.array([[0, -1], [1, 0]]), f0)
     assert np.allclose(res.position(p)[0, :2], x, atol=1e-10)
+
+
+def test_quasi_static_winds_a_torsion_spring_past_half_a_turn():
+    """A motor turns a drum 4 rad/s against a torsion spring (2 N m/rad) while a pendulum hangs from the
+    drum's rim: the spring angle and the motor torque grow past pi at every sample, the pendulum hangs."""
+    k = 2.0
+    model = mb.Model("wind", gravity=(0.0, -G, 0.0))
+    drum = model.add_body("drum", 1.0, inertia=(0.1, 0.1, 0.1))
+    axle = model.add_revolute("axle", model.ground, drum, (0, 0, 0), (0, 0, 1))
+    ts = model.add_torsion_spring("clock", axle, k)
+    motor = model.add_motion("motor", axle, displacement="4*t")
+    bob = model.add_body("bob", 0.2, inertia=(1e-3, 1e-3, 1e-3), position=(0.3, -0.2, 0))
+    model.add_revolute("hook", drum, bob, (0.3, 0, 0), (0, 0, 1))
+    res = mb.quasi_static(model, 1.5, 0.1)
+    th = 4 * res.time
+    assert res.success and np.allclose(res.spring_length(ts), th, atol=1e-9)
+    rim = 0.3 * np.c_[np.cos(th), np.sin(th), 0 * th]
+    assert np.allclose(res.position(bob), rim + [0, -0.2, 0], atol=1e-9)
+    assert np.allclose(res.driver_effort(motor), k * th + 0.2 * G * rim[:, 0], atol=1e-8)

@@ -307,4 +307,5 @@ def _follow_angles(sys, q, dx, t):
             fr = body_frames(sys, q, np.zeros(sys.nv)) if fr is None else fr
             x, _, rws = joint_coordinate(sys, fr, e.joint, "rotation", e.name, t)
             pred = float(x[0] + load_from_rows(sys, fr, rws, 1.0) @ dx)
-            element_state(sys, e.name)["angle_ref"] = [(float(t), pred)]
+            st = element_state(sys, e.name)   # anchors of earlier times stay (quasi-static histories)
+            st["angle_ref"] = [a for a in st.get("angle_ref", []) if a[0] < t] + [(float(t), pred)]
