@@ -24,6 +24,11 @@ JOINT_FIELDS = {"revolute": ("point", "axis"), "translational": ("point", "axis"
 PER = {"displacement": "", "velocity": "/s", "acceleration": "/s**2"}
 
 
+def element_word(kind: str) -> str:
+    """How errors name an element of a kind ("spring_damper" -> "spring", as Model.add_spring_damper does)."""
+    return {"spring_damper": "spring"}.get(kind, kind.replace("_", " "))
+
+
 class ItemError(ModelError):
     """A ModelError attributed to the item at `path` in the model data (section, index[, field...])."""
 
@@ -62,7 +67,10 @@ def rotation_matrix(entity: str, field: str, spec) -> np.ndarray | None:
     if spec is None:
         return None
     if isinstance(spec, EulerSpec):
-        return Rotation.from_euler(spec.sequence, spec.euler).as_matrix()
+        try:
+            return Rotation.from_euler(spec.sequence, spec.euler).as_matrix()
+        except ValueError as exc:   # e.g. "ZZX": consecutive axes must differ
+            raise ModelError(entity, field, f"Euler sequence {spec.sequence!r}: {exc}") from None
     if isinstance(spec, AxisAngleSpec):
         axis = np.asarray(spec.axis, dtype=float)
         n = np.linalg.norm(axis)
@@ -216,7 +224,7 @@ class Builder:
                               dof=m.dof)
 
     def add_element(self, e):
-        entity = f"{e.type.replace('_', ' ')} '{e.name}'"
+        entity = f"{element_word(e.type)} '{e.name}'"
         getattr(self, "add_" + e.type)(entity, e)
 
     def add_force(self, entity, e):

@@ -31,7 +31,8 @@ def entity_of(data, path) -> str:
         name = item.get("name") if isinstance(item, dict) else None
         kind = SECTION_ENTITY.get(path[0])
         if kind is None:
-            kind = str(item.get("type", "element")).replace("_", " ") if isinstance(item, dict) else "element"
+            from .build import element_word
+            kind = element_word(str(item.get("type", "element"))) if isinstance(item, dict) else "element"
         return f"{kind} {name!r}" if isinstance(name, str) else f"{kind} #{path[1] + 1} of {path[0]}"
     return "model"
 
@@ -65,8 +66,9 @@ def _pick(errors):
     first = errors[0]
     prefix = tuple(first["loc"][:2])
     same = [e for e in errors if tuple(e["loc"][:2]) == prefix]
-    better = [e for e in same if e["type"] not in BRANCH_NOISE]
-    return (better or same)[0]
+    better = [e for e in same if e["type"] not in BRANCH_NOISE] or same
+    extra = [e for e in better if e["type"] == "extra_forbidden"]   # a misspelt key also makes one "missing"
+    return (extra or better)[0]
 
 
 def _spec_class(data, path):
@@ -86,19 +88,23 @@ def _spec_class(data, path):
     return None
 
 
-def _message(err, data, path) -> str:
+def _message(err, data, path, missing=()) -> str:
     kind, msg = err["type"], err["msg"]
     if kind == "extra_forbidden":
         key = path[-1]
         cls = _spec_class(data, path) if len(path) in (1, 3) else None
-        if cls is None:
-            return f"unknown field {key!r}"
-        valid = [f for f in cls.model_fields if f != "type"]
+        valid = list(missing) if cls is None else [f for f in cls.model_fields if f != "type"]
         close = difflib.get_close_matches(str(key), valid, n=1)
+        if cls is None:
+            return f"unknown field {key!r}" + (f" (did you mean {close[0]!r}?)" if close else "")
         hint = f" (did you mean {close[0]!r}?)" if close else ""
         return f"unknown field {key!r}{hint}; valid fields: {', '.join(valid)}"
     if kind == "missing":
         return "is required"
+    if kind in ("too_short", "too_long"):
+        ctx = err.get("ctx", {})
+        n = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
+        return f"expected {n} values, got {ctx.get('actual_length')}: {err.get('input')!r}"
     if kind == "union_tag_not_found":
         return "needs a 'type' (see `mbdsim schema` for the kinds of each section)"
     if kind == "union_tag_invalid":
@@ -109,14 +115,16 @@ def _message(err, data, path) -> str:
 
 def from_validation(exc, data, source: str, marks: dict | None) -> ModelFileError:
     """ModelFileError for the first problem of a pydantic ValidationError on model data."""
-    err = _pick(exc.errors())
+    errors = exc.errors()
+    err = _pick(errors)
     path = _data_path(data, err["loc"], err["type"])
+    missing = [e["loc"][-1] for e in errors if e["type"] == "missing" and tuple(e["loc"][:-1]) == tuple(err["loc"][:-1])]
     entity = entity_of(data, path)
     field = field_text(path[2:] if entity != "model" else path)
     if err["type"] in ("union_tag_invalid", "union_tag_not_found"):
         field = "type"
         path = path + ("type",)
-    return ModelFileError(entity, field, _message(err, data, path), source, line_of(marks, path))
+    return ModelFileError(entity, field, _message(err, data, path, missing), source, line_of(marks, path))
 
 
 def from_item_error(exc, source: str, marks: dict | None) -> ModelFileError:

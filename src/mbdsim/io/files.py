@@ -27,13 +27,26 @@ def file_kind(path: Path, entity: str = "file") -> str:
                          str(path))
 
 
-def _walk(node, path, marks, source):
+def _item_name(node) -> str | None:
+    """The `name: ...` of a mapping node, if it has a plain one."""
+    for key, value in getattr(node, "value", ()) if hasattr(node, "flow_style") else ():
+        if getattr(key, "value", None) == "name" and isinstance(getattr(value, "value", None), str):
+            return value.value
+    return None
+
+
+def _walk(node, path, marks, source, entity="model"):
     """Record the line of every key/item under `node` and refuse tags and duplicate keys."""
     import yaml
+
+    from .diagnose import SECTION_ENTITY, field_text
+    if len(path) == 2 and isinstance(path[1], int):
+        name = _item_name(node)
+        entity = f"{SECTION_ENTITY.get(path[0], 'element')} " + (repr(name) if name else f"#{path[1] + 1}")
     if node.tag not in PLAIN_TAGS:
-        raise ModelFileError("file", "/".join(map(str, path)) or "(top level)",
-                             f"YAML tag {node.tag!r} is not allowed in a model file (plain data only)",
-                             source, node.start_mark.line + 1)
+        field = field_text(path[2:] if len(path) > 2 else path) if entity != "model" or path else "(top level)"
+        raise ModelFileError(entity, field, f"YAML tag {node.tag!r} is not allowed in a model file "
+                             "(plain data only, nothing is constructed or run)", source, node.start_mark.line + 1)
     if isinstance(node, yaml.MappingNode):
         seen = set()
         for key, value in node.value:
@@ -46,12 +59,12 @@ def _walk(node, path, marks, source):
             seen.add(key.value)
             sub = path + (key.value,)
             marks[sub] = key.start_mark.line + 1
-            _walk(key, sub, {}, source)
-            _walk(value, sub, marks, source)
+            _walk(key, sub, {}, source, entity)
+            _walk(value, sub, marks, source, entity)
     elif isinstance(node, yaml.SequenceNode):
         for k, item in enumerate(node.value):
             marks[path + (k,)] = item.start_mark.line + 1
-            _walk(item, path + (k,), marks, source)
+            _walk(item, path + (k,), marks, source, entity)
 
 
 def parse_yaml(text: str, source: str):

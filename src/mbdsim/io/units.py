@@ -48,7 +48,8 @@ def _convert(text: str, unit: str) -> float:
     try:
         q = ureg.Quantity(text)
     except Exception as exc:  # noqa: BLE001 - pint's own parser (never eval) fails in many ways on garbage
-        raise UnitError(f"cannot read {text!r} as a number with units ({type(exc).__name__}: {exc})") from None
+        detail = f": {exc}" if str(exc) else ""
+        raise UnitError(f"cannot read {text!r} as a number with units{detail}") from None
     if not isinstance(q, ureg.Quantity):   # a plain number written as a string
         q = ureg.Quantity(float(q))
     target = ureg.Quantity(1.0, unit) if unit else ureg.Quantity(1.0)
