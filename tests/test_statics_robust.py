@@ -212,3 +212,29 @@ def test_quasi_static_winds_a_torsion_spring_past_half_a_turn():
     rim = 0.3 * np.c_[np.cos(th), np.sin(th), 0 * th]
     assert np.allclose(res.position(bob), rim + [0, -0.2, 0], atol=1e-9)
     assert np.allclose(res.driver_effort(motor), k * th + 0.2 * G * rim[:, 0], atol=1e-8)
+
+
+def double_pendulum(a1, a2, l=1.0, m=1.0):
+    model = mb.Model("double", gravity=(0.0, -G, 0.0))
+    p1 = l * np.array([np.cos(a1), np.sin(a1), 0.0])
+    p2 = p1 + l * np.array([np.cos(a2), np.sin(a2), 0.0])
+    b1 = model.add_body("upper", m, inertia=(0.01, m * l * l / 12, m * l * l / 12), position=p1 / 2,
+                        orientation=Rotation.from_rotvec([0, 0, a1]))
+    b2 = model.add_body("lower", m, inertia=(0.01, m * l * l / 12, m * l * l / 12), position=(p1 + p2) / 2,
+                        orientation=Rotation.from_rotvec([0, 0, a2]))
+    model.add_revolute("shoulder", model.ground, b1, (0, 0, 0), (0, 0, 1))
+    model.add_revolute("elbow", b1, b2, tuple(p1), (0, 0, 1))
+    return model
+
+
+def test_double_pendulum_four_equilibria_only_one_stable():
+    """Starts anywhere but on the three unstable equilibria reach the straight hanging one; started exactly
+    on one, it is returned with as many unstable directions as it has (up-up 2, down-up 1)."""
+    for a1, a2 in ((0.0, 0.0), (np.pi / 2 + 0.01, np.pi / 2), (2.0, -2.5), (0.3, 3.0), (np.pi, 0.0)):
+        res = mb.equilibrium(double_pendulum(a1, a2))
+        assert res.stats["stable"] and np.allclose(res.position("lower")[0], [0, -1.5, 0], atol=1e-9)
+    for (a1, a2), n_bad, y in (((np.pi / 2, np.pi / 2), 2, 1.5), ((-np.pi / 2, np.pi / 2), 1, -0.5)):
+        with pytest.warns(mb.UnstableEquilibriumWarning):
+            res = mb.equilibrium(double_pendulum(a1, a2))
+        assert len(res.stats["unstable_directions"]) == n_bad and res.position("lower")[0, 1] == pytest.approx(y)
+        assert np.sum(res.stats["stiffness_eigenvalues"] < 0) == n_bad
