@@ -144,3 +144,14 @@ def test_json_schema_covers_every_kind():
     for kind in ("point_on_curve", "bushing", "contact", "friction", "stop", "torsion_spring", "universal"):
         assert f"'{kind}'" in text
     assert s["additionalProperties"] is False
+
+
+def test_readme_model_file_snippet_loads():
+    import re
+    from pathlib import Path
+
+    import yaml
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = re.findall(r"```yaml\n(.*?)```", text, re.S)[0]
+    m = model_from_dict(yaml.safe_load(block), source="README.md")
+    assert m.bodies["box"].mass == pytest.approx(7800 * 0.006) and m.bodies["rod"].position[0] == 0.5
