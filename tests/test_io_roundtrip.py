@@ -97,7 +97,7 @@ def test_box_mass_properties_closed_form():
 
 @pytest.mark.parametrize("kwargs, field", [
     (dict(mass=0.0 - 1), "mass"), (dict(mass=True), "mass"), (dict(mass=float("inf")), "mass"),
-    (dict(mass=1.0, inertia=(1.0, 1.0, 2.5)), "inertia"), (dict(mass=1.0, inertia=(-1.0, 1.0, 1.0)), "inertia"),
+    (dict(mass=1.0, inertia=(-1.0, 1.0, 1.0)), "inertia"),
     (dict(mass=1.0, inertia=(True, 1.0, 1.0)), "inertia"), (dict(shape=mb.Box((1, 1, 1))), "density"),
     (dict(mass=1.0, shape=mb.Box((1, 1, 1)), density=1.0), "mass"),
 ])
@@ -105,6 +105,14 @@ def test_bad_mass_properties_name_body_and_field(kwargs, field):
     with pytest.raises(ModelError) as err:
         mb.Model().add_body("blk", **kwargs)
     assert err.value.entity == "body 'blk'" and err.value.field == field
+
+
+def test_impossible_inertia_warns_in_the_api_and_fails_in_a_file():
+    from mbdsim.model._check import InertiaWarning
+    with pytest.warns(InertiaWarning, match=r"body 'blk'.inertia: principal moments 1, 1, 2.5"):
+        mb.Model().add_body("blk", mass=1.0, inertia=(1.0, 1.0, 2.5))
+    with pytest.raises(mb.ModelFileError, match=r"body 'blk'.inertia: .*triangle inequality"):
+        model_from_dict({"bodies": [{"name": "blk", "mass": 1, "inertia": [1, 1, 2.5]}]})
 
 
 def test_units_are_converted_and_checked():

@@ -159,6 +159,9 @@ class Builder:
 
     def add_body(self, b):
         entity = f"body '{b.name}'"
+        if b.inertia is not None:   # model files refuse impossible inertias (the API only warns)
+            from ..model._check import inertia_matrix
+            inertia_matrix(entity, b.inertia, strict=True)
         shape = None
         if b.shape is not None:
             mb = self.mb

@@ -57,12 +57,17 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
     return x
 
 
-def inertia_matrix(entity: str, value) -> np.ndarray:
+class InertiaWarning(UserWarning):
+    """Principal moments that no mass distribution has (the triangle inequality I1 + I2 >= I3 fails)."""
+
+
+def inertia_matrix(entity: str, value, strict: bool = False) -> np.ndarray:
     """Inertia about the centre of mass in body axes: (ixx, iyy, izz) or a symmetric 3x3 [kg m^2].
 
     Checked: finite, symmetric, positive semi-definite (a slender rod may have a zero axial moment)
     and the triangle inequality of the principal moments (I1 + I2 >= I3, relative tolerance 1e-6),
-    which every real mass distribution satisfies."""
+    which every real mass distribution satisfies: a violation is a ModelError when `strict` (model
+    files), else an InertiaWarning naming the body (some existing scripts use such test values)."""
     if _has_bool(value):
         raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got a boolean in {value!r}")
     try:
@@ -78,6 +83,10 @@ def inertia_matrix(entity: str, value) -> np.ndarray:
     if ev.min() < -1e-12 * max(1.0, ev.max()):
         raise ModelError(entity, "inertia", f"must be positive semi-definite, eigenvalues {ev}")
     if ev[0] + ev[1] < ev[2] - 1e-6 * ev[2]:
-        raise ModelError(entity, "inertia", f"principal moments {ev[0]:.6g}, {ev[1]:.6g}, {ev[2]:.6g} kg m^2 "
+        err = ModelError(entity, "inertia", f"principal moments {ev[0]:.6g}, {ev[1]:.6g}, {ev[2]:.6g} kg m^2 "
                          "violate the triangle inequality (I1 + I2 >= I3): no mass distribution has them")
+        if strict:
+            raise err
+        import warnings
+        warnings.warn(str(err), InertiaWarning, stacklevel=4)
     return J
