@@ -38,6 +38,7 @@ CASES = {
     "top_level_list.yaml": ("model", "(top level)", 1, "mapping"),
     "motion_on_spherical.yaml": ("motion 'drive'", "joint", 16, "cannot drive a spherical joint"),
     "missing_field.json": ("joint 'pin'", "point", 15, "is required"),
+    "alias_bomb.yaml": ("file", "(size)", 2, "once aliases are expanded"),
 }
 
 

@@ -29,17 +29,26 @@ def file_kind(path: Path, entity: str = "file") -> str:
 
 def _item_name(node) -> str | None:
     """The `name: ...` of a mapping node, if it has a plain one."""
-    for key, value in getattr(node, "value", ()) if hasattr(node, "flow_style") else ():
+    import yaml
+    for key, value in node.value if isinstance(node, yaml.MappingNode) else ():
         if getattr(key, "value", None) == "name" and isinstance(getattr(value, "value", None), str):
             return value.value
     return None
 
 
-def _walk(node, path, marks, source, entity="model"):
-    """Record the line of every key/item under `node` and refuse tags and duplicate keys."""
+MAX_NODES = 200_000   # YAML aliases re-use nodes: a "billion laughs" file expands past any budget
+
+
+def _walk(node, path, marks, source, entity="model", budget=None):
+    """Record the line of every key/item under `node` and refuse tags, duplicate keys and alias bombs."""
     import yaml
 
     from .diagnose import SECTION_ENTITY, field_text
+    budget = [MAX_NODES] if budget is None else budget
+    budget[0] -= 1
+    if budget[0] < 0:
+        raise ModelFileError("file", "(size)", f"more than {MAX_NODES} values once aliases are expanded",
+                             source, node.start_mark.line + 1)
     if len(path) == 2 and isinstance(path[1], int):
         name = _item_name(node)
         entity = f"{SECTION_ENTITY.get(path[0], 'element')} " + (repr(name) if name else f"#{path[1] + 1}")
@@ -59,12 +68,12 @@ def _walk(node, path, marks, source, entity="model"):
             seen.add(key.value)
             sub = path + (key.value,)
             marks[sub] = key.start_mark.line + 1
-            _walk(key, sub, {}, source, entity)
-            _walk(value, sub, marks, source, entity)
+            _walk(key, sub, {}, source, entity, budget)
+            _walk(value, sub, marks, source, entity, budget)
     elif isinstance(node, yaml.SequenceNode):
         for k, item in enumerate(node.value):
             marks[path + (k,)] = item.start_mark.line + 1
-            _walk(item, path + (k,), marks, source, entity)
+            _walk(item, path + (k,), marks, source, entity, budget)
 
 
 def parse_yaml(text: str, source: str):
