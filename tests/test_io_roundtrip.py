@@ -163,3 +163,54 @@ def test_readme_model_file_snippet_loads():
     block = re.findall(r"```yaml\n(.*?)```", text, re.S)[0]
     m = model_from_dict(yaml.safe_load(block), source="README.md")
     assert m.bodies["box"].mass == pytest.approx(7800 * 0.006) and m.bodies["rod"].position[0] == 0.5
+
+
+def joint_model(extra):
+    base = {"bodies": [{"name": "a", "mass": 1, "inertia": [1, 1, 1]}, {"name": "s", "mass": 1, "inertia": [1, 1, 1]}],
+            "joints": [{"name": "pin", "type": "revolute", "body_i": "ground", "body_j": "a", "point": [0, 0, 0],
+                        "axis": [0, 0, 1]},
+                       {"name": "rail", "type": "translational", "body_i": "ground", "body_j": "s", "point": [0, 0, 0],
+                        "axis": [1, 0, 0]}]}
+    base.update(extra)
+    return model_from_dict(base)
+
+
+def test_joint_dependent_units():
+    m = joint_model({
+        "motions": [{"name": "spin", "joint": "pin", "velocity": "60 deg/s", "initial_displacement": "90 deg"}],
+        "forces": [{"name": "lim", "type": "stop", "joint": "rail", "lower": "-20 mm", "upper": "3 cm",
+                    "stiffness": "2 kN/m^1.5", "damping": "10 N*s/m", "penetration": "1 mm"},
+                   {"name": "fr", "type": "friction", "joint": "rail", "mu_static": 0.3, "mu_dynamic": 0.2,
+                    "preload": "2 kN"},
+                   {"name": "ct", "type": "contact", "shape_i": {"type": "sphere", "body": "s", "radius": "5 cm"},
+                    "shape_j": {"type": "plane", "body": "ground", "point": [0, 0, 0], "normal": [0, 0, 1]},
+                    "stiffness": "1 kN/mm^1.5", "exponent": 1.5, "damping": 10, "penetration": "0.1 mm"},
+                   {"name": "bu", "type": "bushing", "marker_i": "a", "marker_j": "s",
+                    "stiffness": ["1 kN/m", 0, 0, "2 N*m/deg", 0, 0], "preload": [0, 0, 0, 0, 0, "3 N*m"]}]})
+    f = m.motions["spin"].function
+    assert f.d1(0.3) == pytest.approx(math.pi / 3) and f.value(0.0) == pytest.approx(math.pi / 2)
+    st = m.forces["lim"]
+    assert (st.lower, st.upper, st.stiffness, st.penetration) == pytest.approx((-0.02, 0.03, 2000.0, 1e-3))
+    assert m.forces["fr"].preload == 2000.0
+    assert m.forces["ct"].stiffness == pytest.approx(1e3 * 1e3 ** 1.5) and m.forces["ct"].shape_i.radius == 0.05
+    assert m.forces["bu"].stiffness[3] == pytest.approx(2 * 180 / math.pi) and m.forces["bu"].preload[5] == 3.0
+    with pytest.raises(mb.ModelFileError, match=r"stop 'lim'.lower: .*not a length"):
+        joint_model({"forces": [{"name": "lim", "type": "stop", "joint": "rail", "lower": "-20 deg", "stiffness": 1}]})
+    with pytest.raises(mb.ModelFileError, match=r"motion 'spin'.velocity"):
+        joint_model({"motions": [{"name": "spin", "joint": "pin", "velocity": "60 mm/s"}]})
+
+
+def test_parametric_curve_from_expressions_round_trips():
+    d = {"bodies": [{"name": "bead", "mass": 1, "inertia": [1, 1, 1], "position": [1, 0, 0],
+                     "markers": [{"name": "c", "point": [1, 0, 0]}]}],
+         "joints": [{"name": "ring", "type": "point_on_curve", "marker": "bead.c", "body": "ground",
+                     "curve": {"type": "curve", "x": "cos(s)", "y": "sin(s)", "z": 0, "s_range": [0, "360 deg"],
+                               "closed": True}}]}
+    m = model_from_dict(d)
+    C, d1, d2 = m.path_constraints["ring"].curve.derivatives(0.3)
+    assert np.allclose(d1, [-math.sin(0.3), math.cos(0.3), 0]) and np.allclose(d2, [-math.cos(0.3), -math.sin(0.3), 0])
+    once = model_to_dict(m)
+    assert model_to_dict(model_from_dict(once)) == once
+    with pytest.raises(mb.ModelFileError, match=r"joint 'ring'.curve: .*not allowed"):
+        d["joints"][0]["curve"]["x"] = "__import__('os').getcwd()"
+        model_from_dict(d)
