@@ -169,7 +169,6 @@ def _info(path):
     from mbdsim.io.summary import summarize
     m = _load(path)
     s = summarize(m)
-    dof, n_redundant, redundant = _rank_dof(m)
     _print_table(f"{m.name}: bodies", [(n, k, f"{mass:.6g} kg") for n, k, mass in s.bodies], ("name", "kind", "mass"))
     _print_table("joints", [(n, k, f"{bi} -> {bj}", str(nc)) for n, k, bi, bj, nc in s.joints],
                  ("name", "type", "bodies", "constraints"))
@@ -177,6 +176,7 @@ def _info(path):
         _print_table("drivers", [(n, j, k, d) for n, j, k, d in s.drivers], ("name", "joint", "kind", "function"))
     if s.elements:
         _print_table("force elements", s.elements, ("name", "kind"))
+    dof, n_redundant, redundant = _rank_dof(m)   # assembles: may fail after the tables are out
     _print_table("mobility", [("DOF (Gruebler)", str(s.gruebler_dof)), ("DOF (rank)", str(dof)),
                               ("redundant constraints", str(n_redundant) + (f" among {', '.join(redundant)}"
                                                                             if redundant else ""))])
