@@ -40,6 +40,7 @@ import dataclasses
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.linalg as sla
 
 from ..errors import ModelError, SolverError
 from ..model.forces import Force, Torque
@@ -50,9 +51,9 @@ from ..system.equations import constraint_terms
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
 from .assembly import assemble_state
-from .common import increment, independent_rows, min_norm_solve, project_positions
+from .common import increment, independent_rows, project_positions
 from .linear_modes import mode_shape_table, modes_table
-from .reduced import Chart, length_scale, tangent_basis, velocity_scale
+from .reduced import Chart, length_scale, min_norm, tangent_basis, velocity_scale
 from .state import state_factory
 
 FD_REL = 1e-5
@@ -145,12 +146,12 @@ def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
     L = min(length_scale(sys, q0), 1.0)
     hz, hy = FD_REL * L, FD_REL * max(L, float(np.max(np.abs(u0), initial=0.0)))
     state = _StateMap(sys, Chart(sys, q0, t0, rows, N), G, u0, state_factory(sys), ins, d)
-    vd0 = state(np.zeros(nx))[2]
+    vd0 = state(np.zeros(nx), multipliers=False)[2]
     a0 = _to_ground(sys, q0, vd0)
     Gd = _basis_rate(sys, q0, v0, vd0, t0, rows, G)
 
     def rate(x, du=None):   # dy/dt = d(G^T du)/dt
-        q, v, vd, _ = state(x, du)
+        q, v, vd, _ = state(x, du, multipliers=False)
         return G.T @ (_to_ground(sys, q, vd) - a0) + Gd.T @ (_to_ground(sys, q, v) - u0)
 
     steps = np.r_[np.full(d, hz), np.full(d, hy), np.full(nm, hz), np.full(nm, hy)]
@@ -215,7 +216,7 @@ class _StateMap:
         self.sys, self.chart, self.G, self.u0, self.sf, self.ins, self.d = sys, chart, G, u0, sf, ins, d
         self.mrows = np.array([i.row for i in ins if i.row >= 0], dtype=int)
 
-    def __call__(self, x, du=None):
+    def __call__(self, x, du=None, multipliers=True):
         sys, d, c, nm = self.sys, self.d, self.chart, len(self.mrows)
         du = np.zeros(len(self.ins)) if du is None else du
         off = np.zeros((3, sys.nc))
@@ -229,7 +230,7 @@ class _StateMap:
             for s, i in zip(du, self.ins):
                 if s and i.row < 0:
                     Qx += _unit_load(sys, fr, c.t, i, float(s))
-        return (q, v) + _kkt(sys, q, v, c.t, c.rows, self.sf, Qx, off[2])
+        return (q, v) + _kkt(sys, q, v, c.t, c.rows, self.sf, Qx, off[2], multipliers)
 
 
 # ----------------------------------------------------------------------------- operating point
@@ -286,29 +287,46 @@ def _spin_matrix(sys, q, v):
 
 
 # ----------------------------------------------------------------------------- equations of motion
-def _kkt(sys, q, v, t, rows, sf, Qx, dgamma):
-    """vd (body-axes angular parts) and multipliers of all rows (minimum norm), with extra load Qx and
-    extra acceleration right-hand side dgamma (nc) of the motion inputs."""
+def _kkt(sys, q, v, t, rows, sf, Qx, dgamma, multipliers=True):
+    """vd (body-axes angular parts) and multipliers of all rows (minimum norm; None unless `multipliers`),
+    with extra load Qx and extra acceleration right-hand side dgamma (nc) of the motion inputs."""
     fr = body_frames(sys, q, v)
     Q = applied_forces(sys, fr, t, sf(t, q, v) if sf else None) + Qx
     _, J, _, gamma = constraint_terms(sys, q, v, t)
     try:
-        vd = solve_kkt(sys.M, J[rows], Q, (gamma + dgamma)[rows])[0]
+        vd = _solve_eom(sys, J[rows], Q, (gamma + dgamma)[rows])
     except (np.linalg.LinAlgError, ValueError) as exc:
         raise SolverError(f"linearize: singular equations of motion ({exc}); massless bodies need a mass "
                           "matrix positive on the free motions", time=t) from None
     Jf = J[sys.fixed_rows]
-    lam = np.zeros(sys.nc)
-    if Jf.shape[0]:
+    lam = np.zeros(sys.nc) if multipliers else None
+    if multipliers and Jf.shape[0]:
         lam[sys.fixed_rows] = np.linalg.lstsq(Jf.T, Q - sys.M @ vd, rcond=None)[0]
     return vd, lam
+
+
+def _solve_eom(sys, J, Q, gamma):
+    """vd of M vd + J^T lambda = Q, J vd = gamma: Schur complement (J M^-1 J^T) lambda = J M^-1 Q - gamma
+    with M^-1 cached on the System (block diagonal), the full augmented solve when M is singular."""
+    Minv = sys.__dict__.get("_linear_Minv")
+    if Minv is None:
+        try:
+            Minv = np.linalg.inv(sys.M) if np.linalg.cond(sys.M) < 1e12 else False
+        except np.linalg.LinAlgError:
+            Minv = False
+        sys.__dict__["_linear_Minv"] = Minv
+    if Minv is False or J.shape[0] == 0:
+        return solve_kkt(sys.M, J, Q, gamma)[0] if Minv is False else Minv @ Q
+    W = J @ Minv
+    lam = sla.cho_solve(sla.cho_factor(W @ J.T), W @ Q - gamma)
+    return Minv @ (Q - J.T @ lam)
 
 
 def _project_velocities(sys, q, v, t, rows, dnu):
     """Minimum-norm correction of v so that phi_q v = nu + dnu on the rows (dnu: motion-input rates)."""
     _, J, nu, _ = constraint_terms(sys, q, v, t)
     J, nu = J[rows], (nu + dnu)[rows]
-    return v - min_norm_solve(J, J @ v - nu) if len(nu) else v
+    return v - min_norm(J, J @ v - nu)
 
 
 # ----------------------------------------------------------------------------- inputs

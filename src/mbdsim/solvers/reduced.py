@@ -14,10 +14,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg as sla
 
 from ..errors import SolverError
 from ..system.equations import constraint_terms
-from .common import increment, min_norm_solve, project_positions
+from .common import increment
 
 
 def length_scale(sys, q) -> float:
@@ -64,10 +65,7 @@ class Chart:
         """Configuration at independent coordinates z (on phi = offset, nc, when given: motion inputs);
         SolverError when the projection fails."""
         x = increment(self.sys, self.q0, self.N @ z) if len(z) else self.q0.copy()
-        if offset is None:
-            q, res, _ = project_positions(self.sys, x, self.t, self.rows, tol=tol, maxit=30)
-        else:
-            q, res = _project_offset(self.sys, x, self.t, self.rows, offset, tol)
+        q, res = _project_offset(self.sys, x, self.t, self.rows, np.zeros(self.sys.nc) if offset is None else offset, tol)
         if res > 1e-9:
             raise SolverError(f"the constraints cannot be satisfied at this configuration (residual {res:.3g})",
                               time=self.t, state=q)
@@ -84,8 +82,18 @@ def _project_offset(sys, q, t, rows, offset, tol, maxit=30):
         res = float(np.max(np.abs(r), initial=0.0))
         if res <= tol:
             break
-        q = increment(sys, q, -min_norm_solve(J[rows], r))
+        q = increment(sys, q, -min_norm(J[rows], r))
     return q, res
+
+
+def min_norm(J, r):
+    """Minimum-norm x with J x = r for independent rows J (Cholesky of J J^T; least squares if that fails)."""
+    if J.shape[0] == 0:
+        return np.zeros(J.shape[1])
+    try:
+        return J.T @ sla.cho_solve(sla.cho_factor(J @ J.T), r)
+    except (np.linalg.LinAlgError, ValueError):
+        return np.linalg.lstsq(J, r, rcond=None)[0]
 
 
 def tangent_residual(sys, q, t, rows, Q):
@@ -94,7 +102,10 @@ def tangent_residual(sys, q, t, rows, Q):
     if not len(rows):
         return Q.copy(), np.zeros(0)
     J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][rows]
-    lam = np.linalg.lstsq(J.T, Q, rcond=None)[0]
+    try:
+        lam = sla.cho_solve(sla.cho_factor(J @ J.T), J @ Q)
+    except (np.linalg.LinAlgError, ValueError):
+        lam = np.linalg.lstsq(J.T, Q, rcond=None)[0]
     return Q - J.T @ lam, lam
 
 
