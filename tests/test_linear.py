@@ -317,3 +317,15 @@ def test_pendulum_carried_round_by_a_driven_shaft():
     assert lin2.modes()["frequency [Hz]"].iloc[0] == pytest.approx(hz(np.sqrt(G / l - W**2)), rel=1e-7)
     fast = mb.linearize(governor(5.0, l))
     assert np.max(fast.eigenvalues.real) == pytest.approx(np.sqrt(25.0 - G / l), rel=1e-6)
+
+
+def test_bead_on_a_vertical_ring_path_constraint():
+    """Point-on-curve (auxiliary curve parameter): statics from 2.5 rad up the ring, then sqrt(g / R)."""
+    R = 0.8
+    circle = mb.Curve(lambda s: R * np.array([np.sin(s), -np.cos(s), 0.0]), (-np.pi, np.pi))
+    model = mb.Model("ring", gravity=(0.0, -G, 0.0))
+    bead = model.add_particle("bead", 0.4, position=circle.point(2.5))
+    model.add_point_on_curve("ring", bead.add_marker("c"), model.ground, circle)
+    lin = mb.linearize(model, at="equilibrium")
+    assert np.allclose(lin.q[:3], [0.0, -R, 0.0], atol=1e-9)
+    assert lin.modes()["frequency [Hz]"].iloc[0] == pytest.approx(hz(np.sqrt(G / R)), rel=1e-7)
