@@ -39,6 +39,8 @@ class Body:
 
     position: centre of mass [m]; orientation: body->ground 3x3; velocity: of the centre of mass [m/s];
     angular_velocity: in ground axes [rad/s]; inertia: about the centre of mass in body axes [kg m^2].
+    `velocity_given` / `angular_velocity_given`: whether the user gave them (then assembly holds them;
+    otherwise they are zero placeholders that assembly solves for).
     """
 
     name: str
@@ -51,6 +53,8 @@ class Body:
     is_particle: bool = False
     is_ground: bool = False
     markers: dict = field(default_factory=dict)
+    velocity_given: bool = False
+    angular_velocity_given: bool = False
 
     def add_marker(self, name: str, point=None, orientation=None) -> Marker:
         """Add a frame fixed on this body; point [m] and orientation (marker->ground) in ground at t=0."""
@@ -95,7 +99,8 @@ def shape_mass_properties(entity: str, shape, density, mass, inertia):
 def make_body(name, mass, inertia, position, orientation, velocity, angular_velocity, particle=False) -> Body:
     """Validate user input and build a Body (or a particle when particle=True).
 
-    mass [kg] must be finite and >= 0 (> 0 for a particle; 0 is a massless link); booleans are refused."""
+    mass [kg] must be finite and >= 0 (> 0 for a particle; 0 is a massless link); booleans are refused.
+    velocity / angular_velocity None: not given (free, solved at assembly), stored as zero."""
     entity = f"{'particle' if particle else 'body'} '{name}'"
     if mass is None:
         raise ModelError(entity, "mass", "is required (or give a shape and a density)")
@@ -106,6 +111,8 @@ def make_body(name, mass, inertia, position, orientation, velocity, angular_velo
         R = np.eye(3) if particle else as_matrix(orientation)
     except ValueError as exc:
         raise ModelError(entity, "orientation", str(exc)) from None
-    return Body(name, m, J, vec3(entity, "position", position), R, vec3(entity, "velocity", velocity),
-                np.zeros(3) if particle else vec3(entity, "angular_velocity", angular_velocity),
-                is_particle=particle)
+    given_w = angular_velocity is not None and not particle
+    vel = np.zeros(3) if velocity is None else vec3(entity, "velocity", velocity)
+    w = vec3(entity, "angular_velocity", angular_velocity) if given_w else np.zeros(3)
+    return Body(name, m, J, vec3(entity, "position", position), R, vel, w, is_particle=particle,
+                velocity_given=velocity is not None, angular_velocity_given=given_w)

@@ -6,13 +6,24 @@ from typing import Any
 
 import numpy as np
 
-from .body import Body
+from ..errors import ModelError
+from ._check import scalar, vector
+from .body import Body, Marker
 
 # Joint kinds and their relative degrees of freedom (rotation, translation) between two rigid bodies.
 JOINT_DOF = {
     "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
     "universal": 2, "planar": 3, "fixed": 0,
 }
+# Number of joint coordinates (Result.joint_coordinate): a universal joint reports its relative rotation
+# vector (3 values, 2 of them independent), as a spherical joint does.
+JOINT_NCOORD = {
+    "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
+    "universal": 3, "planar": 3, "fixed": 0,
+}
+COORD_NAMES = {"cylindrical": "(angle [rad], slide [m])", "planar": "(u [m], v [m], angle [rad])",
+               "spherical": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes",
+               "universal": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes"}
 
 
 @dataclass(eq=False)
@@ -32,11 +43,21 @@ class Joint:
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     axis_j: np.ndarray | None = None
     u_axis: np.ndarray | None = None
+    initial_displacement: np.ndarray | None = None   # held at assembly (joint coordinates, from as drawn)
+    initial_velocity: np.ndarray | None = None       # held at assembly (joint_velocity)
+    marker_i: Marker | None = None   # marker-pair joint: point and axes from the I marker (on body_i) ...
+    marker_j: Marker | None = None   # ... and the J marker (on body_j), which assembly brings together
+    notes: list = field(default_factory=list)   # e.g. axes orthogonalised (shown in the AssemblyReport)
 
     @property
     def dof(self) -> int:
         """Relative degrees of freedom the joint leaves between two rigid bodies."""
         return JOINT_DOF[self.kind]
+
+    @property
+    def ncoord(self) -> int:
+        """Number of joint coordinates (values of `initial_displacement` / `initial_velocity`)."""
+        return JOINT_NCOORD[self.kind]
 
     def __repr__(self) -> str:
         return f"Joint({self.kind} {self.name!r}: {self.body_i.name} -> {self.body_j.name})"
@@ -58,3 +79,18 @@ class Motion:
 
     def __repr__(self) -> str:
         return f"Motion({self.name!r} on {self.joint.name}, {self.kind})"
+
+
+def joint_initial(entity: str, kind: str, field_name: str, value) -> np.ndarray | None:
+    """Validate a joint's `initial_displacement` / `initial_velocity`: None, a number for a one-coordinate
+    joint, else a sequence in the order of Result.joint_coordinate (see COORD_NAMES); SI units."""
+    if value is None:
+        return None
+    n = JOINT_NCOORD[kind]
+    if n == 0:
+        raise ModelError(entity, field_name, "a fixed joint has no coordinates to start from")
+    if n == 1:
+        if np.ndim(value) == 1 and np.size(value) == 1:
+            value = np.asarray(value).reshape(-1)[0]
+        return np.array([scalar(entity, field_name, value)])
+    return vector(entity, field_name, value, n, f" {COORD_NAMES[kind]}")

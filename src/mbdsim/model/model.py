@@ -11,7 +11,7 @@ from .body import Body, Marker, make_body, shape_mass_properties
 from .forces import Force, SpringDamper, Torque
 from .elements import ForceElementsMixin
 from .friction_path import FrictionPathMixin
-from .joints import Joint, Motion
+from .joints import Joint, Motion, joint_initial
 
 
 class Model(ForceElementsMixin, FrictionPathMixin):
@@ -29,9 +29,12 @@ class Model(ForceElementsMixin, FrictionPathMixin):
 
     # ----------------------------------------------------------------- bodies
     def add_body(self, name, mass=None, inertia=None, position=(0, 0, 0), orientation=None,
-                 velocity=(0, 0, 0), angular_velocity=(0, 0, 0), shape=None, density=None) -> Body:
+                 velocity=None, angular_velocity=None, shape=None, density=None) -> Body:
         """Add a rigid body: mass [kg], inertia about the CM in body axes [kg m^2] (3 values or 3x3, default 0),
         CM position [m], orientation (body->ground), CM velocity [m/s] and angular velocity [rad/s] in ground.
+
+        velocity / angular_velocity default to None: free, solved at assembly (the least kinetic energy
+        that the joints, drivers and given values allow); what is given is held exactly when consistent.
 
         Instead of mass and inertia: `shape` (mb.Box, mb.Cylinder or mb.Sphere, centred on the CM, in body
         axes) and `density` [kg/m^3]."""
@@ -45,8 +48,9 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         self.bodies[name] = b
         return b
 
-    def add_particle(self, name, mass, position=(0, 0, 0), velocity=(0, 0, 0)) -> Body:
-        """Add a point mass [kg] at position [m] with velocity [m/s], both in ground; it has no rotation."""
+    def add_particle(self, name, mass, position=(0, 0, 0), velocity=None) -> Body:
+        """Add a point mass [kg] at position [m] with velocity [m/s] (None: free, solved at assembly), both
+        in ground; it has no rotation."""
         self._claim(name, "particle")
         try:
             b = make_body(name, mass, None, position, None, velocity, None, particle=True)
@@ -57,60 +61,94 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         return b
 
     # ----------------------------------------------------------------- joints
-    def add_revolute(self, name, body_i, body_j, point, axis) -> Joint:
-        """Revolute joint at `point` [m] about `axis`, both in ground at t=0."""
-        return self._joint(name, "revolute", body_i, body_j, point, axis)
+    # Every joint-adding method takes either two bodies (names or Body) with the point and axes in ground
+    # at t=0, or two markers (Body.add_marker, on any body or on ground) whose origins and z axes (x axes
+    # for in-plane references) are the joint's I and J frames, Adams style; then the point and axis
+    # arguments are omitted and the bodies may be drawn anywhere (assembly closes the gaps).
+    # initial_displacement / initial_velocity: joint coordinates (from as drawn) and rates held at
+    # assembly, a number for a one-coordinate joint, else in the order of Result.joint_coordinate.
+    def add_revolute(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
+                     initial_velocity=None) -> Joint:
+        """Revolute joint at `point` [m] about `axis`, both in ground at t=0 (or two markers); coordinate:
+        the angle [rad] of body_j about the axis."""
+        return self._joint(name, "revolute", body_i, body_j, point, axis, initial_displacement, initial_velocity)
 
-    def add_translational(self, name, body_i, body_j, point, axis) -> Joint:
-        """Translational (prismatic) joint sliding along `axis` through `point` (ground, t=0)."""
-        return self._joint(name, "translational", body_i, body_j, point, axis)
+    def add_translational(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
+                          initial_velocity=None) -> Joint:
+        """Translational (prismatic) joint sliding along `axis` through `point` (ground, t=0, or two
+        markers); coordinate: the slide [m]."""
+        return self._joint(name, "translational", body_i, body_j, point, axis, initial_displacement,
+                           initial_velocity)
 
-    def add_cylindrical(self, name, body_i, body_j, point, axis) -> Joint:
+    def add_cylindrical(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
+                        initial_velocity=None) -> Joint:
         """Cylindrical joint: rotation about and sliding along `axis` through `point` (ground, t=0).
 
         Its coordinates are (angle [rad], slide [m]); every call that takes `dof=` on it (add_motion,
         add_stop, ...) picks "rotation" or "translation" and defaults to "rotation"."""
-        return self._joint(name, "cylindrical", body_i, body_j, point, axis)
+        return self._joint(name, "cylindrical", body_i, body_j, point, axis, initial_displacement,
+                           initial_velocity)
 
-    def add_spherical(self, name, body_i, body_j, point) -> Joint:
-        """Spherical (ball) joint at `point` [m] in ground at t=0."""
-        return self._joint(name, "spherical", body_i, body_j, point, (0.0, 0.0, 1.0))
+    def add_spherical(self, name, body_i, body_j, point=None, initial_displacement=None,
+                      initial_velocity=None) -> Joint:
+        """Spherical (ball) joint at `point` [m] in ground at t=0 (or two markers); coordinates: the
+        relative rotation vector [rad] and relative angular velocity [rad/s] in body_i axes."""
+        return self._joint(name, "spherical", body_i, body_j, point, _Z, initial_displacement, initial_velocity)
 
-    def add_universal(self, name, body_i, body_j, point, axis_i, axis_j) -> Joint:
-        """Universal joint at `point`; `axis_i` fixed on body_i, `axis_j` on body_j, perpendicular at t=0."""
-        j = self._joint(name, "universal", body_i, body_j, point, axis_i)
-        j.axis_j = vec3(f"joint '{name}'", "axis_j", axis_j, unit=True)
-        if abs(float(j.axis @ j.axis_j)) > 1e-9:
-            del self.joints[name]
-            self._names.discard(name)
-            raise ModelError(f"joint '{name}'", "axis_j", "must be perpendicular to axis_i at t=0")
+    def add_universal(self, name, body_i, body_j, point=None, axis_i=None, axis_j=None,
+                      initial_displacement=None, initial_velocity=None) -> Joint:
+        """Universal joint at `point`; `axis_i` fixed on body_i, `axis_j` on body_j, perpendicular at t=0
+        (within 1e-6 rad: then axis_j is orthogonalised and the AssemblyReport notes it).  With two
+        markers the axes are their z axes.  Coordinates as a spherical joint's (rotation vector)."""
+        j = self._joint(name, "universal", body_i, body_j, point, axis_i, initial_displacement, initial_velocity)
+        try:
+            if j.marker_j is not None:
+                if axis_j is not None:
+                    raise ModelError(f"joint '{name}'", "axis_j", "omit the axes of a joint between two "
+                                     "markers (their z axes are used)")
+                j.axis_j = j.marker_j.orientation[:, 2].copy()
+            else:
+                j.axis_j = _universal_axis_j(j, axis_j)
+        except ModelError:
+            self._drop_joint(name)
+            raise
         return j
 
-    def add_planar(self, name, body_i, body_j, point, normal, u_axis=None) -> Joint:
+    def add_planar(self, name, body_i, body_j, point=None, normal=None, u_axis=None, initial_displacement=None,
+                   initial_velocity=None) -> Joint:
         """Planar joint: body_j moves in the plane through `point` with `normal` fixed on body_i.
 
         Its coordinates (Result.joint_coordinate) are [u, v, angle]: the joint point of body_j along the
         in-plane axes u and v = normal x u [m] and the rotation about the normal [rad], all fixed on
         body_i and zero as built.  `u_axis` (ground, t=0) must be perpendicular to the normal; the
         default is the ground x axis projected onto the plane, or the ground y axis projected when the
-        normal is within about 26 deg of x (|normal . x| > 0.9): normal +z gives u = +x, v = +y."""
-        j = self._joint(name, "planar", body_i, body_j, point, normal)
+        normal is within about 26 deg of x (|normal . x| > 0.9): normal +z gives u = +x, v = +y.
+        With two markers: normal = the I marker's z axis, u = its x axis."""
+        j = self._joint(name, "planar", body_i, body_j, point, normal, initial_displacement, initial_velocity)
         try:
+            if j.marker_i is not None and u_axis is not None:
+                raise ModelError(f"joint '{name}'", "u_axis", "omit it for a joint between two markers "
+                                 "(the I marker's x axis is used)")
             u = None if u_axis is None else vec3(f"joint '{name}'", "u_axis", u_axis, unit=True)
             if u is not None and abs(float(u @ j.axis)) > 1e-9:
                 raise ModelError(f"joint '{name}'", "u_axis", "must be perpendicular to the normal")
         except ModelError:
-            del self.joints[name]
-            self._names.discard(name)
+            self._drop_joint(name)
             raise
-        j.u_axis = _default_u_axis(j.axis) if u is None else u
+        j.u_axis = j.marker_i.orientation[:, 0].copy() if j.marker_i is not None else \
+            (_default_u_axis(j.axis) if u is None else u)
         return j
 
     def add_fixed(self, name, body_i, body_j, point=None) -> Joint:
-        """Fixed joint welding body_j to body_i (at `point`, default body_j's CM)."""
+        """Fixed joint welding body_j to body_i (at `point`, default body_j's CM; or two markers, which
+        assembly makes coincide, axes included)."""
         bj = self.bodies.get(body_j) if isinstance(body_j, str) else body_j   # a body may be given by name
         point = bj.position if point is None and isinstance(bj, Body) else point
-        return self._joint(name, "fixed", body_i, body_j, point, (0.0, 0.0, 1.0))
+        return self._joint(name, "fixed", body_i, body_j, point, _Z)
+
+    def _drop_joint(self, name):
+        del self.joints[name]
+        self._names.discard(name)
 
     # ----------------------------------------------------------------- drivers
     def add_motion(self, name, joint, displacement=None, velocity=None, acceleration=None,
@@ -134,6 +172,10 @@ class Model(ForceElementsMixin, FrictionPathMixin):
                 raise ModelError(entity, "displacement", "give exactly one of displacement, velocity, acceleration")
             kind, f = given[0]
             dof = self._motion_dof(entity, jt, dof)
+            for other in self.motions.values():
+                if other.joint is jt and other.dof == dof:
+                    raise ModelError(entity, "joint", f"the {dof} of joint '{jt.name}' is already driven by "
+                                     f"motion '{other.name}'; a coordinate takes one motion")
             try:
                 tf = time_function(f)
                 x0 = scalar(entity, "initial_displacement", initial_displacement)
@@ -254,20 +296,43 @@ class Model(ForceElementsMixin, FrictionPathMixin):
         body = frame.body if isinstance(frame, Marker) else frame
         self._lookup(body, self.bodies, entity, "frame")
 
-    def _joint(self, name, kind, body_i, body_j, point, axis) -> Joint:
+    def _joint(self, name, kind, body_i, body_j, point, axis, x0=None, v0=None) -> Joint:
         entity = f"joint '{name}'"
         self._claim(name, "joint")
         try:
-            bi = self._lookup(body_i, self.bodies, entity, "body_i")
-            bj = self._lookup(body_j, self.bodies, entity, "body_j")
-            if bi is bj:
-                raise ModelError(entity, "body_j", "a joint needs two different bodies")
-            jt = Joint(name, kind, bi, bj, vec3(entity, "point", point), vec3(entity, "axis", axis, unit=True))
+            if isinstance(body_i, Marker) or isinstance(body_j, Marker):
+                jt = self._marker_joint(entity, name, kind, body_i, body_j, point, axis)
+            else:
+                bi = self._lookup(body_i, self.bodies, entity, "body_i")
+                bj = self._lookup(body_j, self.bodies, entity, "body_j")
+                if bi is bj:
+                    raise ModelError(entity, "body_j", "a joint needs two different bodies")
+                for fld, val in (("point", point), ("axis", axis)):
+                    if val is None:
+                        raise ModelError(entity, fld, "is required (or give two markers instead of the bodies)")
+                jt = Joint(name, kind, bi, bj, vec3(entity, "point", point), vec3(entity, "axis", axis, unit=True))
+            jt.initial_displacement = joint_initial(entity, kind, "initial_displacement", x0)
+            jt.initial_velocity = joint_initial(entity, kind, "initial_velocity", v0)
         except ModelError:
             self._names.discard(name)
             raise
         self.joints[name] = jt
         return jt
+
+    def _marker_joint(self, entity, name, kind, mi, mj, point, axis) -> Joint:
+        """A joint between two markers: I on body_i, J on body_j (point = I's origin, axis = I's z)."""
+        for fld, m in (("body_i", mi), ("body_j", mj)):
+            if not isinstance(m, Marker):
+                raise ModelError(entity, fld, f"give two markers or two bodies, not a mix (got {m!r})")
+            self._lookup(m.body, self.bodies, entity, fld)
+        if mi.body is mj.body:
+            raise ModelError(entity, "body_j", "the two markers are on the same body")
+        if point is not None:
+            raise ModelError(entity, "point", "omit it for a joint between two markers (their origins are used)")
+        if axis is not None and axis is not _Z:
+            raise ModelError(entity, "axis", "omit it for a joint between two markers (their z axes are used)")
+        return Joint(name, kind, mi.body, mj.body, mi.point.copy(), mi.orientation[:, 2].copy(),
+                     marker_i=mi, marker_j=mj)
 
     @staticmethod
     def _motion_dof(entity, joint, dof):
@@ -288,6 +353,26 @@ class Model(ForceElementsMixin, FrictionPathMixin):
     def __repr__(self) -> str:
         return (f"Model({self.name!r}: {len(self.bodies) - 1} bodies, {len(self.joints)} joints, "
                 f"{len(self.motions)} motions, {len(self.forces)} forces)")
+
+
+_Z = np.array([0.0, 0.0, 1.0])   # placeholder axis of joints without one (spherical, fixed)
+
+
+def _universal_axis_j(j, axis_j) -> np.ndarray:
+    """axis_j of a universal joint: perpendicular to axis_i within 1e-6 rad (then orthogonalised, noted)."""
+    entity = f"joint '{j.name}'"
+    if axis_j is None:
+        raise ModelError(entity, "axis_j", "is required (or give two markers instead of the bodies)")
+    aj = vec3(entity, "axis_j", axis_j, unit=True)
+    dev = abs(float(np.arcsin(np.clip(j.axis @ aj, -1.0, 1.0))))
+    if dev > 1e-6:
+        raise ModelError(entity, "axis_j", f"must be perpendicular to axis_i at t=0; they are "
+                         f"{np.degrees(dev):.6g} deg ({dev:.3g} rad) off (1e-6 rad is accepted)")
+    if dev > 0.0:
+        aj = aj - (aj @ j.axis) * j.axis
+        aj = aj / np.linalg.norm(aj)
+        j.notes.append(f"axis_j orthogonalised to axis_i (was {dev:.3g} rad off perpendicular)")
+    return aj
 
 
 def _default_u_axis(normal) -> np.ndarray:

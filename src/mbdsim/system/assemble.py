@@ -122,8 +122,18 @@ def assemble_system(model) -> System:
 
 
 def joint_geometry(joint, fid) -> JointGeom:
-    """Joint point and axes expressed on each of its bodies at t=0."""
+    """Joint point and axes expressed on each of its bodies at t=0.
+
+    A joint between two markers (joint.marker_i / marker_j) takes s_i and (f_i, g_i, h_i) from the I
+    marker and s_j and (f_j, g_j, h_j) from the J marker (their x, y, z axes), so the bodies may be drawn
+    apart; a universal joint's second axis is then the J marker's z axis."""
     bi, bj = joint.body_i, joint.body_j
+    mi, mj = getattr(joint, "marker_i", None), getattr(joint, "marker_j", None)
+    if mi is not None and mj is not None:
+        Ri, Rj = mi.R_BM, mj.R_BM
+        extra = Rj[:, 2] if joint.kind == "universal" else None
+        return JointGeom(joint.name, fid[bi], fid[bj], bi.is_particle, bj.is_particle, mi.s_B, mj.s_B,
+                         Ri[:, 0], Ri[:, 1], Ri[:, 2], Rj[:, 0], Rj[:, 1], Rj[:, 2], extra)
     f, g, h = perpendicular_frame(joint.axis)
     if joint.kind == "planar" and joint.u_axis is not None:   # the user's / documented in-plane axes
         f, g = joint.u_axis, np.cross(joint.axis, joint.u_axis)
