@@ -9,27 +9,53 @@ import numpy as np
 from ..errors import AssemblyError
 from ..system.assemble import System, assemble_system
 from ..system.equations import constraint_terms
-from .common import dependent_owners, independent_rows, project_positions, project_velocities
+from .common import (DENSE_LIMIT, active_rows, dependent_owners, increment, independent_rows, min_norm_solve,
+                     project_velocities)
+from .held import (changed_items, joint_position_items, kinetic_metric, length_scale, lexi_solve,
+                   position_metric, velocity_items)
 
 
 class RedundantConstraintWarning(UserWarning):
     """Some constraint equations are linearly dependent (e.g. a planar loop of 3D revolutes)."""
 
 
+class InitialConditionWarning(UserWarning):
+    """Given initial values (body velocities, joint initial displacements or velocities) that are not
+    consistent with the joints, the drivers and each other: the values used are the closest fit in the
+    kinetic-energy metric; the warning names each changed body or joint with the value given and used."""
+
+
 @dataclass(repr=False)
 class AssemblyReport:
-    """Consistent initial state and what assembly changed (SI units, ground axes)."""
+    """Consistent initial state and what assembly changed (SI units, ground axes).
+
+    Attributes:
+        system: the assembled System.  t: assembly time [s].
+        q, v: consistent coordinates and velocity variables (see mbdsim.system.assemble for the layout).
+        rows: indices of an independent subset of the constraint rows.
+        dof: degrees of freedom left by the joints and motions.
+        redundant: joints/motions involved in redundant (dependent) constraint rows.
+        moved: body name -> (distance its CM moved [m], angle it turned [rad]) from as drawn; nothing
+            below the tolerance (1e-10 of the model size, 1e-10 rad) is listed.
+        velocity_changed: body name -> |change| of its given velocity or angular velocity (SI).
+        changed: (entity, field, given, used) of each given value that could not be held.
+        notes: remarks on the model's geometry (e.g. universal-joint axes orthogonalised).
+        residual: max |phi| after assembly [m or rad].
+    `print(report)` gives a readable summary.
+    """
 
     system: System
     t: float
     q: np.ndarray
     v: np.ndarray
-    rows: np.ndarray                 # independent constraint rows
-    dof: int                         # degrees of freedom left by joints and motions
-    redundant: list = field(default_factory=list)   # joints/motions involved in redundant rows
-    moved: dict = field(default_factory=dict)       # body -> (|dr| [m], rotation angle [rad])
-    velocity_changed: dict = field(default_factory=dict)  # body -> |dv| (velocity variables)
-    residual: float = 0.0            # max |phi| after assembly [m or rad]
+    rows: np.ndarray
+    dof: int
+    redundant: list = field(default_factory=list)
+    moved: dict = field(default_factory=dict)
+    velocity_changed: dict = field(default_factory=dict)
+    residual: float = 0.0
+    changed: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
 
     def __repr__(self) -> str:
         return f"AssemblyReport(t={self.t:g} s, dof={self.dof}, residual={self.residual:.3g}, moved={list(self.moved)})"
@@ -38,15 +64,30 @@ class AssemblyReport:
         lines = [f"assembly at t = {self.t:g} s: {self.dof} DOF, residual {self.residual:.3g}"]
         if self.redundant:
             lines.append("redundant constraints among: " + ", ".join(self.redundant))
+        lines += [f"  note: {n}" for n in self.notes]
+        if not self.moved:
+            lines.append("  no body moved")
         for name, (dr, da) in self.moved.items():
             lines.append(f"  moved {name}: {dr:.6g} m, {np.degrees(da):.6g} deg")
         for name, dv in self.velocity_changed.items():
             lines.append(f"  velocity of {name} changed by {dv:.6g}")
+        lines += [f"  {e} {f}: given {_fmt(g)}, used {_fmt(u)}" for e, f, g, u in self.changed]
         return "\n".join(lines)
 
 
+def _fmt(x):
+    x = np.atleast_1d(x)
+    return f"{x[0]:.9g}" if len(x) == 1 else "(" + ", ".join(f"{a:.9g}" for a in x) + ")"
+
+
 def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
-    """Solve phi(q, t) = 0 and phi_q v = nu from the model's initial values (minimum-norm corrections)."""
+    """Solve phi(q, t) = 0 and phi_q v = nu from the model's initial values.
+
+    Given values (joint initial displacements and velocities, body velocities, drivers) are held exactly
+    when consistent, else fitted in the kinetic-energy metric with an InitialConditionWarning; the rest
+    is the least correction of the drawn positions (weighted by each body's mass and inertia) and the
+    least kinetic energy.  Raises AssemblyError when the constraints cannot be met or a motion is
+    dependent on the constraints and the other motions (over-driven)."""
     from .kinematic import check_model
     check_model(model)
     sys = assemble_system(model)
@@ -54,38 +95,151 @@ def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
 
 
 def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
-    """Assembly from a given state of an assembled System."""
-    _, J0, _, _ = constraint_terms(sys, q0, v0, t)
-    q, res, _ = project_positions(sys, q0, t, sys.fixed_rows, tol=tol, maxit=50)  # friction locks: run time
-    if res > 1e-9:
-        phi = constraint_terms(sys, q, v0, t, jacobian=False)[0][sys.fixed_rows]
-        worst = [sys.row_owner[k] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9]
-        raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
-                            time=t, joints=dict.fromkeys(worst), state=q)
-    J = constraint_terms(sys, q, v0, t)[1][sys.fixed_rows]
+    """Assembly from a given state of an assembled System.
+
+    The model's held values (joint initial values, given body velocities) apply when q0 / v0 are the
+    System's own initial arrays (sys.q0 / sys.v0); other states are corrected by the least change."""
+    rows_all = sys.fixed_rows   # friction locks: run time
+    own_q = q0 is sys.q0
+    q, changed = positions(sys, q0, t, rows_all, tol, held=own_q)
+    J = constraint_terms(sys, q, v0, t)[1][rows_all]
     rows = independent_rows(J, sys=sys)
+    _check_overdriven(sys, J, rows, t, q)
     redundant = dependent_owners(sys, J, rows)
     if redundant:
         warnings.warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
                       f"joints involved: {', '.join(redundant)}. The dynamics use an independent subset; "
                       "indeterminate reaction components are returned as the minimum-norm solution.",
                       RedundantConstraintWarning, stacklevel=3)
-    v = project_velocities(sys, q, v0, t, rows)
+    if v0 is sys.v0:
+        v, vchanged = velocities(sys, q, t, rows)
+        changed += vchanged
+        vmoved = {e.split("'")[1]: float(np.linalg.norm(u - g)) for e, f, g, u in vchanged if e.startswith("body")}
+    else:
+        v = project_velocities(sys, q, v0, t, rows)
+        vmoved = _vchanged(sys, v0, v)
+    if changed:
+        warnings.warn("initial values not consistent with the joints and drivers were changed (kinetic-"
+                      "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)}"
+                                                  for e, f, g, u in changed), InitialConditionWarning, stacklevel=3)
+    phi = constraint_terms(sys, q, v, t, False)[0][rows_all]
+    notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
-                          _vchanged(sys, v0, v), float(np.max(np.abs(constraint_terms(sys, q, v, t, False)[0][sys.fixed_rows]),
-                                                              initial=0.0)))
+                          vmoved, float(np.max(np.abs(phi), initial=0.0)), changed, notes)
+
+
+# ------------------------------------------------------------------------------ positions
+def positions(sys, q0, t, rows, tol, held=True):
+    """Newton onto phi(q, t) = 0 with steps least in the position metric (held.position_metric); with
+    `held`, the joints' initial displacements are reached by continuation from as drawn (so the branch
+    is kept) and held exactly when consistent.  Returns (q, changed items)."""
+    D = position_metric(sys)
+    items = joint_position_items(sys, q0) if held else []
+    q = q0
+    if not items:
+        q, res = _newton(sys, q0, t, rows, tol, D)
+        _check_residual(sys, q, t, rows, res)
+        return q, []
+    L = length_scale(sys)
+    span = max(max(float(np.max(np.abs(np.where(it.angle, it.g, it.g / L)))) for it in items), 1e-300)
+    n = int(min(400, max(1, np.ceil(span / 0.2))))
+    M = np.diag(D)
+    for k in range(1, n + 1):
+        q, consistent, items = _held_newton(sys, q, t, rows, tol, M, k / n)
+    _check_residual(sys, q, t, rows, _residual(sys, q, t, rows))
+    return q, ([] if consistent else changed_items(items, None))
+
+
+def _held_newton(sys, q, t, rows, tol, M, scale, maxit=50):
+    consistent, items = True, []
+    for _ in range(maxit):
+        phi, J = (x[rows] for x in constraint_terms(sys, q, np.zeros(sys.nv), t)[:2])
+        items = joint_position_items(sys, q, scale)
+        for it in items:
+            it.g = it.residual()          # the step's target: the (wrapped) residual
+        dx, consistent = lexi_solve(J, -phi, items, M)
+        q = increment(sys, q, dx)
+        if np.max(np.abs(dx), initial=0.0) < 1e-14 * max(1.0, length_scale(sys)) and \
+                np.max(np.abs(phi), initial=0.0) <= tol:
+            break
+    items = joint_position_items(sys, q, scale)
+    L = length_scale(sys)
+    consistent = all(np.max(np.abs(np.where(it.angle, 1.0, 1.0 / L) * it.residual())) <= 1e-9 for it in items)
+    return q, consistent, items
+
+
+def _newton(sys, q, t, rows, tol, D, maxit=50):
+    """Newton with steps least in the diagonal metric D: dx = D^-1/2 (J D^-1/2)^+ (-phi)."""
+    rows = active_rows(sys, rows, t)
+    s = 1.0 / np.sqrt(D)
+    res = np.inf
+    for _ in range(maxit):
+        phi, J = (x[rows] for x in constraint_terms(sys, q, np.zeros(sys.nv), t)[:2])
+        res = float(np.max(np.abs(phi), initial=0.0))
+        if res <= tol:
+            break
+        dx = s * min_norm_solve(J * s, -phi)
+        q = increment(sys, q, dx)
+        if float(np.max(np.abs(dx))) < 1e-15 * max(1.0, float(np.max(np.abs(q)))):
+            break
+    return q, res
+
+
+def _residual(sys, q, t, rows):
+    return float(np.max(np.abs(constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0][rows]),
+                        initial=0.0))
+
+
+def _check_residual(sys, q, t, rows, res):
+    if res > 1e-9:
+        phi = constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0][rows]
+        worst = [sys.row_owner[rows[k]] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9]
+        raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
+                            time=t, joints=dict.fromkeys(worst), state=q)
+
+
+def _check_overdriven(sys, J, rows, t, q):
+    """AssemblyError naming the motions that are dependent on the constraints and the other motions."""
+    if len(rows) == J.shape[0]:
+        return
+    motions = [m for m in sys.model.motions if m in sys.owner_rows]
+    bad = []
+    for m in motions:
+        keep = np.setdiff1d(np.arange(J.shape[0]), sys.owner_rows[m])
+        if len(independent_rows(J[keep])) == len(rows):   # m adds nothing: it is implied by the rest
+            bad.append(m)
+    if bad:
+        raise AssemblyError("over-driven mechanism: motion(s) " + ", ".join(f"'{m}'" for m in bad) +
+                            " are dependent on the constraints and the other motions (remove one)",
+                            time=t, joints=bad, state=q)
+
+
+# ------------------------------------------------------------------------------ velocities
+def velocities(sys, q, t, rows):
+    """Velocities holding the given values (fitted in the kinetic-energy metric when inconsistent),
+    the rest of least kinetic energy.  Returns (v, changed items)."""
+    _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
+    rows = active_rows(sys, rows, t)
+    items = velocity_items(sys, q)
+    if not items and sys.nv > DENSE_LIMIT:
+        return project_velocities(sys, q, np.zeros(sys.nv), t, rows), []
+    v, consistent = lexi_solve(J[rows], nu[rows], items, kinetic_metric(sys))
+    return v, ([] if consistent else changed_items(items, v))
 
 
 def _moved(sys, q0, q):
     out = {}
+    L = length_scale(sys)
     for k, b in enumerate(sys.bodies):
         dr = float(np.linalg.norm(q[sys.r_idx[k]] - q0[sys.r_idx[k]]))
         da = 0.0
         if not b.is_particle:
             pi = list(sys.rigid_fid).index(k + 1)
-            c = abs(float(q[sys.p_idx[pi]] @ q0[sys.p_idx[pi]]) / np.linalg.norm(q0[sys.p_idx[pi]]))
-            da = 2 * float(np.arccos(min(1.0, c)))
-        if dr > 1e-12 or da > 1e-12:
+            p0, p = q0[sys.p_idx[pi]], q[sys.p_idx[pi]]
+            p0, p = p0 / np.linalg.norm(p0), p / np.linalg.norm(p)
+            rel = np.array([p0 @ p, *(p0[0] * p[1:] - p[0] * p0[1:] - np.cross(p0[1:], p[1:]))])
+            da = 2 * float(np.arctan2(np.linalg.norm(rel[1:]), abs(rel[0])))
+        if dr > 1e-10 * L or da > 1e-10:
             out[b.name] = (dr, da)
     return out
 
