@@ -27,7 +27,7 @@ def assembled(model):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         rep = mb.assemble(model)
-    return rep, [w for w in caught if issubclass(w.category, mb.solvers.assembly.InitialConditionWarning)]
+    return rep, [w for w in caught if issubclass(w.category, mb.InitialConditionWarning)]
 
 
 def test_joint_initial_velocity_sets_the_rod_centre_velocity():
@@ -156,7 +156,7 @@ def universal_values():
 def test_multi_coordinate_joints_start_at_the_given_values(kind, x0, v0):
     model = one_joint(kind, x0, v0)
     with warnings.catch_warnings():
-        warnings.simplefilter("error", mb.solvers.assembly.InitialConditionWarning)
+        warnings.simplefilter("error", mb.InitialConditionWarning)
         res = mb.simulate(model, 0.01, 0.005)
     np.testing.assert_allclose(res.joint_coordinate("j")[0], x0, atol=1e-10)
     np.testing.assert_allclose(res.joint_velocity("j")[0], v0, atol=1e-10)

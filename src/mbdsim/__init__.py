@@ -23,6 +23,7 @@ _LAZY = {
     "Box": ".model.shapes", "Cylinder": ".model.shapes", "load_model": ".io", "save_model": ".io",
     "Result": ".results",
     "AssemblyReport": ".solvers.assembly", "RedundantConstraintWarning": ".solvers.assembly",
+    "InitialConditionWarning": ".solvers.assembly", "SingularConfigurationWarning": ".solvers.kinematic",
     "assemble": ".solvers.assembly", "simulate": ".solvers.dynamic", "kinematics": ".solvers.kinematic",
     "equilibrium": ".solvers.static", "quasi_static": ".solvers.static",
     "UnstableEquilibriumWarning": ".solvers.static", "linearize": ".solvers.linear",

@@ -101,7 +101,11 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     System's own initial arrays (sys.q0 / sys.v0); other states are corrected by the least change."""
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
-    q, changed = positions(sys, q0, t, rows_all, tol, held=own_q)
+    try:
+        q, changed = positions(sys, q0, t, rows_all, tol, held=own_q)
+    except AssemblyError:
+        _overdriven_failure(sys, q0, t, rows_all, tol)
+        raise
     J = constraint_terms(sys, q, v0, t)[1][rows_all]
     rows = independent_rows(J, sys=sys)
     _check_overdriven(sys, J, rows, t, q)
@@ -196,6 +200,21 @@ def _check_residual(sys, q, t, rows, res):
         worst = [sys.row_owner[rows[k]] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9]
         raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
                             time=t, joints=dict.fromkeys(worst), state=q)
+
+
+def _overdriven_failure(sys, q0, t, rows, tol):
+    """When assembly fails: AssemblyError naming the motions if they are dependent on the joints and
+    each other at the configuration the joints alone assemble to (else nothing: the caller re-raises)."""
+    motions = set(sys.model.motions)
+    if not motions:
+        return
+    free = np.array([r for r in rows if sys.row_owner[r] not in motions], dtype=int)
+    try:
+        q, _ = positions(sys, q0, t, free, tol, held=False)
+    except AssemblyError:
+        return
+    J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][rows]
+    _check_overdriven(sys, J, independent_rows(J, sys=sys), t, q)
 
 
 def _check_overdriven(sys, J, rows, t, q):
