@@ -62,10 +62,31 @@ class Result:
                 np.any(ts > hi + 1e-12 * max(1, abs(hi))):
             raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
         if self._evaluate is None:
-            idx = [int(np.argmin(np.abs(self.time - x))) for x in ts]
-            return self._subset(idx)
+            return self._bracketed(ts)
         q, v, vd, lam = self._evaluate(np.clip(ts, lo, hi))
         out = Result(self.system, ts, q, v, vd, lam, self._evaluate, self.success, self.status, self.message)
+        out._parent = self._parent or self
+        return out
+
+    def _bracketed(self, ts) -> "Result":
+        """Without dense output: cubic Hermite between the two samples that bracket each t (q from q and
+        dq/dt, v from v and vd when the result has accelerations, else linear; vd and lambda_ linear);
+        Euler parameters renormalised."""
+        if len(self.time) < 2:
+            return self._subset([0] * len(ts))
+        from ..solvers.common import normalize, qdot
+        k = np.clip(np.searchsorted(self.time, ts), 1, len(self.time) - 1)
+        a, b = k - 1, k
+        h = (self.time[b] - self.time[a])[:, None]
+        s = (ts - self.time[a])[:, None] / h
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, 3 * s**2 - 2 * s**3, s**3 - s**2
+        qd = lambda i: np.array([qdot(self.system, self.q[j], self.v[j]) for j in i])  # noqa: E731
+        herm = lambda y, da, db: h00 * y[a] + h10 * h * da + h01 * y[b] + h11 * h * db  # noqa: E731
+        lin = lambda y: None if y is None else (1 - s) * y[a] + s * y[b]  # noqa: E731
+        q = np.array([normalize(self.system, x) for x in herm(self.q, qd(a), qd(b))])
+        v = lin(self.v) if self.vd is None else herm(self.v, self.vd[a], self.vd[b])
+        out = Result(self.system, ts, q, v, lin(self.vd), lin(self.lambda_), None, self.success, self.status,
+                     self.message)
         out._parent = self._parent or self
         return out
 
