@@ -5,6 +5,8 @@ reactions from the equations of motion phi_q^T lambda_ = Q - M vd (minimum norm 
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
 from ..errors import AssemblyError, ModelError
@@ -17,8 +19,22 @@ from .common import increment, project_positions
 from .state import state_factory
 
 
+SINGULAR_TOL = 1e-4   # relative conditioning of the scaled constraint Jacobian flagged as singular
+
+
+class SingularConfigurationWarning(UserWarning):
+    """The driven mechanism passes a singular configuration (dead centre, toggle, bifurcation): the
+    constraint Jacobian with drivers loses rank; the analysis keeps the branch by continuity."""
+
+
 def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
-    """Kinematic analysis from start_time to end_time [s], sampled every output_step [s]."""
+    """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
+
+    The conditioning of the constraint Jacobian (with drivers, columns weighted by the bodies' masses
+    and inertias, rows normalised) is monitored: samples where it falls below SINGULAR_TOL are recorded
+    in res.stats["singular"] (time [s], conditioning, joints involved) and each passage is warned
+    (SingularConfigurationWarning); the branch is kept by continuity, every prediction coming from
+    the last non-singular sample and the rates at a singular sample from that sample's extrapolation."""
     from ..system.assemble import assemble_system
     check_model(model)
     sys = assemble_system(model)
@@ -28,24 +44,75 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
                          f"driven; {rep.dof} DOF remain free (add motions or use mb.simulate)")
     times = time_grid(start_time, end_time, output_step)
     sf = state_factory(sys)
-    out, q = [], rep.q
-    prev = None
+    mon = Monitor(sys, rep.rows)
+    out, flags, records = [], [], []
+    anchor = None            # last non-singular sample
     message, success, error = "ok", True, None
     for t in times:
         try:
-            q = _predict(sys, prev, t) if prev is not None else q
-            state = solve_at(sys, q, t, sf)
+            guess = rep.q if anchor is None else _predict(sys, anchor, t)
+            state = solve_at(sys, guess, t, sf)
+            cond, joints = mon(state[1], t)
+            if cond < SINGULAR_TOL:
+                state = solve_at(sys, state[1], t, sf, hint=None if anchor is None else _rates_hint(anchor, t))
+                records.append({"time": float(t), "conditioning": cond, "joints": joints, "sample": len(out)})
         except AssemblyError as exc:
             success, error = False, exc
-            message = f"{exc}; last good state at t = {prev[0] if prev else start_time:.9g} s"
+            message = f"{exc}; last good state at t = {out[-1][0] if out else start_time:.9g} s"
             break
         out.append(state)
-        prev = state
+        flags.append(cond < SINGULAR_TOL)
+        if cond >= SINGULAR_TOL:
+            anchor = state
         _continue_angles(sys, state)
-    ev = lambda ts: _evaluate(sys, out, ts, sf)  # noqa: E731
+    _warn_singular(records)
+    singular = np.array(flags, dtype=bool)
+    ev = lambda ts: _evaluate(sys, out, singular, ts, sf)  # noqa: E731
     res = _result(sys, out, ev, success, message)
+    res.stats["singular"] = records
     res.error = error
     return res
+
+
+class Monitor:
+    """Conditioning (smallest / largest singular value) of the constraint Jacobian rows `rows`, its columns
+    weighted by 1/sqrt of the position metric and its rows normalised, and the joints/motions of the
+    weakest direction."""
+
+    def __init__(self, sys, rows):
+        from .held import position_metric
+        self.sys, self.rows = sys, rows
+        self.scale = 1.0 / np.sqrt(position_metric(sys))
+
+    def __call__(self, q, t):
+        sys = self.sys
+        if sys.nv > 600 or not len(self.rows):
+            return 1.0, []
+        J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][self.rows] * self.scale
+        J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
+        u, sv, _ = np.linalg.svd(J, full_matrices=False)
+        k = int(np.argmin(sv))
+        weak = np.abs(u[:, k])
+        names = list(dict.fromkeys(sys.row_owner[self.rows[i]] for i in np.argsort(-weak)
+                                   if weak[i] > 0.2 * weak.max()))
+        return float(sv[k] / max(sv.max(), 1e-300)), names
+
+
+def _warn_singular(records):
+    """One warning per passage (consecutive flagged samples), at its worst-conditioned sample."""
+    passages = []
+    for r in records:
+        if passages and r["sample"] == passages[-1][-1]["sample"] + 1:
+            passages[-1].append(r)
+        else:
+            passages.append([r])
+    for g in passages:
+        worst = min(g, key=lambda r: r["conditioning"])
+        warnings.warn(f"singular configuration (dead centre, toggle or bifurcation) at t = {worst['time']:.9g} s: "
+                      f"the constraint Jacobian with drivers is nearly rank deficient (conditioning "
+                      f"{worst['conditioning']:.3g}); joints involved: {', '.join(worst['joints'])}. The analysis "
+                      "keeps the branch by continuity; see res.stats['singular']", SingularConfigurationWarning,
+                      stacklevel=3)
 
 
 def check_model(model):
@@ -74,18 +141,26 @@ def time_grid(t0, t1, step):
         np.append(t0 + step * np.arange(n), t1)
 
 
-def solve_at(sys, q_guess, t, sf=None):
-    """(t, q, v, vd, lambda_) of the driven mechanism at time t [s]."""
+def solve_at(sys, q_guess, t, sf=None, hint=None):
+    """(t, q, v, vd, lambda_) of the driven mechanism at time t [s].
+
+    `hint` = (v, vd) expected by continuity: at a (nearly) singular configuration the rates are the
+    hint corrected by the least change that satisfies the velocity and acceleration equations."""
     q, res, _ = project_positions(sys, q_guess, t, sys.fixed_rows, tol=1e-13, maxit=30)
     if res > 1e-9:
         phi = constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0]
         worst = list(dict.fromkeys(sys.row_owner[k] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9))
         raise AssemblyError(f"position analysis failed (lock-up or impossible motion), residual {res:.3g}",
                             time=t, joints=worst, state=q)
+    if hint is None:
+        v0, vd0, S, rc = np.zeros(sys.nv), np.zeros(sys.nv), np.ones(sys.nv), None
+    else:   # least change in the mass/inertia metric, the singular direction left to the hint
+        from .held import position_metric
+        (v0, vd0), S, rc = hint, 1.0 / np.sqrt(position_metric(sys)), SINGULAR_TOL
     _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
-    v = np.linalg.lstsq(J, nu, rcond=None)[0]
+    v = v0 + S * np.linalg.lstsq(J * S, nu - J @ v0, rcond=rc)[0]
     _, J, _, gamma = constraint_terms(sys, q, v, t)
-    vd = np.linalg.lstsq(J, gamma, rcond=None)[0]
+    vd = vd0 + S * np.linalg.lstsq(J * S, gamma - J @ vd0, rcond=rc)[0]
     Q = applied_forces(sys, body_frames(sys, q, v), t, sf(t, q, v) if sf else None)
     lam = np.linalg.lstsq(J.T, Q - sys.M @ vd, rcond=None)[0]
     return t, q, v, vd, lam
@@ -108,12 +183,28 @@ def _predict(sys, prev, t):
     return increment(sys, q, h * v + 0.5 * h * h * vd)
 
 
-def _evaluate(sys, out, ts, sf):
+def _rates_hint(prev, t):
+    """(v, vd) at t extrapolated from the sample `prev` (v + h vd, vd)."""
+    t0, _, v, vd, _ = prev
+    return v + (t - t0) * vd, vd
+
+
+def _evaluate(sys, out, singular, ts, sf):
+    """States at times ts: predicted from the nearer non-singular of the two samples that bracket each
+    t (so the branch of the bracketing samples is kept), then solved; rates by continuity from that
+    sample where the configuration is singular."""
     times = np.array([s[0] for s in out])
+    good = np.where(~singular)[0] if (~singular).any() else np.arange(len(out))
     states = []
     for t in ts:
-        k = int(np.argmin(np.abs(times - t)))
-        states.append(solve_at(sys, _predict(sys, out[k], t), t, sf))
+        k = int(np.clip(np.searchsorted(times, t), 1, max(len(times) - 1, 1)))
+        pair = [i for i in (k - 1, k) if 0 <= i < len(out)]
+        cand = [i for i in pair if not singular[i]] or [int(good[np.argmin(np.abs(times[good] - t))])]
+        a = min(cand, key=lambda i: abs(times[i] - t))
+        st = solve_at(sys, _predict(sys, out[a], t), t, sf)
+        if any(singular[i] for i in pair):
+            st = solve_at(sys, st[1], t, sf, hint=_rates_hint(out[a], t))
+        states.append(st)
     return tuple(np.array([s[i] for s in states]) for i in range(1, 5))
 
 
