@@ -160,3 +160,17 @@ def test_multi_coordinate_joints_start_at_the_given_values(kind, x0, v0):
         res = mb.simulate(model, 0.01, 0.005)
     np.testing.assert_allclose(res.joint_coordinate("j")[0], x0, atol=1e-10)
     np.testing.assert_allclose(res.joint_velocity("j")[0], v0, atol=1e-10)
+
+
+def test_readme_initial_conditions_example_matches_the_closed_form():
+    import re
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    section = text.split("## Initial conditions", 1)[1].split("\n## ", 1)[0]
+    code = re.findall(r"```python\n(.*?)```", section, re.S)[0]
+    ns = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
+        exec(compile(code.replace("print(", "str("), "README.md", "exec"), ns)   # noqa: S102 - our own docs
+    x, xd = slider_law(np.radians(60.0), 2 * np.pi)
+    assert ns["x0"] == pytest.approx(x, abs=1e-10) and ns["v0"] == pytest.approx(xd, abs=1e-10)
