@@ -174,3 +174,15 @@ def test_readme_initial_conditions_example_matches_the_closed_form():
         exec(compile(code.replace("print(", "str("), "README.md", "exec"), ns)   # noqa: S102 - our own docs
     x, xd = slider_law(np.radians(60.0), 2 * np.pi)
     assert ns["x0"] == pytest.approx(x, abs=1e-10) and ns["v0"] == pytest.approx(xd, abs=1e-10)
+
+
+def test_joint_initial_values_against_a_driver_are_changed_with_a_warning_naming_the_joint():
+    model, rod = pendulum(iv=1.0)
+    model.joints["pin"].initial_displacement = np.array([0.3])
+    model.add_motion("drive", "pin", displacement="0.1 + 2*t")
+    rep, warned = assembled(model)
+    text = str(warned[0].message)
+    assert "joint 'pin' initial_displacement given 0.3, used 0.1" in text
+    assert "joint 'pin' initial_velocity given 1, used 2" in text
+    assert rep.moved["rod"][1] == pytest.approx(0.1, abs=1e-12)       # turned to the driver's 0.1 rad
+    assert rep.v[5] == pytest.approx(2.0, abs=1e-12)

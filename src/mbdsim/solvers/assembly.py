@@ -240,10 +240,26 @@ def velocities(sys, q, t, rows):
     _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
     rows = active_rows(sys, rows, t)
     items = velocity_items(sys, q)
-    if not items and sys.nv > DENSE_LIMIT:
-        return project_velocities(sys, q, np.zeros(sys.nv), t, rows), []
+    if sys.nv > DENSE_LIMIT:
+        return _velocities_sparse(sys, q, t, rows, J, nu, items)
     v, consistent = lexi_solve(J[rows], nu[rows], items, kinetic_metric(sys))
     return v, ([] if consistent else changed_items(items, v))
+
+
+def _velocities_sparse(sys, q, t, rows, J, nu, items):
+    """Large systems: the given values stacked on the constraints, least kinetic energy (diagonal metric)
+    when consistent; else the given values projected onto the constraints (least change)."""
+    if not items:
+        return project_velocities(sys, q, np.zeros(sys.nv), t, rows), []
+    S = 1.0 / np.sqrt(np.diag(kinetic_metric(sys)))
+    A = np.vstack([J[rows]] + [it.C for it in items])
+    rhs = np.concatenate([nu[rows]] + [it.g for it in items])
+    v = S * min_norm_solve(A * S, rhs)
+    if np.max(np.abs(A @ v - rhs)) <= 1e-9 * max(1.0, float(np.max(np.abs(rhs)))):
+        return v, []
+    v0 = S * min_norm_solve(np.vstack([it.C for it in items]) * S, np.concatenate([it.g for it in items]))
+    v = project_velocities(sys, q, v0, t, rows)
+    return v, changed_items(items, v)
 
 
 def _moved(sys, q0, q):
