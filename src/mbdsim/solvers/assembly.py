@@ -172,18 +172,28 @@ def _held_newton(sys, q, t, rows, tol, M, scale, maxit=50):
     return q, consistent, items
 
 
-def _newton(sys, q, t, rows, tol, D, maxit=50):
-    """Newton with steps least in the diagonal metric D: dx = D^-1/2 (J D^-1/2)^+ (-phi)."""
+def _newton(sys, q0, t, rows, tol, D, maxit=50):
+    """Newton with steps least in the diagonal metric D: dx = D^-1/2 (J D^-1/2)^+ (-phi); when full steps
+    do not converge (a body drawn far off), again with backtracking on |phi|."""
+    q, res = _newton_run(sys, q0, t, rows, tol, D, maxit, False)
+    return (q, res) if res <= 1e-9 else _newton_run(sys, q0, t, rows, tol, D, 4 * maxit, True)
+
+
+def _newton_run(sys, q, t, rows, tol, D, maxit, backtrack):
     rows = active_rows(sys, rows, t)
     s = 1.0 / np.sqrt(D)
     res = np.inf
+    norm = lambda x: float(np.linalg.norm(constraint_terms(sys, x, np.zeros(sys.nv), t, False)[0][rows]))  # noqa: E731
     for _ in range(maxit):
         phi, J = (x[rows] for x in constraint_terms(sys, q, np.zeros(sys.nv), t)[:2])
         res = float(np.max(np.abs(phi), initial=0.0))
         if res <= tol:
             break
         dx = s * min_norm_solve(J * s, -phi)
-        q = increment(sys, q, dx)
+        step, n0 = 1.0, float(np.linalg.norm(phi))
+        while backtrack and step > 1e-3 and res > 1e-6 and norm(increment(sys, q, step * dx)) >= n0:
+            step *= 0.5   # far from the solution: backtrack along the Gauss-Newton direction
+        q = increment(sys, q, step * dx)
         if float(np.max(np.abs(dx))) < 1e-15 * max(1.0, float(np.max(np.abs(q)))):
             break
     return q, res
