@@ -15,7 +15,7 @@ from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .assembly import assemble_state
-from .common import increment, project_positions
+from .common import DENSE_LIMIT, increment, project_positions
 from .state import state_factory
 
 
@@ -86,7 +86,7 @@ class Monitor:
 
     def __call__(self, q, t):
         sys = self.sys
-        if sys.nv > 600 or not len(self.rows):
+        if sys.nv > DENSE_LIMIT or not len(self.rows):
             return 1.0, []
         J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][self.rows] * self.scale
         J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
