@@ -64,7 +64,8 @@ class Model(ForceElementsMixin, FrictionPathMixin):
     # Every joint-adding method takes either two bodies (names or Body) with the point and axes in ground
     # at t=0, or two markers (Body.add_marker, on any body or on ground) whose origins and z axes (x axes
     # for in-plane references) are the joint's I and J frames, Adams style; then the point and axis
-    # arguments are omitted and the bodies may be drawn anywhere (assembly closes the gaps).
+    # arguments are omitted and the bodies may be drawn anywhere (assembly closes the gaps); the joint's
+    # angles and slides (motions, joint_coordinate) are then zero where the markers' axes coincide.
     # initial_displacement / initial_velocity: joint coordinates (from as drawn) and rates held at
     # assembly, a number for a one-coordinate joint, else in the order of Result.joint_coordinate.
     def add_revolute(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
