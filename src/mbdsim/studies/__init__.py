@@ -1,0 +1,30 @@
+"""Parameter studies on dask.distributed: many variants of a model, one row of results per run.
+
+    import mbdsim as mb
+    study = mb.Study("slider_crank.yaml",
+                     parameters={"bodies.rod.mass": {"range": ["1 kg", "3 kg"]},
+                                 "bodies.slider.mass": [1.0, 1.5, 2.0]},
+                     outputs={"peak_rod_force": "max(norm(reaction_force('crank_rod')))"},
+                     analysis={"end_time": 2.0, "output_step": 0.01, "rtol": 1e-6},
+                     sampling="lhs", samples=50)
+    df = study.run(workers=2, out="results.parquet")     # or client=Client(...) / "tcp://host:8786"
+    mb.sensitivity(df, ["bodies.rod.mass", "bodies.slider.mass"], ["peak_rod_force"])
+    mb.plot_study(df, kind="main_effects")
+
+Modules: design (parameter specs, samplers), measures (output expressions), variant (one run; the Dask
+task), runner (Dask, Parquet, resume), store, spec (study files), sensitivity, plots, models (factories).
+"""
+from .spec import load_study
+from .study import Study
+
+__all__ = ["Study", "load_study", "sensitivity", "plot_study"]
+
+
+def __getattr__(name):
+    if name == "sensitivity":
+        from .sensitivity import sensitivity
+        return sensitivity
+    if name == "plot_study":
+        from .plots import plot_study
+        return plot_study
+    raise AttributeError(f"module 'mbdsim.studies' has no attribute {name!r}")

@@ -1,0 +1,129 @@
+"""Running a study: chunks of variants as dask.distributed tasks (or in this process), rows written to
+Parquet as they arrive, finished runs skipped on a re-run, lost tasks reported instead of crashing."""
+from __future__ import annotations
+
+import logging
+import math
+import sys
+from contextlib import contextmanager
+
+import pandas as pd
+
+from ..errors import ModelError
+from .store import STUDY_COLUMN, load_rows, write_rows
+from .variant import run_chunk
+
+__all__ = ["execute", "chunks_of", "default_chunk_size"]
+
+
+def default_chunk_size(n_runs: int, n_workers: int) -> int:
+    """About four tasks per worker (load balance) and at most 32 variants per task."""
+    return max(1, min(32, math.ceil(n_runs / max(1, 4 * n_workers))))
+
+
+def chunks_of(design: pd.DataFrame, size: int) -> list[list]:
+    """[(run, {parameter: value}), ...] in chunks of `size` runs."""
+    records = [(int(run), row) for run, row in zip(design.index, design.to_dict("records"))]
+    return [records[k:k + size] for k in range(0, len(records), size)]
+
+
+@contextmanager
+def _client(client, workers):
+    """A Client: the given one, one connected to an address, or a LocalCluster for this run (closed after)."""
+    from distributed import Client, LocalCluster
+    if client is not None and not isinstance(client, str):
+        yield client
+        return
+    if isinstance(client, str):
+        with Client(client, timeout="30s") as c:
+            yield c
+        return
+    n = 2 if workers is None else int(workers)
+    if n < 1:
+        raise ModelError("study", "workers", f"expected a positive number of workers (0: no Dask), got {workers!r}")
+    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                      silence_logs=logging.ERROR) as cluster, Client(cluster) as c:
+        yield c
+
+
+class _Sink:
+    """Collects rows; rewrites the output file after each chunk (atomic) when there is one."""
+
+    def __init__(self, study, out, previous):
+        self.study_id, self.out = study.study_id, out
+        self.frames = [] if previous is None else [previous]
+        self.executed = 0
+
+    def add(self, rows: list[dict], keep: bool = True):
+        df = pd.DataFrame(rows)
+        df[STUDY_COLUMN] = self.study_id
+        self.frames.append(df)
+        self.executed += len(rows)
+        if self.out is not None and keep:
+            write_rows(self.out, pd.concat([f for f in self.frames if f["status"].ne("lost").all()],
+                                           ignore_index=True))
+
+    def frame(self, study) -> pd.DataFrame:
+        cols = ["run", *study.design.columns, *study.plan.outputs, "status", "message", "wall_time", "worker"]
+        if not self.frames:
+            return pd.DataFrame(columns=cols)
+        df = pd.concat(self.frames, ignore_index=True).sort_values("run", kind="stable").reset_index(drop=True)
+        df = df[cols]
+        df.attrs["executed"] = self.executed
+        return df
+
+
+def _progress(enabled, total, done):
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeRemainingColumn
+    if enabled is None:
+        enabled = sys.stderr.isatty()
+    bar = Progress(TextColumn("study"), BarColumn(), MofNCompleteColumn(), TimeRemainingColumn(),
+                   console=Console(stderr=True), disable=not enabled)
+    task = bar.add_task("runs", total=total, completed=done)
+    return bar, task
+
+
+def _lost_rows(study, chunk, exc):
+    msg = f"{type(exc).__name__}: {exc}"
+    return [{"run": run, **params, **{k: math.nan for k in study.plan.outputs}, "status": "lost",
+             "message": msg, "wall_time": math.nan, "worker": ""} for run, params in chunk]
+
+
+def execute(study, client=None, workers=None, out=None, chunk_size=None, progress=None) -> pd.DataFrame:
+    """Study.run (see there)."""
+    previous = load_rows(out, study.study_id) if out is not None else None
+    done = set() if previous is None else set(previous["run"].astype(int))
+    pending = study.design[~study.design.index.isin(done)]
+    sink = _Sink(study, out, None if previous is None else previous.drop(columns=[STUDY_COLUMN]))
+    bar, task = _progress(progress, len(study.design), len(study.design) - len(pending))
+    serial = workers == 0 and client is None
+    with bar:
+        if len(pending) == 0:
+            pass
+        elif serial:
+            for chunk in chunks_of(pending, chunk_size or 1):
+                sink.add(run_chunk(study.plan, chunk))
+                bar.advance(task, len(chunk))
+        else:
+            _run_dask(study, pending, client, workers, chunk_size, sink, lambda n: bar.advance(task, n))
+    return sink.frame(study)
+
+
+def _run_dask(study, pending, client, workers, chunk_size, sink, advance):
+    from distributed import as_completed
+    with _client(client, workers) as c:
+        n_workers = max(1, len(c.scheduler_info().get("workers", {})) or (workers or 1))
+        chunks = chunks_of(pending, chunk_size or default_chunk_size(len(pending), n_workers))
+        [plan] = c.scatter([study.plan], broadcast=True, hash=False)
+        futures = {c.submit(run_chunk, plan, chunk, pure=False): chunk for chunk in chunks}
+        try:
+            for fut in as_completed(futures):
+                chunk = futures[fut]
+                try:
+                    sink.add(fut.result())
+                except Exception as exc:  # noqa: BLE001 - KilledWorker etc.: rows marked lost, retried on resume
+                    sink.add(_lost_rows(study, chunk, exc), keep=False)
+                advance(len(chunk))
+        finally:
+            c.cancel(list(futures))
