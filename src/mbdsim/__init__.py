@@ -28,6 +28,7 @@ _LAZY = {
     "equilibrium": ".solvers.static", "quasi_static": ".solvers.static",
     "UnstableEquilibriumWarning": ".solvers.static", "linearize": ".solvers.linear",
     "Linearization": ".solvers.linear", "plot": ".plotting", "animate": ".viewer",
+    "Study": ".studies", "load_study": ".studies", "plot_study": ".studies", "sensitivity": ".studies",
 }
 
 
@@ -54,5 +55,6 @@ __all__ = [
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
     "expressions", "functions", "parse",
     "plot", "animate",
+    "Study", "load_study", "plot_study", "sensitivity",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]

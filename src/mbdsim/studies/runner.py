@@ -65,11 +65,11 @@ class _Sink:
 
     def frame(self, study) -> pd.DataFrame:
         cols = ["run", *study.design.columns, *study.plan.outputs, "status", "message", "wall_time", "worker"]
-        if not self.frames:
-            return pd.DataFrame(columns=cols)
-        df = pd.concat(self.frames, ignore_index=True).sort_values("run", kind="stable").reset_index(drop=True)
+        frames = self.frames or [pd.DataFrame(columns=cols)]
+        df = pd.concat(frames, ignore_index=True).sort_values("run", kind="stable").reset_index(drop=True)
         df = df[cols]
-        df.attrs["executed"] = self.executed
+        df.attrs.update(executed=self.executed, parameters=list(study.design.columns),
+                        outputs=list(study.plan.outputs))
         return df
 
 
@@ -95,7 +95,7 @@ def execute(study, client=None, workers=None, out=None, chunk_size=None, progres
     previous = load_rows(out, study.study_id) if out is not None else None
     done = set() if previous is None else set(previous["run"].astype(int))
     pending = study.design[~study.design.index.isin(done)]
-    sink = _Sink(study, out, None if previous is None else previous.drop(columns=[STUDY_COLUMN]))
+    sink = _Sink(study, out, previous)
     bar, task = _progress(progress, len(study.design), len(study.design) - len(pending))
     serial = workers == 0 and client is None
     with bar:
