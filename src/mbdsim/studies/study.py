@@ -12,7 +12,7 @@ import pandas as pd
 
 from ..errors import ModelError
 from .design import make_design, parse_parameter
-from .measures import compile_output
+from .measures import compile_output, fill_template
 from .spec import validate_analysis
 from .variant import Plan, apply_path, is_path
 
@@ -43,6 +43,20 @@ def _identity(obj):
     if callable(obj):
         return f"{getattr(obj, '__module__', '?')}.{getattr(obj, '__qualname__', repr(obj))}"
     return obj
+
+
+def _check_schema(data: dict, source: str, entity: str) -> None:
+    """The first variant's model data against the model-file schema: a misspelt field in a parameter path
+    or a `set` entry is an error of the study, not of each run."""
+    from pydantic import ValidationError
+
+    from ..io import diagnose
+    from ..io.schema import ModelSpec
+    try:
+        ModelSpec.model_validate(data)
+    except ValidationError as exc:
+        err = diagnose.from_validation(exc, data, source, None)
+        raise ModelError(entity, "path", f"makes the model data invalid: {err}") from None
 
 
 class Study:
@@ -106,11 +120,13 @@ class Study:
         for name in parameters:
             if is_path(name):
                 apply_path(probe, name, first[name], self.plan.source)
+                _check_schema(probe, self.plan.source, f"study parameter '{name}'")
             elif not re.search(r"\{[^{}]*\b" + re.escape(name) + r"\b[^{}]*\}", text):
                 raise ModelError(f"study parameter '{name}'", "name", "is neither a path into the model "
                                  "(section.item.field) nor used in a 'set' template ({" + name + "})")
-        for path in settings:
-            apply_path(probe, path, 0.0, self.plan.source)
+        for path, template in settings.items():
+            apply_path(probe, path, fill_template(template, first, path), self.plan.source)
+            _check_schema(probe, self.plan.source, f"study set '{path}'")
 
     def __repr__(self):
         names = ", ".join(p.name for p in self.parameters)

@@ -1,0 +1,162 @@
+"""Parameter studies without Dask: design, units, paths, outputs against closed forms, failing variants,
+resume from a partial file, sensitivity against an exact linear model, study files, plots, CLI."""
+import math
+import warnings
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import mbdsim as mb
+from mbdsim.errors import ModelError, ModelFileError
+from mbdsim.studies.design import make_design, parse_parameter, to_si_value
+from mbdsim.studies.measures import OutputError, fill_template
+from mbdsim.studies.models import slider_crank
+from mbdsim.studies.variant import apply_path
+
+SC_OUT = {"amax": "peak(x(acceleration('slider')))",
+          "t_idc": "crossing(x(velocity('slider')), 0, direction=1)",
+          "F": "max(norm(reaction_force('crank_rod')))"}
+FAST = {"end_time": 0.6, "output_step": 0.01, "rtol": 1e-6}
+
+
+def test_units_and_expressions():
+    assert to_si_value("200 mm", "p") == pytest.approx(0.2)
+    assert to_si_value("60 rpm", "p") == pytest.approx(2 * math.pi)
+    assert to_si_value(150, "p", "mm") == pytest.approx(0.15)
+    assert to_si_value("3 kN/m", "p") == pytest.approx(3000.0)
+    assert to_si_value("2*pi*t", "p") == "2*pi*t"          # an expression stays text
+    assert fill_template(["{a + b/2}", 0, "2*{a}*t"], {"a": 1.5, "b": 1.0}, "x") == [2.0, 0, "2*1.5*t"]
+    with pytest.raises(ModelError, match="study set 'x'"):
+        fill_template("{a + nope}", {"a": 1.0}, "x")
+
+
+def test_grid_and_samplers():
+    grid = make_design([parse_parameter("a", [1, 2, 3]), parse_parameter("b", {"range": [0, 1], "num": 2})])
+    assert len(grid) == 6 and list(grid.loc[1]) == [1.0, 1.0] and list(grid.loc[5]) == [3.0, 1.0]
+    n = 16
+    for method in ("lhs", "sobol"):
+        d = make_design([parse_parameter("x", {"range": ["100 mm", "300 mm"]}),
+                         parse_parameter("y", {"distribution": "uniform", "low": 2, "high": 4})], method, n, seed=3)
+        assert len(d) == n and d["x"].between(0.1, 0.3).all() and d["y"].between(2, 4).all()
+        # both designs put exactly one point in each of the n equal strata of every parameter
+        for col, lo, hi in (("x", 0.1, 0.3), ("y", 2, 4)):
+            strata = np.floor((d[col] - lo) / (hi - lo) * n).astype(int)
+            assert sorted(strata) == list(range(n))
+    mc = make_design([parse_parameter("m", {"distribution": "normal", "mean": "2 kg", "std": "100 g"}),
+                      parse_parameter("k", [1, 2])], "random", 2000, seed=1)
+    assert len(mc) == 4000 and abs(mc["m"].mean() - 2.0) < 4 * 0.1 / math.sqrt(2000)
+    assert abs(mc["m"].std() - 0.1) < 0.01
+    with pytest.raises(ModelError, match="study parameter 'm'"):
+        parse_parameter("m", {"distribution": "cauchy", "mean": 1, "std": 1})
+    with pytest.raises(ModelError, match="grid needs discrete values"):
+        make_design([parse_parameter("x", {"range": [0, 1]})], "grid")
+
+
+def test_paths_into_model_data():
+    data = {"bodies": [{"name": "rod", "mass": 1.0}], "gravity": [0, -9.81, 0]}
+    apply_path(data, "bodies.rod.mass", 2.5)
+    apply_path(data, "gravity.1", -1.62)
+    assert data == {"bodies": [{"name": "rod", "mass": 2.5}], "gravity": [0, -1.62, 0]}
+    with pytest.raises(ModelError, match="no item named 'rod2'.*names are: rod"):
+        apply_path(data, "bodies.rod2.mass", 1.0)
+    with pytest.raises(ModelError, match="neither a path"):
+        mb.Study("examples/slider_crank.yaml", {"crank": [0.1]}, {"a": SC_OUT["amax"]}, analysis=FAST)
+    with pytest.raises(ModelError, match="not an argument"):
+        mb.Study(slider_crank, {"crank_length": [0.1]}, {"a": SC_OUT["amax"]}, analysis=FAST)
+
+
+@pytest.mark.parametrize("text", ["__import__('os')", "res.system", "lambda: 1", "open('x')", "max(t)[0]("])
+def test_output_expressions_are_not_code(text):
+    with pytest.raises(OutputError, match="study output 'o'"):
+        mb.Study(slider_crank, {"crank": [0.1]}, {"o": text}, analysis=FAST)
+
+
+def test_outputs_against_closed_form_and_failures():
+    """Slider max acceleration r w^2 (1 + r/l) (outer dead centre), first inner dead centre at pi/w; a rod
+    shorter than the crank locks up (status failed), a negative mass is refused (status error)."""
+    study = mb.Study(slider_crank, {"crank": [0.1, 0.2, 0.5], "rod": [0.4], "speed": ["60 rpm", "90 rpm"],
+                                    "rod_mass": [2.0]}, SC_OUT, analysis=FAST)
+    bad = mb.Study(slider_crank, {"crank_mass": [-1.0]}, SC_OUT, analysis=FAST)
+    df = study.run(workers=0)
+    assert len(df) == 6 and df.attrs["executed"] == 6
+    ok = df[df.crank < 0.4]
+    assert (ok.status == "ok").all() and (df[df.crank == 0.5].status == "failed").all()
+    assert df[df.crank == 0.5].message.str.contains("t = ").all()
+    r, l, w = ok.crank, ok.rod, ok.speed
+    assert np.allclose(ok.amax, r * w**2 * (1 + r / l), rtol=1e-8)
+    assert np.allclose(ok.t_idc, math.pi / w, rtol=1e-8)
+    row = bad.run(workers=0).iloc[0]
+    assert row.status == "error" and "mass" in row.message and math.isnan(row.amax)
+
+
+def test_resume_runs_only_missing(tmp_path):
+    out = tmp_path / "r.parquet"
+    study = mb.Study(slider_crank, {"crank": [0.1, 0.15, 0.2], "rod": [0.3, 0.4]}, SC_OUT, analysis=FAST)
+    full = study.run(workers=0, out=out)
+    part = pd.read_parquet(out).iloc[[0, 2, 5]]          # as if killed after three rows
+    part.to_parquet(out, index=False)
+    again = study.run(workers=0, out=out)
+    assert again.attrs["executed"] == 3 and len(pd.read_parquet(out)) == 6
+    cols = ["run", "crank", "rod", *SC_OUT, "status"]
+    pd.testing.assert_frame_equal(again[cols], full[cols])
+    assert again.set_index("run").loc[[0, 2, 5], "wall_time"].tolist() == part.wall_time.tolist()
+    assert study.run(workers=0, out=out).attrs["executed"] == 0
+    other = mb.Study(slider_crank, {"crank": [0.1, 0.12]}, SC_OUT, analysis=FAST)
+    with pytest.raises(ModelError, match="another study"):
+        other.run(workers=0, out=out)
+
+
+def test_sensitivity_exact_linear_model():
+    """y = 2 x1 + x2 with x1, x2 ~ U(0, 1): SRC = (2, 1)/sqrt(5), first-order Sobol (4/5, 1/5)."""
+    d = make_design([parse_parameter("x1", {"range": [0, 1]}), parse_parameter("x2", {"range": [0, 1]})],
+                    "sobol", 1024, seed=2)
+    d["y"], d["status"] = 2 * d.x1 + d.x2, "ok"
+    src = mb.sensitivity(d, ["x1", "x2"], ["y"])
+    assert src.loc[("y", "x1"), "src"] == pytest.approx(2 / math.sqrt(5), abs=1e-3)
+    assert src.loc[("y", "x2"), "src"] == pytest.approx(1 / math.sqrt(5), abs=1e-3)
+    assert src["r2"].iloc[0] == pytest.approx(1.0)
+    s1 = mb.sensitivity(d, ["x1", "x2"], ["y"], method="sobol")["S1"]
+    assert s1[("y", "x1")] == pytest.approx(0.8, abs=0.02) and s1[("y", "x2")] == pytest.approx(0.2, abs=0.02)
+
+
+def test_study_file_and_errors(tmp_path):
+    study = mb.load_study("examples/slider_crank_study.yaml")
+    assert len(study) >= 100 and {"crank", "rod", "speed", "bodies.slider.mass"} <= set(study.design.columns)
+    assert study.design["speed"].between(math.pi - 1e-12, 3 * math.pi + 1e-12).all()   # 30..90 rpm in rad/s
+    text = (tmp_path / "x.yaml")
+    (tmp_path / "slider_crank.yaml").write_text(open("examples/slider_crank.yaml").read())
+    text.write_text("model: slider_crank.yaml\nanalysis: {end_time: 1}\nparameters:\n  bodies.rod.mass: [1, 2]\n"
+                    "outputs: {f: 'final(t)'}\nsamples: 4\n")
+    with pytest.raises(ModelFileError, match=r"x.yaml, line 6: study.samples: unknown field"):
+        mb.load_study(text)
+    text.write_text("model: slider_crank.yaml\nanalysis: {end_time: 1}\nparameters:\n  bodies.rod.mas: [1, 2]\n"
+                    "outputs: {f: 'final(t)'}\n")
+    with pytest.raises(ModelFileError, match=r"line 4: study parameter .bodies.rod.mas..path: .*unknown field .mas."):
+        mb.load_study(text)
+    text.write_text("model: slider_crank.yaml\nanalysis: {end_time: 1}\nparameters:\n  bodies.rod.mass: [1, 2]\n"
+                    "outputs: {f: 'final(t'}\n")
+    with pytest.raises(ModelFileError, match=r"line 5: study output 'f'"):
+        mb.load_study(text)
+
+
+def test_plots_and_cli(tmp_path):
+    from typer.testing import CliRunner
+
+    from mbdsim.cli.app import app
+    (tmp_path / "slider_crank.yaml").write_text(open("examples/slider_crank.yaml").read())
+    (tmp_path / "s.yaml").write_text(
+        "model: slider_crank.yaml\nanalysis: {end_time: 0.5 s, output_step: 10 ms, rtol: 1.0e-6}\n"
+        "sampling: {method: lhs, samples: 5}\nparameters:\n  bodies.rod.mass: {range: [1 kg, 3 kg]}\n"
+        "  bodies.slider.mass: {range: [1000 g, 2000 g]}\noutputs: {F: \"max(norm(reaction_force('crank_rod')))\"}\n")
+    out = tmp_path / "r.parquet"
+    res = CliRunner().invoke(app, ["study", str(tmp_path / "s.yaml"), "--workers", "0", "--out", str(out),
+                                   "--plots", str(tmp_path / "p")])
+    assert res.exit_code == 0, res.output
+    df = pd.read_parquet(out)
+    assert len(df) == 5 and (df.status == "ok").all() and df["bodies.slider.mass"].between(1, 2).all()
+    assert {p.name for p in (tmp_path / "p").iterdir()} == {"main_effects.png", "scatter_matrix.png", "surface.png"}
+    fig = mb.plot_study(df, "main_effects", ["bodies.rod.mass", "bodies.slider.mass"], ["F"])
+    assert len(fig.axes) == 2
+    bad = CliRunner().invoke(app, ["study", str(tmp_path / "nope.yaml")])
+    assert bad.exit_code == 2 and "does not exist" in bad.output
