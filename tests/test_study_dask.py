@@ -1,0 +1,124 @@
+"""Parameter studies on dask.distributed: a LocalCluster of 2 workers, a study killed and resumed, and a
+separately started scheduler with two workers (one killed mid-study).  Few variants, short end times."""
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+import mbdsim as mb
+from mbdsim.studies.models import slider_crank
+
+pytest.importorskip("distributed")
+
+OUT = {"amax": "peak(x(acceleration('slider')))", "F": "max(norm(reaction_force('crank_rod')))"}
+FAST = {"end_time": 0.5, "output_step": 0.01, "rtol": 1e-6}
+SAME = ["run", "crank", "rod", "amax", "F", "status", "message"]
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def test_local_cluster_complete_and_identical_to_serial():
+    study = mb.Study(slider_crank, {"crank": [0.1, 0.15, 0.2, 0.5], "rod": [0.3, 0.4]}, OUT, analysis=FAST)
+    df = study.run(workers=2, chunk_size=2, progress=False)
+    assert list(df.run) == list(range(8)) and df.attrs["executed"] == 8
+    assert df.worker.nunique() == 2                                    # both workers ran chunks
+    failing = df[df.crank == 0.5]
+    assert (failing.status == "failed").all() and failing.message.str.contains("joints involved").all()
+    assert (df[df.crank < 0.5].status == "ok").all()
+    serial = study.run(workers=0)
+    pd.testing.assert_frame_equal(df[SAME], serial[SAME])             # bit-identical outputs
+
+
+def _rows(path):
+    try:
+        return len(pd.read_parquet(path))
+    except Exception:  # noqa: BLE001 - not written yet
+        return 0
+
+
+def test_killed_study_resumes_missing_runs_only(tmp_path):
+    (tmp_path / "slider_crank.yaml").write_text((ROOT / "examples/slider_crank.yaml").read_text())
+    study_file = tmp_path / "s.yaml"
+    study_file.write_text("model: slider_crank.yaml\nanalysis: {end_time: 0.5, output_step: 0.01, rtol: 1.0e-6}\n"
+                          "parameters:\n  bodies.rod.mass: {range: [1, 3], num: 40}\n"
+                          "outputs: {F: \"max(norm(reaction_force('crank_rod')))\"}\n")
+    out = tmp_path / "r.parquet"
+    proc = subprocess.Popen([sys.executable, "-m", "mbdsim", "study", str(study_file), "--workers", "0",
+                             "--chunk", "1", "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.time() + 60
+        while _rows(out) < 3 and time.time() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+        proc.send_signal(signal.SIGKILL)
+    finally:
+        proc.kill()
+        proc.wait(10)
+    before = pd.read_parquet(out)
+    assert 3 <= len(before) < 40, "the study was not killed mid-way"
+    df = mb.load_study(study_file).run(workers=0, out=out)
+    assert df.attrs["executed"] == 40 - len(before) and len(df) == 40 and (df.status == "ok").all()
+    kept = df.set_index("run").loc[before.run]
+    assert kept.wall_time.tolist() == before.wall_time.tolist()      # finished rows were not re-run
+    # heavier rod, larger pin force: the rows are those of their own parameters
+    assert np.all(np.diff(df.sort_values("bodies.rod.mass").F) > 0)
+
+
+def _spawn(args, log):
+    return subprocess.Popen([sys.executable, "-m", *args], stdout=log, stderr=subprocess.STDOUT,
+                            start_new_session=True)
+
+
+def test_remote_scheduler_and_a_killed_worker(tmp_path):
+    """`dask scheduler` and two `dask worker` processes on 127.0.0.1; the study goes through the address;
+    one worker is killed once rows arrive: its tasks are retried on the other, nothing is lost."""
+    from distributed import Client
+    sched_file = tmp_path / "scheduler.json"
+    log = open(tmp_path / "dask.log", "w")
+    procs = [_spawn(["distributed.cli.dask_scheduler", "--host", "127.0.0.1", "--port", "0", "--no-dashboard",
+                     "--scheduler-file", str(sched_file)], log)]
+    try:
+        deadline = time.time() + 30
+        while not sched_file.exists() and time.time() < deadline:
+            time.sleep(0.1)
+        for _ in range(2):
+            procs.append(_spawn(["distributed.cli.dask_worker", "--scheduler-file", str(sched_file), "--nthreads", "1",
+                                 "--no-dashboard", "--no-nanny", "--host", "127.0.0.1"], log))
+        with Client(scheduler_file=str(sched_file), timeout="30s") as c:
+            c.wait_for_workers(2, timeout=30)
+            address = c.scheduler.address
+        study = mb.Study(slider_crank, {"crank": list(np.linspace(0.1, 0.2, 16))}, OUT,
+                         analysis={**FAST, "end_time": 1.0})
+        out = tmp_path / "r.parquet"
+
+        killed = []
+
+        def kill_one():
+            while _rows(out) < 2 and time.time() < deadline + 60:
+                time.sleep(0.02)
+            os.kill(procs[1].pid, signal.SIGKILL)
+            killed.append(time.time())
+        killer = threading.Thread(target=kill_one, daemon=True)
+        killer.start()
+        df = study.run(client=address, out=out, chunk_size=1)
+        finished = time.time()
+        killer.join(5)
+        assert killed and killed[0] < finished, "the worker was not killed during the study"
+        assert len(df) == 16 and (df.status == "ok").all()
+        r, w = df.crank, 2 * np.pi
+        assert np.allclose(df.amax, r * w**2 * (1 + r / 0.4), rtol=1e-8)
+    finally:
+        for p in reversed(procs):
+            if p.poll() is None:
+                p.terminate()
+        for p in procs:
+            try:
+                p.wait(10)
+            except subprocess.TimeoutExpired:
+                p.kill()
+        log.close()
