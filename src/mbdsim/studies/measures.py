@@ -158,7 +158,6 @@ class _Interpreter:
         if fn in REFINED and len(args) == 1:
             sign, which = REFINED[fn]
             signal = lambda r: _signal(self.ev(args[0], r), fn)  # noqa: E731
-            signal(res)
             found = res.maximum(signal) if sign > 0 else res.minimum(signal)
             return float(found[which])
         vals = [self.ev(a, res) for a in args]
