@@ -160,3 +160,17 @@ def test_plots_and_cli(tmp_path):
     assert len(fig.axes) == 2
     bad = CliRunner().invoke(app, ["study", str(tmp_path / "nope.yaml")])
     assert bad.exit_code == 2 and "does not exist" in bad.output
+
+
+def test_readme_study_snippet_runs():
+    import re
+    from pathlib import Path
+    text = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    code = re.findall(r"```python\n(.*?)```", text.split("## Parameter studies", 1)[1].split("\n## ", 1)[0], re.S)[0]
+    code = code.replace('workers=2, out="runs.parquet"', "workers=0").replace("samples=50", "samples=4")
+    ns = {"mb": mb}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        exec(compile(code, "README.md", "exec"), ns)   # noqa: S102 - our own docs
+    assert len(ns["df"]) == 4 and (ns["df"].status == "ok").all()
+    assert np.all(np.diff(ns["df"].sort_values("bodies.rod.mass").F) > 0)   # heavier rod, larger pin force
