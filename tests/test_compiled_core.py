@@ -377,3 +377,15 @@ def test_progress_callback_and_interrupt_keep_the_outputs():
     assert not part.success and "interrupted" in part.message
     n = len(part.time)
     assert 500 <= n < 2001 and np.allclose(part.q, res.q[:n], atol=1e-12)
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    (dict(rtol=1e-30), "rtol"), (dict(start_time=float("nan")), "start_time"), (dict(start_time="a"), "start_time"),
+    (dict(end_time=1e6, output_step=1e-6), "output_step")])
+def test_simulate_refuses_settings_that_cannot_work(kwargs, field):
+    """Issue 10 items: no hang on an impossible tolerance, no multi-terabyte allocation, named fields."""
+    m = _pendulum_chain(1)
+    end = kwargs.pop("end_time", 0.2)
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, end, **kwargs)
+    assert err.value.field == field

@@ -55,8 +55,13 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
         raise ModelError("simulate", "method", f"unknown method {method!r}; choose from "
                          f"{sorted(list(SCIPY_METHODS) + ['hht', 'auto'])}")
     user_rtol = None if rtol is None else _positive("rtol", rtol)
+    if user_rtol is not None and user_rtol < RTOL_FLOOR:
+        raise ModelError("simulate", "rtol", f"{rtol!r} is below what double precision can deliver "
+                         f"(at least {RTOL_FLOOR:g})")
     user_atol = None if atol is None else _positive("atol", atol)
     max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
+    start_time = _number("start_time", start_time)
+    _check_budget(model, start_time, end_time, output_step)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
@@ -106,6 +111,35 @@ def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
+
+
+RTOL_FLOOR = 1e-14          # relative tolerances below this cannot be met in double precision
+RESULT_BUDGET = 4 * 2**30   # bytes of output arrays an analysis may allocate
+
+
+def _check_budget(model, t0, t1, step):
+    """ModelError naming output_step when the output arrays would exceed RESULT_BUDGET (checked before any
+    allocation, from the model's size: 7 coordinates, 12 velocity variables and accelerations per body and
+    6 multipliers per joint or motion per sample)."""
+    try:
+        n = (float(t1) - t0) / float(step) + 1
+    except (TypeError, ValueError, ZeroDivisionError):
+        return   # time_grid names the bad argument
+    per_sample = 8 * (19 * len(model.bodies) + 6 * (len(model.joints) + len(model.motions)) + 1)
+    if np.isfinite(n) and n * per_sample > RESULT_BUDGET:
+        raise ModelError("simulate", "output_step", f"{n:.3g} output times would need {n * per_sample / 2**30:.3g} "
+                         f"GiB of results (more than {RESULT_BUDGET / 2**30:g} GiB); use a larger output_step")
+
+
+def _number(field, value) -> float:
+    """A finite number for simulate.<field>, else ModelError."""
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ModelError("simulate", field, f"expected a number, got {value!r}") from None
+    if not np.isfinite(x):
+        raise ModelError("simulate", field, f"must be finite, got {value!r}")
+    return x
 
 
 def _positive(field, value, strict=True, finite=True) -> float:
