@@ -86,6 +86,8 @@ def test_outputs_against_closed_form_and_failures():
     r, l, w = ok.crank, ok.rod, ok.speed
     assert np.allclose(ok.amax, r * w**2 * (1 + r / l), rtol=1e-8)
     assert np.allclose(ok.t_idc, math.pi / w, rtol=1e-8)
+    kin = mb.Study(slider_crank, {"crank": [0.15]}, SC_OUT, analysis={**FAST, "type": "kinematics"}).run(workers=0)
+    assert kin.amax[0] == pytest.approx(0.15 * (2 * math.pi) ** 2 * (1 + 0.15 / 0.4), rel=1e-8)
     row = bad.run(workers=0).iloc[0]
     assert row.status == "error" and "mass" in row.message and math.isnan(row.amax)
 
@@ -174,3 +176,22 @@ def test_readme_study_snippet_runs():
         exec(compile(code, "README.md", "exec"), ns)   # noqa: S102 - our own docs
     assert len(ns["df"]) == 4 and (ns["df"].status == "ok").all()
     assert np.all(np.diff(ns["df"].sort_values("bodies.rod.mass").F) > 0)   # heavier rod, larger pin force
+
+
+def _compiled_signatures():
+    import sys
+
+    from numba.core.registry import CPUDispatcher
+    return sum(len(obj.signatures) for name, mod in list(sys.modules.items()) if name.startswith("mbdsim")
+               for obj in vars(mod).values() if isinstance(obj, CPUDispatcher))
+
+
+def test_variants_reuse_compiled_kernels():
+    """After the first variant, other lengths, masses and speeds compile nothing new (same topology)."""
+    study = mb.Study(slider_crank, {"crank": [0.1, 0.12, 0.14], "rod_mass": [1.0, 3.0], "speed": [3.0, 7.0]},
+                     SC_OUT, analysis={**FAST, "end_time": 0.1})
+    first = mb.Study(slider_crank, {"crank": [0.2]}, SC_OUT, analysis={**FAST, "end_time": 0.1}).run(workers=0)
+    assert first.status[0] == "ok"
+    before = _compiled_signatures()
+    df = study.run(workers=0)
+    assert (df.status == "ok").all() and before > 0 and _compiled_signatures() == before
