@@ -6,6 +6,7 @@ import subprocess
 import sys
 import threading
 import time
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -21,6 +22,14 @@ OUT = {"amax": "peak(x(acceleration('slider')))", "F": "max(norm(reaction_force(
 FAST = {"end_time": 0.5, "output_step": 0.01, "rtol": 1e-6}
 SAME = ["run", "crank", "rod", "amax", "F", "status", "message"]
 ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _kernels_on_disk():
+    """Compile (or load) the kernels here first, so that worker processes load them from numba's disk cache."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mb.simulate(slider_crank(), 0.05, 0.01, rtol=1e-6)
 
 
 def test_local_cluster_complete_and_identical_to_serial():
@@ -52,7 +61,7 @@ def test_killed_study_resumes_missing_runs_only(tmp_path):
     proc = subprocess.Popen([sys.executable, "-m", "mbdsim", "study", str(study_file), "--workers", "0",
                              "--chunk", "1", "--out", str(out)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     try:
-        deadline = time.time() + 60
+        deadline = time.time() + 120
         while _rows(out) < 3 and time.time() < deadline and proc.poll() is None:
             time.sleep(0.05)
         proc.send_signal(signal.SIGKILL)
