@@ -86,8 +86,14 @@ def test_outputs_against_closed_form_and_failures():
     r, l, w = ok.crank, ok.rod, ok.speed
     assert np.allclose(ok.amax, r * w**2 * (1 + r / l), rtol=1e-8)
     assert np.allclose(ok.t_idc, math.pi / w, rtol=1e-8)
-    kin = mb.Study(slider_crank, {"crank": [0.15]}, SC_OUT, analysis={**FAST, "type": "kinematics"}).run(workers=0)
+    more = {**SC_OUT, "t_min": "time_of_min(x(position('slider')))", "x_min": "min(x(position('slider')))",
+            "travel": "final(x(position('slider'))) - initial(x(position('slider')))",
+            "int_v": "integral(x(velocity('slider')))", "v_rms": "rms(x(velocity('slider')))"}
+    kin = mb.Study(slider_crank, {"crank": [0.15]}, more, analysis={**FAST, "type": "kinematics"}).run(workers=0)
     assert kin.amax[0] == pytest.approx(0.15 * (2 * math.pi) ** 2 * (1 + 0.15 / 0.4), rel=1e-8)
+    assert kin.t_min[0] == pytest.approx(0.5, abs=1e-6) and kin.x_min[0] == pytest.approx(0.4 - 0.15, abs=1e-9)
+    assert kin.int_v[0] == pytest.approx(kin.travel[0], abs=2e-4)       # trapezoid rule, 10 ms samples
+    assert 0 < kin.v_rms[0] < 0.15 * 2 * math.pi * (1 + 0.15 / 0.4)
     row = bad.run(workers=0).iloc[0]
     assert row.status == "error" and "mass" in row.message and math.isnan(row.amax)
 
@@ -195,3 +201,20 @@ def test_variants_reuse_compiled_kernels():
     before = _compiled_signatures()
     df = study.run(workers=0)
     assert (df.status == "ok").all() and before > 0 and _compiled_signatures() == before
+
+
+def test_lost_tasks_are_reported_not_stored(tmp_path):
+    """A chunk Dask gave up on (KilledWorker) is a 'lost' row in the DataFrame but not in the file, so a
+    re-run with the same file runs it again."""
+    from mbdsim.studies.runner import _lost_rows, _Sink, chunks_of
+    from mbdsim.studies.variant import run_chunk
+    study = mb.Study(slider_crank, {"crank": [0.1, 0.12, 0.14]}, SC_OUT, analysis={**FAST, "end_time": 0.1})
+    out = tmp_path / "r.parquet"
+    sink = _Sink(study, out, None)
+    first, second = chunks_of(study.design, 2)
+    sink.add(run_chunk(study.plan, first))
+    sink.add(_lost_rows(study, second, RuntimeError("worker died three times")), keep=False)
+    df = sink.frame(study)
+    assert list(df.status) == ["ok", "ok", "lost"] and "worker died" in df.message[2]
+    assert sorted(pd.read_parquet(out).run) == [0, 1]
+    assert study.run(workers=0, out=out).attrs["executed"] == 1
