@@ -21,8 +21,8 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
     @njit(cache=True, _nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
-from ..system.kernels import frames_into, rows_kernel
-from .kkt_tree import dense_factor, dense_solve, kkt_factor, kkt_solve
+from ..system.kernels import frames_into, quat_step, rows_kernel
+from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
 
@@ -369,18 +369,7 @@ def increment_kernel6(r_idx, p_idx, rigid_fid, q, dx6):
             q[r_idx[k, c]] += dx6[k + 1, c]
     for k in range(p_idx.shape[0]):
         f = rigid_fid[k]
-        x, y, z = dx6[f, 3], dx6[f, 4], dx6[f, 5]
-        ang = np.sqrt(x * x + y * y + z * z)
-        c0 = np.cos(0.5 * ang)
-        s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
-        b0, b1, b2, b3 = c0, s * x, s * y, s * z
-        a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
-        p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
-        p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
-        p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
-        p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
-        n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
-        q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
+        quat_step(q, p_idx, k, dx6[f, 3], dx6[f, 4], dx6[f, 5])
 
 
 @njit(cache=True, _nrt=False)
@@ -435,13 +424,7 @@ def project(cm, wk, t, q, v, tol):
     Jc, bi, bj, nu = wk[5], cm[12], cm[13], wk[6]
     for i in range(active.shape[0]):
         row = active[i]
-        s = 0.0
-        for side in range(2):
-            f = bi[row] if side == 0 else bj[row]
-            if f != 0:
-                for k in range(6):
-                    s += Jc[row, side, k] * v6[f, k]
-        c[row] = nu[row] - s
+        c[row] = nu[row] - _row_dot(Jc, bi, bj, row, v6)
     _solve(cm, wk, zero6, c, x6, lam)
     vadr, rigid = cm[5], cm[6]
     for f in range(1, x6.shape[0]):

@@ -44,26 +44,6 @@ def chol(A, n, L3, il):
 
 
 @njit(cache=True, _nrt=False)
-def chol_solve(L3, il, n, b2, ib):
-    """Solve (L L^T) x = b in place for the leading n entries of b2[ib] (L = L3[il] from `chol`)."""
-    for i in range(n):
-        s = b2[ib, i]
-        for k in range(i):
-            s -= L3[il, i, k] * b2[ib, k]
-        b2[ib, i] = s * L3[il, i, i]
-    for i in range(n - 1, -1, -1):
-        s = b2[ib, i]
-        for k in range(i + 1, n):
-            s -= L3[il, k, i] * b2[ib, k]
-        b2[ib, i] = s * L3[il, i, i]
-
-
-@njit(cache=True, _nrt=False)
-def _side(bi, bj, row, f):
-    return 0 if bi[row] == f else 1
-
-
-@njit(cache=True, _nrt=False)
 def _fwd(L3, il, n, b2, ib):
     """b2[ib] <- L^-1 b2[ib] (forward substitution with L = L3[il] from `chol`)."""
     for i in range(n):
@@ -81,6 +61,18 @@ def _bwd(L3, il, n, b2, ib):
         for k in range(i + 1, n):
             s -= L3[il, k, i] * b2[ib, k]
         b2[ib, i] = s * L3[il, i, i]
+
+
+@njit(cache=True, _nrt=False)
+def chol_solve(L3, il, n, b2, ib):
+    """Solve (L L^T) x = b in place for the leading n entries of b2[ib] (L = L3[il] from `chol`)."""
+    _fwd(L3, il, n, b2, ib)
+    _bwd(L3, il, n, b2, ib)
+
+
+@njit(cache=True, _nrt=False)
+def _side(bi, bj, row, f):
+    return 0 if bi[row] == f else 1
 
 
 @njit(cache=True, _nrt=False)

@@ -226,6 +226,23 @@ def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
     return r, A, rd, w
 
 
+@njit(cache=True, _nrt=False)
+def quat_step(q, p_idx, k, x, y, z):
+    """Euler parameters p_idx[k] of q <- p (x) exp((x, y, z) / 2), normalised, in place: the rotation by
+    the body-axes rotation vector (x, y, z) [rad] applied on the right."""
+    ang = np.sqrt(x * x + y * y + z * z)
+    c0 = np.cos(0.5 * ang)
+    s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
+    b0, b1, b2, b3 = c0, s * x, s * y, s * z
+    a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
+    p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
+    p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
+    p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
+    p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
+    n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
+    q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
+
+
 @njit(cache=True)
 def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
     """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) for body-axes rotation vectors."""
@@ -234,18 +251,7 @@ def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
         for c in range(3):
             out[r_idx[k, c]] += dx[rd_idx[k, c]]
     for k in range(p_idx.shape[0]):
-        x, y, z = dx[w_idx[k, 0]], dx[w_idx[k, 1]], dx[w_idx[k, 2]]
-        ang = np.sqrt(x * x + y * y + z * z)
-        c0 = np.cos(0.5 * ang)
-        s = np.sin(0.5 * ang) / ang if ang > 1e-8 else 0.5 - ang * ang / 48.0
-        b0, b1, b2, b3 = c0, s * x, s * y, s * z
-        a0, a1, a2, a3 = q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]]
-        p0 = a0 * b0 - a1 * b1 - a2 * b2 - a3 * b3
-        p1 = a0 * b1 + a1 * b0 + a2 * b3 - a3 * b2
-        p2 = a0 * b2 - a1 * b3 + a2 * b0 + a3 * b1
-        p3 = a0 * b3 + a1 * b2 - a2 * b1 + a3 * b0
-        n = np.sqrt(p0 * p0 + p1 * p1 + p2 * p2 + p3 * p3)
-        out[p_idx[k, 0]], out[p_idx[k, 1]], out[p_idx[k, 2]], out[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
+        quat_step(out, p_idx, k, dx[w_idx[k, 0]], dx[w_idx[k, 1]], dx[w_idx[k, 2]])
     return out
 
 
