@@ -5,6 +5,8 @@ pdot = 1/2 p (x) (0, w_B) with w_B the angular velocity expressed in body axes [
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -32,10 +34,33 @@ def quat_to_matrix(p: np.ndarray) -> np.ndarray:
 
 
 def matrix_to_quat(A: np.ndarray) -> np.ndarray:
-    """Euler parameters (scalar first, e0 >= 0) of a rotation matrix (3, 3)."""
-    x, y, z, w = Rotation.from_matrix(np.asarray(A, dtype=float)).as_quat()
-    p = np.array([w, x, y, z])
+    """Euler parameters (scalar first, e0 >= 0) of a rotation matrix (3, 3) (Shepperd's method: the
+    largest of the four squared components first, so no division by a small number)."""
+    (a00, a01, a02), (a10, a11, a12), (a20, a21, a22) = np.asarray(A, dtype=float).tolist()
+    tr = a00 + a11 + a22
+    k = max(range(4), key=(tr, a00, a11, a22).__getitem__)
+    if k == 0:
+        s = 2.0 * math.sqrt(max(1.0 + tr, 0.0))
+        p = (0.25 * s, (a21 - a12) / s, (a02 - a20) / s, (a10 - a01) / s)
+    elif k == 1:
+        s = 2.0 * math.sqrt(max(1.0 + a00 - a11 - a22, 0.0))
+        p = ((a21 - a12) / s, 0.25 * s, (a01 + a10) / s, (a02 + a20) / s)
+    elif k == 2:
+        s = 2.0 * math.sqrt(max(1.0 + a11 - a00 - a22, 0.0))
+        p = ((a02 - a20) / s, (a01 + a10) / s, 0.25 * s, (a12 + a21) / s)
+    else:
+        s = 2.0 * math.sqrt(max(1.0 + a22 - a00 - a11, 0.0))
+        p = ((a10 - a01) / s, (a02 + a20) / s, (a12 + a21) / s, 0.25 * s)
+    p = np.array(p)
+    p /= np.linalg.norm(p)
     return p if p[0] >= 0 else -p
+
+
+def cross3(a, b) -> np.ndarray:
+    """Cross product of two 3-vectors (a few times faster than np.cross on single vectors)."""
+    a0, a1, a2 = a
+    b0, b1, b2 = b
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def quat_mul(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -82,7 +107,7 @@ def perpendicular_frame(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """Right-handed orthonormal (f, g, h) with h the given unit axis (deterministic choice of f)."""
     h = np.asarray(h, dtype=float) / np.linalg.norm(h)
     trial = np.eye(3)[int(np.argmin(np.abs(h)))]
-    f = np.cross(trial, h)
+    f = cross3(trial, h)
     f /= np.linalg.norm(f)
-    g = np.cross(h, f)
+    g = cross3(h, f)
     return f, g, h

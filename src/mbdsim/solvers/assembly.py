@@ -273,20 +273,18 @@ def _velocities_sparse(sys, q, t, rows, J, nu, items):
 
 
 def _moved(sys, q0, q):
-    out = {}
+    """{body name: (CM shift [m], rotation angle [rad])} of the bodies assembly moved (beyond 1e-10)."""
     L = length_scale(sys)
-    for k, b in enumerate(sys.bodies):
-        dr = float(np.linalg.norm(q[sys.r_idx[k]] - q0[sys.r_idx[k]]))
-        da = 0.0
-        if not b.is_particle:
-            pi = list(sys.rigid_fid).index(k + 1)
-            p0, p = q0[sys.p_idx[pi]], q[sys.p_idx[pi]]
-            p0, p = p0 / np.linalg.norm(p0), p / np.linalg.norm(p)
-            rel = np.array([p0 @ p, *(p0[0] * p[1:] - p[0] * p0[1:] - np.cross(p0[1:], p[1:]))])
-            da = 2 * float(np.arctan2(np.linalg.norm(rel[1:]), abs(rel[0])))
-        if dr > 1e-10 * L or da > 1e-10:
-            out[b.name] = (dr, da)
-    return out
+    dr = np.sqrt(((q[sys.r_idx] - q0[sys.r_idx]) ** 2).sum(-1))
+    da = np.zeros(len(sys.bodies))
+    if len(sys.rigid_fid):
+        p0, p = q0[sys.p_idx], q[sys.p_idx]
+        p0 = p0 / np.linalg.norm(p0, axis=-1, keepdims=True)
+        p = p / np.linalg.norm(p, axis=-1, keepdims=True)
+        vec = p0[:, :1] * p[:, 1:] - p[:, :1] * p0[:, 1:] - np.cross(p0[:, 1:], p[:, 1:])
+        da[np.asarray(sys.rigid_fid) - 1] = 2 * np.arctan2(np.linalg.norm(vec, axis=-1), np.abs((p0 * p).sum(-1)))
+    return {b.name: (float(dr[k]), float(da[k])) for k, b in enumerate(sys.bodies)
+            if dr[k] > 1e-10 * L or da[k] > 1e-10}
 
 
 def _vchanged(sys, v0, v):

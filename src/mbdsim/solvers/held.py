@@ -45,11 +45,14 @@ class Held:
 def length_scale(sys) -> float:
     """Characteristic length of the model [m]: the largest distance of a joint point or marker from
     its body's CM, else the largest CM distance from the origin, else 1."""
-    d = [np.linalg.norm(g.s_i) for g in sys.geoms.values() if hasattr(g, "s_i")]
-    d += [np.linalg.norm(g.s_j) for g in sys.geoms.values() if hasattr(g, "s_j")]
-    d += [np.linalg.norm(b.position) for b in sys.bodies]
-    d = [x for x in d if np.isfinite(x) and x > 0]
-    return float(max(d)) if d else 1.0
+    pts = [g.s_i for g in sys.geoms.values() if hasattr(g, "s_i")]
+    pts += [g.s_j for g in sys.geoms.values() if hasattr(g, "s_j")]
+    pts += [b.position for b in sys.bodies]
+    if not pts:
+        return 1.0
+    d = np.sqrt(np.einsum("ij,ij->i", *(np.array(pts, dtype=float).reshape(-1, 3),) * 2))
+    d = d[np.isfinite(d) & (d > 0)]
+    return float(d.max()) if len(d) else 1.0
 
 
 def position_metric(sys) -> np.ndarray:
@@ -159,6 +162,14 @@ def lexi_solve(J, b, items, M, rel_tol=1e-9):
 
     Returns (x, consistent)."""
     n = M.shape[0]
+    if not items and J.shape[0]:   # nothing held: x = M^-1 J^T (J M^-1 J^T)^-1 b when J has full row rank
+        MiJt = np.linalg.solve(M, J.T)
+        try:
+            x = MiJt @ sla.cho_solve(sla.cho_factor(J @ MiJt), b)
+            if np.allclose(J @ x, b, rtol=1e-10, atol=1e-12 * max(1.0, float(np.abs(b).max()))):
+                return x, True
+        except (np.linalg.LinAlgError, ValueError):
+            pass   # dependent rows or an inconsistent b: the general path below
     if J.shape[0]:
         xp = np.linalg.lstsq(J, b, rcond=None)[0]
         N = sla.null_space(J, rcond=1e-10)

@@ -17,7 +17,7 @@ import warnings
 import numpy as np
 
 from ..errors import ModelError
-from ..math.rotation import matrix_to_quat, perpendicular_frame
+from ..math.rotation import cross3, matrix_to_quat, perpendicular_frame
 from .constraints.base import JointGeom, RowSpec
 from .constraints.driver import driver_rows
 from .constraints.path import path_specs
@@ -136,7 +136,7 @@ def joint_geometry(joint, fid) -> JointGeom:
                          Ri[:, 0], Ri[:, 1], Ri[:, 2], Rj[:, 0], Rj[:, 1], Rj[:, 2], extra)
     f, g, h = perpendicular_frame(joint.axis)
     if joint.kind == "planar" and joint.u_axis is not None:   # the user's / documented in-plane axes
-        f, g = joint.u_axis, np.cross(joint.axis, joint.u_axis)
+        f, g = joint.u_axis, cross3(joint.axis, joint.u_axis)
     Ai, Aj = bi.orientation, bj.orientation
     loc = lambda A, x: A.T @ x  # noqa: E731
     extra = None if joint.axis_j is None else loc(Aj, joint.axis_j)
