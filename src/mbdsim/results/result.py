@@ -16,19 +16,20 @@ from ..system import measures as ms
 from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
-from ..system.frames import body_frames
+from ..system.frames import Frames, body_frames
 
 
 class Result:
     """Time history of an analysis; a failed run keeps every step computed before the failure."""
 
     def __init__(self, system, time, q, v, vd, lambda_, evaluate: Callable | None = None,
-                 success=True, status=0, message="ok", stats=None):
+                 success=True, status=0, message="ok", stats=None, accelerations: Callable | None = None):
         self.system = system
         self.time = np.atleast_1d(np.asarray(time, dtype=float))   # [s]
         self.q, self.v = np.atleast_2d(q), np.atleast_2d(v)         # coordinates, velocity variables
-        self.vd = None if vd is None else np.atleast_2d(vd)          # accelerations of v
-        self.lambda_ = None if lambda_ is None else np.atleast_2d(lambda_)  # multipliers (N, nc)
+        self._vd = None if vd is None else np.atleast_2d(vd)
+        self._lambda = None if lambda_ is None else np.atleast_2d(lambda_)
+        self._accelerations = accelerations   # () -> (vd, lambda_), called once on first use
         self._evaluate = evaluate
         self.success, self.status, self.message = success, status, message
         self.stats = stats or {}
@@ -47,11 +48,34 @@ class Result:
         from ..viewer.notebook import result_html; return result_html(self)  # noqa: E702
 
     @property
+    def vd(self):
+        """Accelerations of the velocity variables v (N, nv) [m/s^2, rad/s^2 in body axes], or None."""
+        if self._vd is None and self._accelerations is not None:
+            self._materialize()
+        return self._vd
+
+    @property
+    def lambda_(self):
+        """Lagrange multipliers of the constraint rows (N, nc) [N, N m], or None."""
+        if self._lambda is None and self._accelerations is not None:
+            self._materialize()
+        return self._lambda
+
+    def _materialize(self):
+        """Compute the accelerations and multipliers of a run that left them for later (compiled runs)."""
+        fn, self._accelerations = self._accelerations, None
+        vd, lam = fn()
+        self._vd, self._lambda = np.atleast_2d(vd), np.atleast_2d(lam)
+
+    @property
     def frames(self):
         if self._fr is None:
-            self._fr = body_frames(self.system, self.q, self.v, self.vd)
+            if self._vd is None and self._accelerations is not None:   # positions need no accelerations
+                self._fr = _LazyFrames(body_frames(self.system, self.q, self.v), self)
+            else:
+                self._fr = body_frames(self.system, self.q, self.v, self.vd)
+                self._fr.lambda_ = self.lambda_   # multipliers, for friction measures (force_elements.friction)
             self._fr.t = self.time   # sample times, for time-dependent element measures
-            self._fr.lambda_ = self.lambda_   # multipliers, for friction measures (force_elements.friction)
         return self._fr
 
     def at(self, t) -> "Result":
@@ -111,7 +135,7 @@ class Result:
         relative to f's origin (Adams VX(i, j, k, l) with j = l = f, k = frame):
         v = v_rel + v_O + w_f x rho (see mbdsim.results.kinematics)."""
         if relative_to is None:
-            v = ms.point_kinematics(self.system, self.frames, target)[1]
+            v = ms.point_kinematics(self.system, self.frames, target, False)[1]
         else:
             v = kin.relative_point_motion(self.system, self.frames, target, relative_to).v_rel
         return self._express(v, frame)
@@ -361,3 +385,22 @@ def _spring(res, el):
     from ..system.force_elements.loads import spring_state
     L, Ld, *_ = spring_state(res.system, res.frames, el)
     return L, Ld
+
+
+class _LazyFrames(Frames):
+    """Body frames of a Result whose accelerations (rdd, alpha) and multipliers are computed on first use."""
+
+    def __init__(self, fr: Frames, res: Result):
+        self.r, self.A, self.rd, self.w = fr.r, fr.A, fr.rd, fr.w
+        self._res = res
+
+    def _full(self, key):
+        if key not in self.__dict__:
+            res = self._res
+            full = body_frames(res.system, res.q, res.v, res.vd)
+            self.__dict__.update(_rdd=full.rdd, _alpha=full.alpha, _lam=res.lambda_)
+        return self.__dict__[key]
+
+    rdd = property(lambda self: self._full("_rdd"), lambda self, x: self.__dict__.__setitem__("_rdd", x))
+    alpha = property(lambda self: self._full("_alpha"), lambda self, x: self.__dict__.__setitem__("_alpha", x))
+    lambda_ = property(lambda self: self._full("_lam"), lambda self, x: self.__dict__.__setitem__("_lam", x))

@@ -41,16 +41,17 @@ class CompiledRun:
         self.stiff_check = bool(stiff_check)
 
     def integrate(self, t0, y0, tout, progress=None):
-        """Outputs (Y, VD, LAM, n_written, status, t_fail) from the consistent state y0 at t0 over tout."""
-        sys, a, w = self.sys, self.cm.arrays(), self.work.arrays()
+        """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
+        tout; accelerations and multipliers at them come from `outputs` (on demand)."""
+        a, w = self.cm.arrays(), self.work.arrays()
         n, nout = len(y0), len(tout)
-        Y, VD, LAM = np.zeros((nout, n)), np.zeros((nout, sys.nv)), np.zeros((nout, sys.nc))
+        Y = np.zeros((nout, n))
         y, f = np.array(y0, dtype=float), np.zeros(n)
         status = fastdop.rhs(a, w, t0, y, f)
         iout = 0
         if status == 0 and abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
-            status = fastdop.write_output(a, w, t0, y, Y[0], VD[0], LAM[0])
-            iout = 1 if status == 0 else 0
+            Y[0] = y
+            iout = 1
         st = np.array([t0, 0.0])
         if status == 0:
             st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n),
@@ -58,14 +59,24 @@ class CompiledRun:
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         try:
             while status == 0 and iout < nout:
-                status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, VD,
-                                           LAM, self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
+                status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
+                                           self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
                                            1e-12, self.stats, K, F, sc, self.stiff_check)
                 if progress is not None:
                     progress(float(st[0]))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
-        return Y, VD, LAM, iout, status, st[0], y
+        return Y, iout, status, st[0], y
+
+    def outputs(self, times, Y):
+        """(VD, LAM): accelerations and multipliers of the independent rows at the output states Y;
+        SolverError naming the time if the equations of motion are singular at one of them."""
+        sys = self.sys
+        VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
+        done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM)
+        if done < len(times):
+            raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[done]))
+        return VD, LAM
 
     def states_at(self, times, Y, ts):
         """(q, v, vd, lambda_) at times ts by re-integrating from the sample at or before each t."""
@@ -73,17 +84,16 @@ class CompiledRun:
         for t in np.atleast_1d(ts):
             k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
             if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)):
-                tout = np.array([t])
-                y0 = Y[k]
-            else:
-                tout, y0 = np.array([times[k], t]), Y[k]
-            Yk, VDk, LAMk, m, status, _, _ = self.integrate(times[k], y0, tout)
-            if m < len(tout):
+                out.append(Y[k])
+                continue
+            Yk, m, status, _, _ = self.integrate(times[k], Y[k], np.array([times[k], t]))
+            if m < 2:
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))
-            out.append((Yk[-1], VDk[-1], LAMk[-1]))
+            out.append(Yk[-1])
         nq = self.sys.nq
-        Ys = np.array([o[0] for o in out])
-        return (Ys[:, :nq], Ys[:, nq:], np.array([o[1] for o in out]), np.array([o[2] for o in out]))
+        Ys = np.array(out).reshape(-1, len(Y[0]))
+        VD, LAM = self.outputs(np.atleast_1d(ts), Ys)
+        return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, np.atleast_1d(ts), Ys, VD, LAM)
 
 
 class Stiff(Exception):
@@ -102,7 +112,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
-    Y, VD, LAM, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress)
+    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress)
     if status == STIFF:
         raise Stiff(float(t_fail))
     if status != 0:
@@ -116,15 +126,20 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                             state=y_fail[:sys.nq])
         last = f"{times[n - 1]:.9g}" if n else "none"
         success, message = False, f"{error}; last good output at t = {last} s"
-    LAM = _full_multipliers(sys, rep.rows, times[:n], Y[:n], VD[:n], LAM[:n])
     nq = sys.nq
-    res = Result(sys, times[:n], Y[:n, :nq], Y[:n, nq:], VD[:n], LAM,
-                 evaluate=lambda ts: run.states_at(times[:n], Y[:n], ts), success=success,
+    t_out, Y = times[:n], Y[:n]
+
+    def accelerations():   # on first use of vd / lambda_ (most runs are read for positions only)
+        VD, LAM = run.outputs(t_out, Y)
+        return VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)
+
+    res = Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None,
+                 evaluate=lambda ts: run.states_at(t_out, Y, ts), success=success,
                  status=0 if success else -1, message=message,
                  stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
                         "njev": 0, "factorizations": int(run.stats[2] + 2 * run.stats[3]),
                         "projections": int(run.stats[3]), "order": 8, "method": "DOP853 (compiled)",
-                        "assembly": rep})
+                        "assembly": rep}, accelerations=accelerations)
     res.error = error
     return res
 

@@ -2,8 +2,9 @@
 
 The whole step loop runs in compiled code: stages (the O(N) equations of motion of `fastdyn`), the
 error norm, step-size control, coordinate projection after every accepted step, and the outputs at the
-requested times (dense output, then projection, accelerations and multipliers). Python is re-entered
-only when a chunk of outputs is written, at the end, or on failure. The Butcher tableau is scipy's
+requested times (dense output, then projection; accelerations and multipliers after the run, on
+demand: `outputs_at`). Python is re-entered only when a chunk of outputs is written, at the end, or on
+failure. The Butcher tableau is scipy's
 (`scipy.integrate._ivp.dop853_coefficients`); the control follows scipy's `DOP853`: error norm
 |h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2)) with scale atol + rtol max(|y_old|, |y_new|), safety 0.9,
 factor limits 0.2..10, exponent -1/8.
@@ -66,6 +67,17 @@ def write_output(cm, wk, t, y, yout, vdout, lamout, refactor=True):
 
 
 @njit(cache=True, _nrt=False)
+def outputs_at(cm, wk, times, Y, VD, LAM):
+    """Accelerations VD and multipliers LAM at the output states Y (rows at `times`), computed after the
+    run and only when a result asks for them; returns the number of rows done (< len on failure)."""
+    nq = cm[31][0]
+    for k in range(times.shape[0]):
+        if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], True) != OK:
+            return k
+    return times.shape[0]
+
+
+@njit(cache=True, _nrt=False)
 def _dense(F, y_old, t_old, h, t, out):
     x = (t - t_old) / h
     for i in range(out.shape[0]):
@@ -81,10 +93,11 @@ def _dense(F, y_old, t_old, h, t, out):
 
 
 @njit(cache=True, _nrt=False)
-def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_step, max_steps, chunk,
+def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
         proj_tol, stats, K, F, sc, stiff_check):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
-    outputs tout[iout:] into Y, VD, LAM; stops after `chunk` outputs. Returns (status, next iout).
+    projected output states at tout[iout:] into Y (accelerations: `outputs_at`, on demand); stops after
+    `chunk` outputs. Returns (status, next iout).
     stats: steps, rejected, rhs evaluations, projections, stiffness counters (int64, accumulated);
     K (16, n), F (7, n) and sc (4, n) are scratch. With stiff_check, Hairer's test (h |df| / |dy| > 6.1
     on the last stage, 15 times without 6 non-stiff steps between) stops the run with STIFF."""
@@ -191,15 +204,13 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, VD, LAM, rtol, atol, max_ste
             while iout < tout.shape[0] and tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):
                 to = min(tout[iout], t_new)
                 _dense(F, y, t, h, to, yo)
-                s_ = project(cm, wk, to, yo[:nq], yo[nq:], proj_tol)
+                s_ = project(cm, wk, to, yo[:nq], yo[nq:], proj_tol, False)
                 stats[3] += 1
                 if s_ != OK:
                     st[0], st[1] = t, h
                     return s_, iout
-                s_ = write_output(cm, wk, to, yo, Y[iout], VD[iout], LAM[iout], False)
-                if s_ != OK:
-                    st[0], st[1] = t, h
-                    return s_, iout
+                for i in range(n):
+                    Y[iout, i] = yo[i]
                 iout += 1
                 written += 1
         for i in range(n):

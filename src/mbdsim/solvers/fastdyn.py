@@ -390,9 +390,13 @@ def normalize_kernel(p_idx, q):
 
 
 @njit(cache=True, _nrt=False)
-def project(cm, wk, t, q, v, tol):
+def project(cm, wk, t, q, v, tol, exact_factor=True):
     """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu.
-    Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`)."""
+    Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`); with
+    exact_factor=False the velocity step reuses the last Newton step's factorisation (positions a
+    Newton step apart: the velocity residual is of the order of that step times the correction, far
+    below round-off of the constraints), for outputs, after which the factorisation is not reused."""
+    factored = False
     active = cm[32]
     x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
     normalize_into(cm, q)
@@ -410,6 +414,7 @@ def project(cm, wk, t, q, v, tol):
             break
         if not _factor(cm, wk):
             return SINGULAR
+        factored = True
         for i in range(c.shape[0]):
             c[i] = -wk[4][i]
         _solve(cm, wk, zero6, c, x6, lam)
@@ -417,7 +422,7 @@ def project(cm, wk, t, q, v, tol):
     if not ok:
         return PROJECTION
     # velocities: v <- v + dv with M dv + J^T mu = 0, J dv = nu - J v, at the rows just evaluated
-    if not _factor(cm, wk):
+    if (exact_factor or not factored) and not _factor(cm, wk):
         return SINGULAR
     v6 = wk[30]
     _to6(cm, v, v6)

@@ -66,8 +66,9 @@ def express(sys, fr, vec, frame):
     return vec if R is None else np.einsum("nji,nj->ni", R, vec)
 
 
-def point_kinematics(sys, fr, target):
-    """Ground position, velocity, acceleration (N, 3) of a body CM or marker origin."""
+def point_kinematics(sys, fr, target, with_acc=True):
+    """Ground position, velocity, acceleration (N, 3) of a body CM or marker origin (acceleration None
+    when the frames hold none, or with_acc=False: then a result's lazy accelerations stay uncomputed)."""
     fid, s_B, _ = locate(sys, target)
     A = fr.A[:, fid]
     s = A @ s_B
@@ -75,17 +76,17 @@ def point_kinematics(sys, fr, target):
     pos = fr.r[:, fid] + s
     vel = fr.rd[:, fid] + np.cross(w, s)
     acc = None
-    if fr.rdd is not None:
+    if with_acc and fr.rdd is not None:
         acc = fr.rdd[:, fid] + np.cross(fr.alpha[:, fid], s) + np.cross(w, np.cross(w, s))
     return pos, vel, acc
 
 
 def position(sys, fr, target, frame=None):
     """Position [m] of target, in ground or relative to `frame` in its axes."""
-    pos = point_kinematics(sys, fr, target)[0]
+    pos = point_kinematics(sys, fr, target, False)[0]
     if frame is None:
         return pos
-    return express(sys, fr, pos - point_kinematics(sys, fr, frame)[0], frame)
+    return express(sys, fr, pos - point_kinematics(sys, fr, frame, False)[0], frame)
 
 
 def flat(fr: Frames, bi, bj):
