@@ -79,21 +79,24 @@ class CompiledRun:
         return VD, LAM
 
     def states_at(self, times, Y, ts):
-        """(q, v, vd, lambda_) at times ts by re-integrating from the sample at or before each t."""
-        out = []
-        for t in np.atleast_1d(ts):
+        """(q, v, vd, lambda_) at times ts by re-integrating from the sample at or before each t (one
+        compiled call per time: `fastdop.span`)."""
+        ts = np.atleast_1d(np.asarray(ts, dtype=float))
+        n = Y.shape[1]
+        Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), self.sys.nv)), np.zeros((len(ts), self.sys.nc))
+        a, w = self.cm.arrays(), self.work.arrays()
+        K, F, sc, f = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n)), np.zeros(n)
+        for j, t in enumerate(ts):
             k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
-            if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)):
-                out.append(Y[k])
-                continue
-            Yk, m, status, _, _ = self.integrate(times[k], Y[k], np.array([times[k], t]))
-            if m < 2:
+            tout = np.array([t]) if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)) else np.array([times[k], t])
+            Yk, VDk, LAMk = np.zeros((len(tout), n)), np.zeros((len(tout), self.sys.nv)), np.zeros((len(tout), self.sys.nc))
+            status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), np.array(Y[k]), f, tout, Yk, VDk, LAMk,
+                                     self.rtol, self.atol, self.max_step, self.max_steps, self.stats, K, F, sc)
+            if m < len(tout):
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))
-            out.append(Yk[-1])
+            Ys[j], VD[j], LAM[j] = Yk[-1], VDk[-1], LAMk[-1]
         nq = self.sys.nq
-        Ys = np.array(out).reshape(-1, len(Y[0]))
-        VD, LAM = self.outputs(np.atleast_1d(ts), Ys)
-        return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, np.atleast_1d(ts), Ys, VD, LAM)
+        return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
 
 
 class Stiff(Exception):
@@ -146,18 +149,28 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
 
 def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
-    solution of phi_q^T lambda_ = Q - M vd over all rows (determinate components exact)."""
+    lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
+    rows, so that the determinate components are exact. All samples in one batched pseudo-inverse."""
     if len(rows) == sys.nc or not len(times):
         return LAM
-    from ..system.dynamics import applied_forces
-    from ..system.equations import constraint_terms
-    from ..system.frames import body_frames
-    from .state import state_factory
-    sf = state_factory(sys)
+    from ..system.equations import jacobians
+    J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows`
+    load = np.einsum("nri,nr->ni", J, LAM)
+    # J = C J_r (C = J J_r^T G^-1, G = J_r J_r^T): J^T lam = J_r^T lam_r  <=>  C^T lam = lam_r, whose
+    # least-norm solution is lam = C (C^T C)^-1 lam_r (r x r solves only)
+    rows = np.asarray(rows)
+    Jr = J[:, rows]
     out = np.zeros_like(LAM)
-    for k, t in enumerate(times):
-        q, v = Y[k, :sys.nq], Y[k, sys.nq:]
-        _, J, _, _ = constraint_terms(sys, q, v, t)
-        Q = applied_forces(sys, body_frames(sys, q, v), t, sf(t, q, v) if sf else None)
-        out[k] = np.linalg.lstsq(J.T, Q - sys.M @ VD[k], rcond=None)[0]
+    try:
+        Ct = np.linalg.solve(Jr @ np.transpose(Jr, (0, 2, 1)), Jr @ np.transpose(J, (0, 2, 1)))   # (N, r, nc)
+        w = np.linalg.solve(Ct @ np.transpose(Ct, (0, 2, 1)), LAM[:, rows][..., None])[..., 0]
+        out = np.einsum("nrc,nr->nc", Ct, w)
+        bad = ~np.all(np.isfinite(out), axis=1)
+    except np.linalg.LinAlgError:
+        bad = np.ones(len(times), dtype=bool)
+    scale = np.abs(load).max(axis=1) + 1e-300
+    bad |= np.abs(np.einsum("nri,nr->ni", J, out) - load).max(axis=1) > 1e-9 * scale
+    if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
+        rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
+        out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load[bad])
     return out

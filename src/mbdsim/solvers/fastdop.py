@@ -17,7 +17,7 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from scipy.integrate._ivp import dop853_coefficients as _c
 
-from .fastdyn import MAX_STEPS, NONFINITE, OK, STIFF, TINY_STEP, accelerations, project, rhs
+from .fastdyn import MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs
 
 N_STAGES = _c.N_STAGES
 COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
@@ -235,3 +235,29 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             break   # back to Python now and then (progress, Ctrl-C), also between sparse outputs
     st[0], st[1] = t, h
     return OK, iout
+
+
+@njit(cache=True, _nrt=False)
+def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps, stats, K, F, sc):
+    """Short re-integration in one compiled call (Result.at): from the consistent state y at t0 over all
+    of tout (tout[0] == t0 is written as is), then accelerations and multipliers at the outputs; returns
+    (status, outputs written); st = [t0, (step)] as in `run`. Same stepping as `run`; no stiffness test,
+    no return to Python."""
+    n = y.shape[0]
+    t0 = st[0]
+    status = rhs(cm, wk, t0, y, f)
+    iout = 0
+    if status != OK:
+        return status, 0
+    if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
+        for i in range(n):
+            Y[0, i] = y[i]
+        iout = 1
+    st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
+    while status == OK and iout < tout.shape[0]:
+        status, iout = run(cm, wk, co, st, y, f, tout[-1], tout, iout, Y, rtol, atol, max_step, max_steps,
+                           tout.shape[0], 1e-12, stats, K, F, sc, False)
+    done = outputs_at(cm, wk, tout[:iout], Y[:iout], VD[:iout], LAM[:iout])
+    if done < iout:
+        return SINGULAR, done
+    return status, iout

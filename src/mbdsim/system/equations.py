@@ -89,6 +89,21 @@ def _terms_compiled(sys, q, v, t, jacobian):
     return phi_, (J if jacobian else None), nu, gamma
 
 
+def jacobians(sys, q) -> np.ndarray:
+    """Constraint Jacobians phi_q (N, nc, nv) at position samples q (N, nq), one compiled call (the
+    numpy path row by row for models with path constraints)."""
+    q = np.atleast_2d(np.asarray(q, dtype=float))
+    if not sys.nc or len(sys.aux_q_idx):
+        return np.array([constraint_terms(sys, x, np.zeros(sys.nv), 0.0)[1] for x in q]).reshape(len(q), sys.nc, sys.nv)
+    packed = getattr(sys, "_packed", None)
+    if packed is None:
+        packed = sys._packed = kernels.pack_rows(sys)
+    kind, bi, bj, v1, v2, v3, drv, fns = packed
+    return kernels.jacobian_batch(q, sys.r_idx, sys.p_idx, sys.rd_idx, sys.w_idx, sys.rigid_fid, sys.nbody + 1,
+                                  kind, bi, bj, v1, v2, v3, drv, len(fns), sys.frame_v_adr, sys.frame_rigid,
+                                  sys.nv)
+
+
 def constraint_terms_numpy(sys, q, v, t, jacobian=True):
     """Reference numpy implementation of constraint_terms (vectorised primitives)."""
     fr = body_frames(sys, q, v)

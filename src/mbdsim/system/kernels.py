@@ -182,6 +182,24 @@ def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, 
     scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
 
 
+@njit(cache=True)
+def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_, v1, v2, v3, drv, nd, vadr,
+                   rigid, nv):
+    """Constraint Jacobians phi_q (N, nc, nv) at the position samples Q (N, nq); phi_q does not depend on
+    the velocities or on the driver values (those enter phi, nu and gamma only)."""
+    N, nc = Q.shape[0], kind.shape[0]
+    out = np.zeros((N, nc, nv))
+    r, A, rd, w = np.zeros((nf, 3)), np.zeros((nf, 3, 3)), np.zeros((nf, 3)), np.zeros((nf, 3))
+    v0 = np.zeros(nv)
+    z = np.zeros(max(nd, 1))
+    phi, nu, gamma, Jc = np.zeros(nc), np.zeros(nc), np.zeros(nc), np.zeros((nc, 2, 6))
+    for n in range(N):
+        frames_into(Q[n], v0, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
+        rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, z, z, z, rigid, phi, Jc, nu, gamma)
+        scatter_dense(Jc, bi_, bj_, vadr, rigid, out[n])
+    return out
+
+
 @njit(cache=True, _nrt=False)
 def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
     """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""

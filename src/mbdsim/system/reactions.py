@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from .equations import constraint_terms
+from .equations import jacobians
 from .frames import body_frames
 
 
@@ -28,34 +28,25 @@ def joint_reaction(sys, q, lambda_, joint, on=None):
     fid = geom.bj if body is None else sys.fid.get(body, -1)
     if fid not in (geom.bi, geom.bj):
         raise ModelError(f"joint '{name}'", "on", f"{body!r} is not one of the joint's bodies")
-    s_B = geom.s_j if fid == geom.bj else geom.s_i
-    N = len(q)
-    F, T = np.zeros((N, 3)), np.zeros((N, 3))
     if fid == 0:  # ground: the opposite of the load on the other body, reduced to the same point
         other = geom.bi if geom.bj == 0 else geom.bj
-        return _negated(sys, q, lambda_, rows, other, geom, N)
+        F, T = _load_on(sys, q, lambda_, rows, other, geom)
+        return -F, -T
+    return _load_on(sys, q, lambda_, rows, fid, geom)
+
+
+def _load_on(sys, q, lambda_, rows, fid, geom):
+    """Constraint force [N] and torque about the joint point [N m] (N, 3), ground axes, of `rows` on frame
+    fid, for all samples at once."""
+    s_B = geom.s_j if fid == geom.bj else geom.s_i
     a = sys.frame_v_adr[fid]
-    for n in range(N):
-        J = constraint_terms(sys, q[n], np.zeros(sys.nv), 0.0)[1][rows]
-        lam = lambda_[n, rows]
-        F[n] = -J[:, a:a + 3].T @ lam
-        fr = body_frames(sys, q[n])
-        if sys.frame_rigid[fid]:
-            T_cm = fr.A[fid] @ (-J[:, a + 3:a + 6].T @ lam)
-            T[n] = T_cm + np.cross(-(fr.A[fid] @ s_B), F[n])
-    return F, T
-
-
-def _negated(sys, q, lambda_, rows, other, geom, N):
-    s_B = geom.s_j if other == geom.bj else geom.s_i
-    a = sys.frame_v_adr[other]
-    F, T = np.zeros((N, 3)), np.zeros((N, 3))
-    for n in range(N):
-        J = constraint_terms(sys, q[n], np.zeros(sys.nv), 0.0)[1][rows]
-        lam = lambda_[n, rows]
-        F[n] = J[:, a:a + 3].T @ lam
-        if sys.frame_rigid[other]:
-            fr = body_frames(sys, q[n])
-            T_cm = fr.A[other] @ (J[:, a + 3:a + 6].T @ lam)
-            T[n] = T_cm + np.cross(-(fr.A[other] @ s_B), F[n])
+    q = np.atleast_2d(q)
+    J = jacobians(sys, q)[:, rows]                    # (N, nr, nv)
+    lam = np.asarray(lambda_)[:, rows]
+    F = -np.einsum("nri,nr->ni", J[:, :, a:a + 3], lam)
+    T = np.zeros_like(F)
+    if sys.frame_rigid[fid]:
+        A = body_frames(sys, q).A[:, fid]
+        T_cm = np.einsum("nij,nj->ni", A, -np.einsum("nri,nr->ni", J[:, :, a + 3:a + 6], lam))
+        T = T_cm + np.cross(-(A @ s_B), F)
     return F, T
