@@ -25,6 +25,7 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
              STIFF: "the model is stiff for an explicit method",
              INTERRUPTED: "interrupted (KeyboardInterrupt)"}
 CHUNK = 256
+CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand
 
 
 class CompiledRun:
@@ -40,9 +41,11 @@ class CompiledRun:
         self.stats = np.zeros(6, dtype=np.int64)
         self.stiff_check = bool(stiff_check)
 
-    def integrate(self, t0, y0, tout, progress=None):
+    def integrate(self, t0, y0, tout, progress=None, checkpoints=False):
         """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
-        tout; accelerations and multipliers at them come from `outputs` (on demand)."""
+        tout; accelerations and multipliers at them come from `outputs` (on demand). With `checkpoints`,
+        every accepted step's start state and (t, h) are kept (self.checkpoints, within
+        CHECKPOINT_BUDGET bytes, else None) for dense output on demand."""
         a, w = self.cm.arrays(), self.work.arrays()
         n, nout = len(y0), len(tout)
         Y = np.zeros((nout, n))
@@ -57,15 +60,25 @@ class CompiledRun:
             st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n),
                                          np.zeros(n), np.zeros(n))
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
+        keep = checkpoints and n * 8 * 64 <= CHECKPOINT_BUDGET
+        SY, ST, ns = np.zeros((64 if keep else 0, n)), np.zeros((64 if keep else 0, 2)), np.zeros(1, np.int64)
         try:
-            while status == 0 and iout < nout:
+            while status in (0, fastdop.CHECKPOINTS_FULL) and iout < nout:
+                if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
+                    if 2 * SY.size * 8 <= CHECKPOINT_BUDGET:
+                        SY = np.concatenate([SY, np.zeros_like(SY)])
+                        ST = np.concatenate([ST, np.zeros_like(ST)])
+                    else:
+                        keep, SY, ST = False, SY[:0], ST[:0]
                 status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
                                            self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
-                                           1e-12, self.stats, K, F, sc, self.stiff_check)
+                                           1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns)
                 if progress is not None:
                     progress(float(st[0]))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
+        if checkpoints:
+            self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
         return Y, iout, status, st[0], y
 
     def outputs(self, times, Y):
@@ -79,9 +92,26 @@ class CompiledRun:
         return VD, LAM
 
     def states_at(self, times, Y, ts):
-        """(q, v, vd, lambda_) at times ts by re-integrating from the sample at or before each t (one
-        compiled call per time: `fastdop.span`)."""
+        """(q, v, vd, lambda_) at times ts: from the dense output of the run's own step containing each t
+        (redone from its checkpoint), else by re-integrating from the sample at or before t (one compiled
+        call per time: `fastdop.span`)."""
         ts = np.atleast_1d(np.asarray(ts, dtype=float))
+        cp = getattr(self, "checkpoints", None)
+        if cp is not None and len(cp[1]):
+            k = np.clip(np.searchsorted(times, ts), 0, len(times) - 1)
+            k = np.where((k > 0) & (np.abs(times[k - 1] - ts) < np.abs(times[k] - ts)), k - 1, k)
+            at_sample = np.abs(times[k] - ts) <= 1e-14 * np.maximum(1.0, np.abs(ts))
+            if not np.any(at_sample):
+                return self._from_checkpoints(cp, ts)
+            # output times give the stored samples themselves (bit-identical), the rest the dense output
+            Ys = np.array(Y[k], dtype=float)
+            VD, LAM = self.outputs(ts, Ys)
+            if not np.all(at_sample):
+                rest = np.flatnonzero(~at_sample)
+                q, v, vd, lam = self._from_checkpoints(cp, ts[rest], full=False)
+                Ys[rest], VD[rest], LAM[rest] = np.hstack([q, v]), vd, lam
+            nq = self.sys.nq
+            return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
         n = Y.shape[1]
         Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), self.sys.nv)), np.zeros((len(ts), self.sys.nc))
         a, w = self.cm.arrays(), self.work.arrays()
@@ -97,6 +127,28 @@ class CompiledRun:
             Ys[j], VD[j], LAM[j] = Yk[-1], VDk[-1], LAMk[-1]
         nq = self.sys.nq
         return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
+
+
+    def _from_checkpoints(self, cp, ts, full=True):
+        SY, ST = cp
+        n = SY.shape[1]
+        sys = self.sys
+        Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), sys.nv)), np.zeros((len(ts), sys.nc))
+        a, w = self.cm.arrays(), self.work.arrays()
+        K, F, sc, f = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n)), np.zeros(n)
+        step = np.clip(np.searchsorted(ST[:, 0], ts, side="right") - 1, 0, len(ST) - 1)
+        for j in np.unique(step):
+            sel = np.flatnonzero(step == j)
+            t0, h = ST[j]
+            tq = np.clip(ts[sel], t0, t0 + h)
+            Yk, VDk, LAMk = np.zeros((len(sel), n)), np.zeros((len(sel), sys.nv)), np.zeros((len(sel), sys.nc))
+            status = fastdop.from_checkpoint(a, w, fastdop.COEFFS, float(t0), float(h), SY[j].copy(), f, tq, Yk,
+                                             VDk, LAMk, K, F, sc)
+            if status != 0:
+                raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(ts[sel[0]]))
+            Ys[sel], VD[sel], LAM[sel] = Yk, VDk, LAMk
+        nq = sys.nq
+        return Ys[:, :nq], Ys[:, nq:], VD, (_full_multipliers(sys, self.rows, ts, Ys, VD, LAM) if full else LAM)
 
 
 class Stiff(Exception):
@@ -115,7 +167,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
-    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress)
+    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress, True)
     if status == STIFF:
         raise Stiff(float(t_fail))
     if status != 0:

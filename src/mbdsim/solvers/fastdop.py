@@ -19,6 +19,8 @@ from scipy.integrate._ivp import dop853_coefficients as _c
 
 from .fastdyn import MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs
 
+CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
+
 N_STAGES = _c.N_STAGES
 COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
@@ -93,15 +95,64 @@ def _dense(F, y_old, t_old, h, t, out):
 
 
 @njit(cache=True, _nrt=False)
+def _stages(cm, wk, co, t, h, y, K, ys, ynew):
+    """The 12 stages of a DOP853 step from y (K[0] = f(t, y) given), ynew and K[12] = f(t + h, ynew);
+    False when an evaluation failed."""
+    A, B, C = co[0], co[1], co[2]
+    n = y.shape[0]
+    for s in range(1, N_STAGES):
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, i]
+            ys[i] = y[i] + h * acc
+        if rhs(cm, wk, t + C[s] * h, ys, K[s]) != OK:
+            return False
+    for i in range(n):
+        acc = 0.0
+        for j in range(N_STAGES):
+            acc += B[j] * K[j, i]
+        ynew[i] = y[i] + h * acc
+    return rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
+
+
+@njit(cache=True, _nrt=False)
+def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
+    """The 7th-order dense output coefficients F (7, n) of an accepted step (3 more evaluations)."""
+    A, C, D = co[0], co[2], co[5]
+    n = y.shape[0]
+    for s in range(N_STAGES + 1, 16):
+        for i in range(n):
+            acc = 0.0
+            for j in range(s):
+                acc += A[s, j] * K[j, i]
+            ys[i] = y[i] + h * acc
+        rhs(cm, wk, t + C[s] * h, ys, K[s])
+    for i in range(n):
+        dy = ynew[i] - y[i]
+        F[0, i] = dy
+        F[1, i] = h * K[0, i] - dy
+        F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
+        for r in range(4):
+            acc = 0.0
+            for j in range(16):
+                acc += D[r, j] * K[j, i]
+            F[3 + r, i] = h * acc
+
+
+@njit(cache=True, _nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
-        proj_tol, stats, K, F, sc, stiff_check):
+        proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
     projected output states at tout[iout:] into Y (accelerations: `outputs_at`, on demand); stops after
     `chunk` outputs. Returns (status, next iout).
     stats: steps, rejected, rhs evaluations, projections, stiffness counters (int64, accumulated);
     K (16, n), F (7, n) and sc (4, n) are scratch. With stiff_check, Hairer's test (h |df| / |dy| > 6.1
-    on the last stage, 15 times without 6 non-stiff steps between) stops the run with STIFF."""
-    A, B, C, E3, E5, D = co
+    on the last stage, 15 times without 6 non-stiff steps between) stops the run with STIFF.
+    Checkpoints: when SY has rows, each accepted step's start state goes to SY[ns[0]] and its (t, h) to
+    ST[ns[0]] (so that `from_checkpoint` redoes exactly that step for dense output on demand); when they
+    are full the run returns CHECKPOINTS_FULL before its next step for the caller to grow them."""
+    E3, E5 = co[3], co[4]
     nq = cm[31][0]
     n = y.shape[0]
     ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
@@ -114,6 +165,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if stats[0] >= max_steps:
             st[0], st[1] = t, h
             return MAX_STEPS, iout
+        if SY.shape[0] > 0 and ns[0] >= SY.shape[0]:
+            st[0], st[1] = t, h
+            return CHECKPOINTS_FULL, iout
         hmin = 10.0 * eps * max(abs(t), 1.0)
         h = min(h, max_step, t_end - t)
         if h < hmin:
@@ -123,25 +177,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             h = t_end - t
         for i in range(n):
             K[0, i] = f[i]
-        ok = True
-        for s in range(1, N_STAGES):
-            for i in range(n):
-                acc = 0.0
-                for j in range(s):
-                    acc += A[s, j] * K[j, i]
-                ys[i] = y[i] + h * acc
-            if rhs(cm, wk, t + C[s] * h, ys, K[s]) != OK:
-                ok = False
-                break
-        stats[2] += N_STAGES - 1
-        if ok:
-            for i in range(n):
-                acc = 0.0
-                for j in range(N_STAGES):
-                    acc += B[j] * K[j, i]
-                ynew[i] = y[i] + h * acc
-            ok = rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
-            stats[2] += 1
+        ok = _stages(cm, wk, co, t, h, y, K, ys, ynew)
+        stats[2] += N_STAGES
         err = np.inf
         if ok:
             e5, e3 = 0.0, 0.0
@@ -167,6 +204,12 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         rejected = False
         t_new = t + h
         stats[0] += 1
+        if SY.shape[0] > 0:
+            for i in range(n):
+                SY[ns[0], i] = y[i]
+            ST[ns[0], 0] = t
+            ST[ns[0], 1] = h
+            ns[0] += 1
         if stiff_check:   # stats[4]: consecutive stiff verdicts, stats[5]: non-stiff ones since
             num, den = 0.0, 0.0
             for i in range(n):
@@ -183,24 +226,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 if stats[5] >= 6:
                     stats[4] = 0
         if tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):   # outputs inside this step
-            for s in range(N_STAGES + 1, 16):
-                for i in range(n):
-                    acc = 0.0
-                    for j in range(s):
-                        acc += A[s, j] * K[j, i]
-                    ys[i] = y[i] + h * acc
-                rhs(cm, wk, t + C[s] * h, ys, K[s])
+            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
             stats[2] += 3
-            for i in range(n):
-                dy = ynew[i] - y[i]
-                F[0, i] = dy
-                F[1, i] = h * K[0, i] - dy
-                F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
-                for r in range(4):
-                    acc = 0.0
-                    for j in range(16):
-                        acc += D[r, j] * K[j, i]
-                    F[3 + r, i] = h * acc
             while iout < tout.shape[0] and tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):
                 to = min(tout[iout], t_new)
                 _dense(F, y, t, h, to, yo)
@@ -256,8 +283,34 @@ def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps
     st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
     while status == OK and iout < tout.shape[0]:
         status, iout = run(cm, wk, co, st, y, f, tout[-1], tout, iout, Y, rtol, atol, max_step, max_steps,
-                           tout.shape[0], 1e-12, stats, K, F, sc, False)
+                           tout.shape[0], 1e-12, stats, K, F, sc, False, Y[:0], Y[:0, :2], stats[:1])
     done = outputs_at(cm, wk, tout[:iout], Y[:iout], VD[:iout], LAM[:iout])
     if done < iout:
         return SINGULAR, done
     return status, iout
+
+
+@njit(cache=True, _nrt=False)
+def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
+    """States, accelerations and multipliers at the times tq (inside [t0, t0 + h]) from the dense output
+    of the step (t0, h) redone from its checkpoint y0: the run's own step, so the same solution; status."""
+    nq = cm[31][0]
+    n = y0.shape[0]
+    ys, ynew, yo = sc[0], sc[1], sc[2]
+    if rhs(cm, wk, t0, y0, f) != OK:
+        return SINGULAR
+    for i in range(n):
+        K[0, i] = f[i]
+    if not _stages(cm, wk, co, t0, h, y0, K, ys, ynew):
+        return SINGULAR
+    _dense_coeffs(cm, wk, co, t0, h, y0, ynew, K, ys, F)
+    for k in range(tq.shape[0]):
+        _dense(F, y0, t0, h, tq[k], yo)
+        s_ = project(cm, wk, tq[k], yo[:nq], yo[nq:], 1e-12)
+        if s_ != OK:
+            return s_
+        for i in range(n):
+            Y[k, i] = yo[i]
+        if accelerations(cm, wk, tq[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], False) != OK:
+            return SINGULAR
+    return OK
