@@ -158,6 +158,8 @@ def compile_system(sys, rows) -> CompiledModel:
         raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
     if len(sys.lock_rows):
         raise NotCompiled("joint friction (stick/slip) is not compiled yet")
+    if getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows, sensors
+        raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
     nf = sys.nbody + 1
     M6 = np.zeros((nf, 6, 6))
     for f in range(nf):
