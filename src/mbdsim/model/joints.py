@@ -14,16 +14,24 @@ from .body import Body, Marker
 JOINT_DOF = {
     "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
     "universal": 2, "planar": 3, "fixed": 0,
+    # issue 11: joint primitives (Adams JPRIM), screw, constant-velocity joint
+    "inline": 4, "inplane": 5, "orientation": 3, "parallel_axes": 4, "perpendicular": 5, "atpoint": 3,
+    "screw": 1, "constant_velocity": 2,
 }
 # Number of joint coordinates (Result.joint_coordinate): a universal joint reports its relative rotation
 # vector (3 values, 2 of them independent), as a spherical joint does.
 JOINT_NCOORD = {
     "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
     "universal": 3, "planar": 3, "fixed": 0,
+    # primitives have no joint coordinates; a screw reports its angle [rad] (slide = lead angle / 2 pi);
+    # a constant-velocity joint its relative rotation vector, as a universal joint does
+    "inline": 0, "inplane": 0, "orientation": 0, "parallel_axes": 0, "perpendicular": 0, "atpoint": 0,
+    "screw": 1, "constant_velocity": 3,
 }
 COORD_NAMES = {"cylindrical": "(angle [rad], slide [m])", "planar": "(u [m], v [m], angle [rad])",
                "spherical": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes",
-               "universal": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes"}
+               "universal": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes",
+               "constant_velocity": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes"}
 
 
 @dataclass(eq=False)
@@ -43,6 +51,7 @@ class Joint:
     axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
     axis_j: np.ndarray | None = None
     u_axis: np.ndarray | None = None
+    lead: float | None = None   # screw joint: slide per revolution [m/rev]
     initial_displacement: np.ndarray | None = None   # held at assembly (joint coordinates, from as drawn)
     initial_velocity: np.ndarray | None = None       # held at assembly (joint_velocity)
     marker_i: Marker | None = None   # marker-pair joint: point and axes from the I marker (on body_i) ...
@@ -88,7 +97,7 @@ def joint_initial(entity: str, kind: str, field_name: str, value) -> np.ndarray 
         return None
     n = JOINT_NCOORD[kind]
     if n == 0:
-        raise ModelError(entity, field_name, "a fixed joint has no coordinates to start from")
+        raise ModelError(entity, field_name, f"a {kind} joint has no coordinates to start from")
     if n == 1:
         if np.ndim(value) == 1 and np.size(value) == 1:
             value = np.asarray(value).reshape(-1)[0]

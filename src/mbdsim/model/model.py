@@ -12,9 +12,10 @@ from .forces import Force, SpringDamper, Torque
 from .elements import ForceElementsMixin
 from .friction_path import FrictionPathMixin
 from .joints import Joint, Motion, joint_initial
+from .joints_extra import JointsExtraMixin
 
 
-class Model(ForceElementsMixin, FrictionPathMixin):
+class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0)):
@@ -338,10 +339,10 @@ class Model(ForceElementsMixin, FrictionPathMixin):
     @staticmethod
     def _motion_dof(entity, joint, dof):
         allowed = {"revolute": ("rotation",), "translational": ("translation",),
-                   "cylindrical": ("rotation", "translation")}
+                   "cylindrical": ("rotation", "translation"), "screw": ("rotation", "translation")}
         if joint.kind not in allowed:
             raise ModelError(entity, "joint", f"cannot drive a {joint.kind} joint; use revolute, "
-                             "translational or cylindrical")
+                             "translational, cylindrical or screw")
         if dof is None:
             return allowed[joint.kind][0]
         if dof not in allowed[joint.kind]:

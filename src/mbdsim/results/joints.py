@@ -29,7 +29,7 @@ from ..errors import ModelError
 from ..model.joints import Joint
 from ..system import measures as ms
 
-ROTATION_JOINTS = ("spherical", "universal", "fixed")
+ROTATION_JOINTS = ("spherical", "universal", "fixed", "constant_velocity")
 _TWO_PI = 2.0 * np.pi
 
 
@@ -43,6 +43,9 @@ def joint_of(res, joint) -> Joint:
 
 
 def _check_kind(jt, kind):
+    if jt.ncoord == 0 and jt.kind != "fixed":
+        raise ModelError(f"joint '{jt.name}'", "joint", f"a {jt.kind} joint primitive has no joint coordinates; "
+                         "measure its bodies (position, orientation) instead")
     if kind is None:
         return
     if kind != "angles" or jt.kind != "universal":
@@ -90,7 +93,7 @@ def acceleration(res, joint, kind=None):
         ang = np.zeros(len(res.time)) if g.particle_j else _spin_acc(g, fr, axes[2])
         return np.stack([_slide_acc(g, fr, axes[0]), _slide_acc(g, fr, axes[1]), ang], -1)
     ang = sl = None
-    if jt.kind in ("revolute", "cylindrical") and not g.particle_j:
+    if jt.kind in ("revolute", "cylindrical", "screw") and not g.particle_j:
         ang = _spin_acc(g, fr, axes[2])
     if jt.kind in ("translational", "cylindrical"):
         sl = _slide_acc(g, fr, axes[2])

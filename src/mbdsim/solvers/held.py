@@ -19,7 +19,7 @@ import scipy.linalg as sla
 from ..system import measures as ms
 from ..system.frames import body_frames
 
-ROTVEC_JOINTS = ("spherical", "universal")
+ROTVEC_JOINTS = ("spherical", "universal", "constant_velocity")
 
 
 @dataclass

@@ -208,7 +208,7 @@ def _hermite_y(sys, s0, s1, t):
     if h <= 0 or t <= s0.t:
         return np.concatenate([s0.q, s0.v])
     tau = (t - s0.t) / h
-    delta = _log_increment(sys, s0.q, s1.q)
+    delta = _log_increment(sys, s0.q, s1.q, 0.5 * h * (s0.v + s1.v))
     h10, h01, h11 = tau**3 - 2 * tau**2 + tau, -2 * tau**3 + 3 * tau**2, tau**3 - tau**2
     dpos = h10 * h * s0.v + h01 * delta + h11 * h * s1.v
     vel = ((3 * tau**2 - 4 * tau + 1) * h * s0.v + (-6 * tau**2 + 6 * tau) * delta
@@ -221,8 +221,12 @@ def _dense(sys, s0, s1, t, rows, sf):
     return consistent_state(sys, _hermite_y(sys, s0, s1, t), t, rows, sf)
 
 
-def _log_increment(sys, q0, q1):
-    """Increment dx with q0 (+) dx = q1 (translation difference; body-axes rotation vector)."""
+def _log_increment(sys, q0, q1, pred=None):
+    """Increment dx with q0 (+) dx = q1 (translation difference; body-axes rotation vector).
+
+    A rotation vector is defined up to whole turns: with `pred` (nv,), a predicted increment (the
+    trapezoidal one of a step), each body's is the equivalent (|r| + 2 pi k) r / |r| nearest to it, so a
+    step turning a body by more than pi is interpolated the way it turned."""
     from ..math.rotation import quat_mul
     from scipy.spatial.transform import Rotation
     dx = np.zeros(sys.nv)
@@ -233,6 +237,13 @@ def _log_increment(sys, q0, q1):
         conj = p0 * np.array([1, -1, -1, -1])
         rel = quat_mul(conj, p1)
         dx[sys.w_idx] = Rotation.from_quat(np.concatenate([rel[:, 1:], rel[:, :1]], 1)).as_rotvec()
+        if pred is not None:
+            r, p = dx[sys.w_idx], pred[sys.w_idx]
+            n = np.linalg.norm(r, axis=1)
+            u = np.where(n[:, None] > 1e-12, r / np.maximum(n, 1e-300)[:, None], p / np.maximum(
+                np.linalg.norm(p, axis=1), 1e-300)[:, None])
+            k = np.round(((p * u).sum(1) - n) / (2 * np.pi))
+            dx[sys.w_idx] = (n + 2 * np.pi * k)[:, None] * u
     return dx
 
 

@@ -24,6 +24,8 @@ from .constraints.path import path_specs
 from .constraints.registry import JOINT_TYPES
 from .force_elements.friction import lock_specs
 
+KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide")   # row kinds of system.kernels
+
 
 @dataclass
 class Group:
@@ -69,6 +71,9 @@ class System:
     aux_v_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     lock_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     switched: dict = field(default_factory=dict)   # friction name -> StickSlip (mode history)
+    # issue 11: why the compiled core cannot run this system (rows of numpy-only kinds: screw, constant-
+    # velocity, couplers, user constraints; sensors); empty when it can.  compile_system checks it.
+    not_compiled: list = field(default_factory=list)
 
     @property
     def nbody(self) -> int:
@@ -76,6 +81,11 @@ class System:
 
     def __repr__(self) -> str:
         return f"System({self.model.name!r}: nq={self.nq}, nv={self.nv}, nc={self.nc})"
+
+    @property
+    def kernel_rows(self) -> bool:
+        """True when every row is of a kind the compiled constraint kernel evaluates."""
+        return not len(self.aux_q_idx) and all(g.kind in KERNEL_KINDS for g in self.groups)
 
     @property
     def fixed_rows(self) -> np.ndarray:
@@ -113,12 +123,15 @@ def assemble_system(model) -> System:
     locks = lock_specs(model, geoms)
     specs += pspecs + locks
     groups, owners, owner_rows = _groups(specs, fid)
+    not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
+                    for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
     as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
     return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                   as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
                   np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
                   owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
-                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks})
+                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
+                  not_compiled)
 
 
 def joint_geometry(joint, fid) -> JointGeom:
@@ -131,7 +144,7 @@ def joint_geometry(joint, fid) -> JointGeom:
     mi, mj = getattr(joint, "marker_i", None), getattr(joint, "marker_j", None)
     if mi is not None and mj is not None:
         Ri, Rj = mi.R_BM, mj.R_BM
-        extra = Rj[:, 2] if joint.kind == "universal" else None
+        extra = Rj[:, 2] if joint.kind in ("universal", "perpendicular") else getattr(joint, "lead", None)
         return JointGeom(joint.name, fid[bi], fid[bj], bi.is_particle, bj.is_particle, mi.s_B, mj.s_B,
                          Ri[:, 0], Ri[:, 1], Ri[:, 2], Rj[:, 0], Rj[:, 1], Rj[:, 2], extra)
     f, g, h = perpendicular_frame(joint.axis)
@@ -140,17 +153,26 @@ def joint_geometry(joint, fid) -> JointGeom:
     Ai, Aj = bi.orientation, bj.orientation
     loc = lambda A, x: A.T @ x  # noqa: E731
     extra = None if joint.axis_j is None else loc(Aj, joint.axis_j)
+    if joint.kind == "screw":
+        extra = joint.lead
+    fi = fj = (f, g, h)
+    if hasattr(JOINT_TYPES.get(joint.kind), "frames"):   # own axes on each body (constant-velocity joint)
+        fi, fj = JOINT_TYPES[joint.kind].frames(joint)
     return JointGeom(joint.name, fid[bi], fid[bj], bi.is_particle, bj.is_particle,
                      loc(Ai, joint.point - bi.position), loc(Aj, joint.point - bj.position),
-                     loc(Ai, f), loc(Ai, g), loc(Ai, h), loc(Aj, f), loc(Aj, g), loc(Aj, h), extra)
+                     *(loc(Ai, x) for x in fi), *(loc(Aj, x) for x in fj), extra)
 
 
 def _row_specs(model, fid):
     specs, geoms = [], {}
     for jt in model.joints.values():
-        if jt.body_i.is_particle and not jt.body_j.is_particle and jt.kind not in ("spherical",):
+        if jt.body_i.is_particle and not jt.body_j.is_particle and jt.kind not in ("spherical", "atpoint"):
             raise ModelError(f"joint '{jt.name}'", "body_i", "a particle must be body_j of a "
                              f"{jt.kind} joint (it has no orientation to carry the joint axes)")
+        if getattr(JOINT_TYPES[jt.kind], "needs_orientation", False) and (jt.body_i.is_particle or
+                                                                          jt.body_j.is_particle):
+            raise ModelError(f"joint '{jt.name}'", "body_j" if jt.body_j.is_particle else "body_i",
+                             f"a {jt.kind} joint constrains orientations; a particle has none")
         g = joint_geometry(jt, fid)
         geoms[jt.name] = g
         _warn_particle_offset(jt, g)

@@ -10,6 +10,7 @@ import numpy as np
 
 from . import kernels
 from .constraints import primitives as pr
+from .constraints.registry import PAIR_ROW_KINDS
 from .frames import Frames, body_frames
 
 
@@ -32,6 +33,8 @@ def group_rows(sys, fr: Frames, group):
     elif group.kind == "curve":   # point on a curve, with the curve parameter as extra coordinate
         from .constraints.path import curve_rows
         rows = curve_rows(sys, fr, group)
+    elif group.kind in PAIR_ROW_KINDS:   # screw, constant-velocity: numpy only
+        rows = PAIR_ROW_KINDS[group.kind](fr, group)
     elif group.kind in ("angle", "slide"):
         if group.kind == "angle":
             _, rows, _ = pr.angle(fr, group.bi, group.bj, v[0], v[1], v[2])
@@ -68,7 +71,7 @@ def scatter_jacobian(sys, fr: Frames, idx, rows, out):
 
 def constraint_terms(sys, q, v, t, jacobian=True):
     """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False."""
-    if sys.nc and not len(sys.aux_q_idx):   # path constraints (auxiliary coordinates): numpy path
+    if sys.nc and sys.kernel_rows:   # path constraints, numpy-only row kinds: numpy path
         return _terms_compiled(sys, q, v, t, jacobian)
     return constraint_terms_numpy(sys, q, v, t, jacobian)
 
@@ -93,7 +96,7 @@ def jacobians(sys, q) -> np.ndarray:
     """Constraint Jacobians phi_q (N, nc, nv) at position samples q (N, nq), one compiled call (the
     numpy path row by row for models with path constraints)."""
     q = np.atleast_2d(np.asarray(q, dtype=float))
-    if not sys.nc or len(sys.aux_q_idx):
+    if not sys.nc or not sys.kernel_rows:
         return np.array([constraint_terms(sys, x, np.zeros(sys.nv), 0.0)[1] for x in q]).reshape(len(q), sys.nc, sys.nv)
     packed = getattr(sys, "_packed", None)
     if packed is None:
