@@ -12,10 +12,11 @@ from .forces import Force, SpringDamper, Torque
 from .elements import ForceElementsMixin
 from .friction_path import FrictionPathMixin
 from .joints import Joint, Motion, joint_initial
+from .couplers import CouplersMixin
 from .joints_extra import JointsExtraMixin
 
 
-class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin):
+class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0)):

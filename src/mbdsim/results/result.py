@@ -233,6 +233,13 @@ class Result:
         F, T = joint_reaction(self.system, self.q, self.lambda_, jt, body)
         return self._express(F, frame), self._express(T, frame)
 
+    def coupler_load(self, coupler):
+        """Load (N, k) a coupler, gear or user constraint transmits along each joint coordinate it couples
+        (in the order given): torque [N m] about a rotation's axis, force [N] along a translation's,
+        on that joint's body_j.  A gear's tooth force is the torque on a gear over its pitch radius."""
+        from ..system.constraints.coupler import coupler_load
+        return coupler_load(self, getattr(coupler, "name", coupler))
+
     def driver_effort(self, motion):
         """Effort [N m for a rotation, N for a translation] (N,) of a motion driver: the torque about /
         force along the driven joint axis that the driver applies to body_j."""

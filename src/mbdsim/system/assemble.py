@@ -19,6 +19,7 @@ import numpy as np
 from ..errors import ModelError
 from ..math.rotation import cross3, matrix_to_quat, perpendicular_frame
 from .constraints.base import JointGeom, RowSpec
+from .constraints.coupler import coord_specs
 from .constraints.driver import driver_rows
 from .constraints.path import path_specs
 from .constraints.registry import JOINT_TYPES
@@ -120,11 +121,17 @@ def assemble_system(model) -> System:
             M[a + 3:a + 6, a + 3:a + 6] = b.inertia
     specs, geoms = _row_specs(model, fid)
     geoms.update(pgeoms)
+    cspecs, psi0, psid0, caux_q, caux_v = coord_specs(model, fid, geoms, len(q0), len(v0))
+    if len(psi0):   # continuous angles of coupled joints (issue 11), massless like the path parameters
+        q0, v0, nv = q0 + psi0, v0 + psid0, nv + len(psi0)
+        aux_q, aux_v = np.concatenate([aux_q, caux_q]), np.concatenate([aux_v, caux_v])
+        M = np.pad(M, ((0, len(psi0)), (0, len(psi0))))
     locks = lock_specs(model, geoms)
-    specs += pspecs + locks
+    specs += pspecs + cspecs + locks
     groups, owners, owner_rows = _groups(specs, fid)
     not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
                     for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
+    not_compiled += [f"sensor '{n}'" for n in getattr(model, "sensors", {})]
     as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
     return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                   as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),

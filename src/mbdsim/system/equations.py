@@ -117,6 +117,10 @@ def constraint_terms_numpy(sys, q, v, t, jacobian=True):
     gamma = np.zeros(sys.nc)
     J = np.zeros((sys.nc, sys.nv)) if jacobian else None
     for g in sys.groups:
+        if g.kind == "coord":   # couplers, gears, user constraints: rows over several joints
+            from .constraints.coupler import coord_terms
+            coord_terms(sys, g, fr, np.asarray(q), np.asarray(v), t, phi_, J, nu, gamma)
+            continue
         rows, nu_g, extra = group_rows(sys, fr, g)
         idx = _rows_of(g)
         phi_[idx] = rows.phi
