@@ -19,9 +19,16 @@ from .joints_extra import JointsExtraMixin
 class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
-    def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0)):
+    def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0), planar=False):
+        """planar: True (plane normal +z) or a normal vector marks a 2D mechanism built of 3D joints: its
+        out-of-plane equations are dependent by design, dropped without a RedundantConstraintWarning and
+        noted in the AssemblyReport (see mbdsim.solvers.planar)."""
         self.name = str(name)
         self.gravity = vec3(f"model '{name}'", "gravity", gravity)
+        if isinstance(planar, (bool, np.bool_)) or planar is None:
+            self.planar = np.array([0.0, 0.0, 1.0]) if planar else None
+        else:
+            self.planar = vec3(f"model '{name}'", "planar", planar, unit=True)
         self.ground = Body("ground", is_ground=True)
         self.bodies: dict[str, Body] = {"ground": self.ground}
         self.joints: dict[str, Joint] = {}

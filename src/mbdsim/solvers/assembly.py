@@ -110,6 +110,10 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     rows = independent_rows(J, sys=sys)
     _check_overdriven(sys, J, rows, t, q)
     redundant = dependent_owners(sys, J, rows)
+    planar_note = None
+    if redundant and getattr(sys.model, "planar", None) is not None:   # dependent by design (issue 11)
+        from .planar import planar_redundancy
+        redundant, planar_note = planar_redundancy(sys, q, J, rows)
     if redundant:
         warnings.warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
                       f"joints involved: {', '.join(redundant)}. The dynamics use an independent subset; "
@@ -128,6 +132,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
                                                   for e, f, g, u in changed), InitialConditionWarning, stacklevel=3)
     phi = constraint_terms(sys, q, v, t, False)[0][rows_all]
     notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
+    notes += [planar_note] if planar_note else []
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
                           vmoved, float(np.max(np.abs(phi), initial=0.0)), changed, notes)
 
