@@ -14,9 +14,10 @@ from .friction_path import FrictionPathMixin
 from .joints import Joint, Motion, joint_initial
 from .couplers import CouplersMixin
 from .joints_extra import JointsExtraMixin
+from .sensors import SensorsMixin
 
 
-class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin):
+class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0), planar=False):

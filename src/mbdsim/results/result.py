@@ -233,6 +233,16 @@ class Result:
         F, T = joint_reaction(self.system, self.q, self.lambda_, jt, body)
         return self._express(F, frame), self._express(T, frame)
 
+    @property
+    def sensor_events(self):
+        """Sensors met during the run, in time order: [SensorEvent(name, time [s], value, action)], each
+        time located on the dense output to 1e-13 s (empty without sensors)."""
+        return list(self.__dict__.get("_sensor_events", []))
+
+    @sensor_events.setter
+    def sensor_events(self, events):
+        self.__dict__["_sensor_events"] = sorted(events, key=lambda e: e.time)
+
     def coupler_load(self, coupler):
         """Load (N, k) a coupler, gear or user constraint transmits along each joint coordinate it couples
         (in the order given): torque [N m] about a rotation's axis, force [N] along a translation's,

@@ -97,6 +97,9 @@ def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result
     """One named method over the output grid from the assembled state."""
     if method == "hht":
         from .hht import integrate_hht
+        if getattr(sys.model, "sensors", None):
+            raise ModelError(f"sensor '{next(iter(sys.model.sensors))}'", "method", "sensors are located by "
+                             "the index-1 methods (method='auto', 'dop853', 'rk45', 'radau' or 'bdf'), not HHT")
         if _default_method(sys.model) != "hht":
             names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
             raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
@@ -155,8 +158,10 @@ def _positive(field, value, strict=True, finite=True) -> float:
 
 
 def _default_method(model) -> str:
-    """'hht', or 'dop853' when a force element needs event-driven mode switching (joint friction)."""
-    if any(getattr(evaluator(e), "needs_lambda", False) for e in model.forces.values()):
+    """'hht', or 'dop853' when a force element needs event-driven mode switching (joint friction) or the
+    model has sensors (located on DOP853's dense output)."""
+    if any(getattr(evaluator(e), "needs_lambda", False) for e in model.forces.values()) or \
+            getattr(model, "sensors", None):
         return "dop853"
     return "hht"
 
@@ -239,6 +244,12 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
             y = np.concatenate([q, v])
             if hit is not None:
                 events.after(t_new, y)
+                if events.stop:   # a sensor with action "stop" (issue 11): the event is the last sample
+                    if t_new > times[len(out) - 1]:
+                        out.append(consistent_state(sys, y, t_new, rows, sf))
+                        times = np.append(times[:len(out) - 1], t_new)
+                    message = f"stopped by sensor '{events.sensor_events[-1].name}' at t = {t_new:.12g} s"
+                    break
                 if t_new < t_end:
                     solver = solver_cls(rhs, t_new, y, t_end, **opts)
                 continue
@@ -253,6 +264,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
                  status=0 if success else -1, message=message,
                  stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
     res.error = error
+    res.sensor_events = list(events.sensor_events)
     return res
 
 

@@ -31,11 +31,16 @@ class EventTracker:
         self.rows, self.sf = rows, sf
         self.need_lam = any(getattr(ev, "needs_lambda", False) for _, ev in self.items)
         self.positive = np.zeros(0, dtype=bool)
+        from .sensors import sensor_items   # sensors (issue 11): switching functions after the elements'
+        self.sensors = sensor_items(sys)
+        self.sensor_events, self.stop, self.fired, self.nforce = [], False, [], 0
 
     def values(self, t, y):
-        if not self.items:
+        if not self.items and not self.sensors:
             return np.zeros(0)
         q, v = normalize(self.sys, y[:self.sys.nq]), y[self.sys.nq:]
+        if not self.items:
+            return self._with_sensors(np.zeros(0), t, q, v)
         fr = body_frames(self.sys, q, v)
         if self.need_lam:
             fr.q, fr.v = q, v
@@ -43,7 +48,14 @@ class EventTracker:
         gs = [np.atleast_1d(ev.switch(self.sys, fr, e, t)) for e, ev in self.items]
         self.positive = np.concatenate([np.full(len(g), bool(getattr(ev, "restart_positive", False)))
                                         for g, (_, ev) in zip(gs, self.items)])
-        return np.concatenate(gs)
+        return self._with_sensors(np.concatenate(gs), t, q, v)
+
+    def _with_sensors(self, g, t, q, v):
+        self.nforce = len(g)
+        if not self.sensors:
+            return g
+        self.positive = np.concatenate([self.positive[:len(g)], np.zeros(len(self.sensors), dtype=bool)])
+        return np.concatenate([g, [s.value(t, q, v) for s in self.sensors]])
 
     def start(self, t, y):
         q, v = normalize(self.sys, y[:self.sys.nq]), y[self.sys.nq:]
@@ -54,14 +66,14 @@ class EventTracker:
 
     def check(self, t_old, t_new, dense):
         """Earliest event time in (t_old, t_new], or None."""
-        if not self.items:
+        if not self.items and not self.sensors:
             return None
         g1 = self.values(t_new, dense(t_new))
         cross = np.where((np.sign(g1) != np.sign(self.prev)) & (self.prev != 0))[0]
         if len(cross) == 0:
             self.prev = g1
             return None
-        best = t_new
+        best, roots = t_new, {}
         for k in cross:
             f = lambda t: self.values(t, dense(t))[k]  # noqa: E731
             try:
@@ -69,6 +81,8 @@ class EventTracker:
             except ValueError:
                 continue
             best = min(best, tk)
+            roots[k] = tk
+        self.fired = [k for k, tk in roots.items() if tk <= best + 1e-12 * max(1.0, abs(best))]
         return best if best > t_old else None
 
     def after(self, t, y):
@@ -76,6 +90,11 @@ class EventTracker:
         for e, ev in self.items:
             if hasattr(ev, "on_event"):
                 ev.on_event(self.sys, e, t, q, v)
+        for k in self.fired:   # sensors met at this event: record, maybe stop
+            if k >= self.nforce and self.prev is not None and self.prev[k] != 0:
+                item = self.sensors[k - self.nforce]
+                self.stop |= item.fire(t, self.prev[k], -self.prev[k], self.sensor_events)
+        self.fired = []
         g = self.values(t, y)
         # values exactly at the root: take the sign just after the event
         flip = np.where(self.positive, 1.0, -self.prev if self.prev is not None else g)

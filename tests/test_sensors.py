@@ -1,0 +1,100 @@
+"""Sensors (Adams SENSOR, issue 11): stop or record when a signal reaches a value, located on the dense
+output to solver precision.  Closed forms: a body falling from rest through a height h takes
+sqrt(2 h / g); a pendulum released from theta_0 reaches the bottom after K(sin^2(theta_0 / 2)) /
+sqrt(g / l) (a quarter period, complete elliptic integral K); a driven joint passes given angles at
+known times.
+"""
+import numpy as np
+import pytest
+from scipy.special import ellipk
+
+import mbdsim as mb
+from mbdsim.errors import ModelError
+
+G = 9.81
+
+
+def falling(h=2.0):
+    m = mb.Model("drop", gravity=(0, 0, -G))
+    m.add_body("ball", 0.5, inertia=(0.01, 0.01, 0.01), position=(0, 0, h))
+    return m
+
+
+@pytest.mark.parametrize("method", ["auto", "dop853", "rk45"])
+def test_falling_body_stops_at_the_floor(method):
+    m = falling()
+    m.add_sensor("floor", lambda t, s: s.position("ball")[2], value=0.0, direction=-1, action="stop")
+    res = mb.simulate(m, 5.0, 0.01, method=method)
+    t_hit = np.sqrt(2 * 2.0 / G)
+    assert res.success and "stopped by sensor 'floor'" in res.message
+    (ev,) = res.sensor_events
+    assert ev.name == "floor" and ev.action == "stop"
+    assert ev.time == pytest.approx(t_hit, abs=1e-9)
+    assert res.time[-1] == pytest.approx(t_hit, abs=1e-9)        # the last sample is the event
+    assert abs(res.position("ball")[-1, 2]) < 1e-8
+    assert np.all(np.diff(res.time) > 0)
+
+
+def test_record_keeps_running_and_threshold_alias():
+    m = falling(h=10.0)
+    m.add_sensor("half", lambda t, s: s.position("ball")[2], threshold=5.0, action="record")
+    m.add_sensor("late", "t", value=0.75, direction=+1, action="record")
+    res = mb.simulate(m, 1.2, 0.1)
+    assert res.time[-1] == pytest.approx(1.2)
+    names = [e.name for e in res.sensor_events]
+    assert names == ["late", "half"]
+    assert res.sensor_events[1].time == pytest.approx(np.sqrt(2 * 5.0 / G), abs=1e-9)
+    assert res.sensor_events[0].time == pytest.approx(0.75, abs=1e-12)
+
+
+def pendulum(theta0):
+    """A point-like bob (particle, 1 kg) on a massless-rod-free revolute: a rigid body with its mass at
+    distance l from the pin and no moment of inertia about its CM (simple pendulum), released at theta0."""
+    l = 0.8
+    m = mb.Model("pendulum", gravity=(0, -G, 0))
+    m.add_body("bob", 1.0, inertia=(1e-12, 1e-12, 1e-12), position=(l * np.sin(theta0), -l * np.cos(theta0), 0))
+    m.add_revolute("pin", "ground", "bob", (0, 0, 0), (0, 0, 1))
+    return m, l
+
+
+def test_pendulum_passes_the_bottom_at_the_elliptic_quarter_period():
+    theta0 = np.radians(60)
+    m, l = pendulum(theta0)
+    # the joint angle is zero as built (theta0): the bottom is at -theta0
+    m.add_sensor("bottom", "pin", value=-theta0, direction=-1, action="record")
+    m.add_sensor("back", "pin_dot", value=0.0, direction=+1, action="stop")   # far turning point
+    res = mb.simulate(m, 10.0, 0.01, rtol=1e-12)
+    quarter = ellipk(np.sin(theta0 / 2) ** 2) / np.sqrt(G / l)
+    ev = {e.name: e.time for e in res.sensor_events}
+    assert ev["bottom"] == pytest.approx(quarter, rel=1e-9)
+    assert ev["back"] == pytest.approx(2 * quarter, rel=1e-9)
+    assert res.time[-1] == pytest.approx(2 * quarter, rel=1e-9)
+    assert res.joint_coordinate("pin")[-1] == pytest.approx(-2 * theta0, abs=1e-7)   # symmetric swing
+
+
+def test_driven_angle_past_several_turns():
+    """A motion at 3 rad/s: the (continuous) angle reaches 20 rad at 20/3 s, after three turns."""
+    m = mb.Model("spin")
+    m.add_body("disc", 1.0, inertia=(0.1, 0.1, 0.2))
+    m.add_revolute("axle", "ground", "disc", (0, 0, 0), (0, 0, 1))
+    m.add_motion("drive", "axle", velocity=3.0)
+    m.add_sensor("twenty", "axle - 20", action="stop")
+    res = mb.simulate(m, 30.0, 0.05)
+    assert res.time[-1] == pytest.approx(20 / 3, abs=1e-9)
+    assert "not compiled yet: sensor 'twenty'" in res.stats["method"]
+
+
+def test_sensor_errors_name_the_field():
+    m = falling()
+    m.add_revolute("pin", "ground", "ball", (0, 0, 0), (0, 1, 0))
+    for kw, field in [({"signal": "pin + nope"}, "signal"), ({"signal": 3.0}, "signal"),
+                      ({"signal": "pin", "action": "halt"}, "action"),
+                      ({"signal": "pin", "direction": 2}, "direction"),
+                      ({"signal": "pin", "value": "x"}, "value"),
+                      ({"signal": "pin", "value": 1.0, "threshold": 2.0}, "threshold")]:
+        with pytest.raises(ModelError, match=f"sensor 's'.*{field}"):
+            m.add_sensor("s", **kw)
+        assert "s" not in m.__dict__.get("sensors", {})
+    m.add_sensor("s", "pin")
+    with pytest.raises(ModelError, match="sensor 's'.*method"):
+        mb.simulate(m, 1.0, method="hht")
