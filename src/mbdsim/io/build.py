@@ -17,10 +17,15 @@ from .units import UnitError, to_si
 
 JOINT_METHODS = {"revolute": "add_revolute", "translational": "add_translational", "cylindrical": "add_cylindrical",
                  "spherical": "add_spherical", "universal": "add_universal", "planar": "add_planar",
-                 "fixed": "add_fixed"}
+                 "fixed": "add_fixed", "inline": "add_inline", "inplane": "add_inplane", "orientation": "add_orientation",
+                 "parallel_axes": "add_parallel_axes", "perpendicular": "add_perpendicular", "atpoint": "add_atpoint",
+                 "screw": "add_screw", "constant_velocity": "add_constant_velocity"}
 JOINT_FIELDS = {"revolute": ("point", "axis"), "translational": ("point", "axis"), "cylindrical": ("point", "axis"),
                 "spherical": ("point",), "universal": ("point", "axis_i", "axis_j"),
-                "planar": ("point", "normal", "u_axis"), "fixed": ("point",)}
+                "planar": ("point", "normal", "u_axis"), "fixed": ("point",), "inline": ("point", "axis"),
+                "inplane": ("point", "normal"), "orientation": (), "parallel_axes": ("axis",),
+                "perpendicular": ("axis_i", "axis_j"), "atpoint": ("point",), "screw": ("point", "axis", "lead"),
+                "constant_velocity": ("point", "axis_i", "axis_j")}
 PER = {"displacement": "", "velocity": "/s", "acceleration": "/s**2"}
 
 
@@ -86,7 +91,7 @@ class Builder:
     def __init__(self, spec: ModelSpec):
         import mbdsim as mb
         self.spec, self.mb = spec, mb
-        self.model = mb.Model(spec.name, gravity=spec.gravity)
+        self.model = mb.Model(spec.name, gravity=spec.gravity, planar=spec.planar)
         self.path: tuple = ()
 
     # ------------------------------------------------------------------ references
@@ -138,7 +143,9 @@ class Builder:
         s = self.spec
         for section, items, fn in (("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
                                    ("joints", s.joints, self.add_joint), ("motions", s.motions, self.add_motion),
-                                   ("forces", s.forces, self.add_element)):
+                                   ("forces", s.forces, self.add_element),
+                                   ("constraints", s.constraints, self.add_constraint),
+                                   ("sensors", s.sensors, self.add_sensor)):
             for k, item in enumerate(items):
                 self.path = (section, k)
                 try:
@@ -182,6 +189,17 @@ class Builder:
         bi, bj = self.body(entity, "body_i", j.body_i), self.body(entity, "body_j", j.body_j)
         args = [getattr(j, f) for f in JOINT_FIELDS[j.type]]
         getattr(self.model, JOINT_METHODS[j.type])(j.name, bi, bj, *args)
+
+    def add_constraint(self, c):
+        """Coupler, gear or user constraint (issue 11)."""
+        if c.type == "user_constraint":
+            return self.model.add_user_constraint(c.name, c.expression)
+        if c.type == "gear":
+            return self.model.add_gear(c.name, c.joint_1, c.joint_2, c.ratio)
+        return self.model.add_coupler(c.name, c.joint_1, c.joint_2, c.ratio, c.dof_1, c.dof_2)
+
+    def add_sensor(self, s):
+        self.model.add_sensor(s.name, s.signal, s.value, s.direction, s.action)
 
     def add_point_on_curve(self, entity, j):
         mb, c = self.mb, j.curve

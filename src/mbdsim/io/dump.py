@@ -92,8 +92,15 @@ def _body(b) -> dict:
 
 def _joint(j) -> dict:
     d = {"name": j.name, "type": j.kind, "body_i": j.body_i.name, "body_j": j.body_j.name, "point": _vec(j.point)}
-    if j.kind in ("revolute", "translational", "cylindrical"):
+    if j.kind in ("orientation", "parallel_axes", "perpendicular"):   # primitives without a point
+        del d["point"]
+    if j.kind in ("revolute", "translational", "cylindrical", "inline", "parallel_axes", "screw"):
         d["axis"] = _unit(j.axis)
+        _put(d, "lead", j.lead)
+    elif j.kind == "inplane":
+        d["normal"] = _unit(j.axis)
+    elif j.kind in ("perpendicular", "constant_velocity"):
+        d.update(axis_i=_unit(j.axis), axis_j=_unit(j.axis_j))
     elif j.kind == "universal":
         d.update(axis_i=_unit(j.axis), axis_j=_unit(j.axis_j))
     elif j.kind == "planar":
@@ -228,4 +235,27 @@ def model_to_dict(model) -> dict:
          + [_path(p) for p in getattr(model, "path_constraints", {}).values()],
          "motions": [_motion(m) for m in model.motions.values()],
          "forces": [_element(e) for e in model.forces.values()]}
+    d["constraints"] = [_constraint(c) for c in getattr(model, "coord_constraints", {}).values()]
+    d["sensors"] = [_sensor(s) for s in getattr(model, "sensors", {}).values()]
+    if getattr(model, "planar", None) is not None:
+        d["planar"] = True if np.allclose(model.planar, [0, 0, 1]) else _unit(model.planar)
     return {k: v for k, v in d.items() if v != [] or k == "bodies"}
+
+
+def _constraint(c) -> dict:
+    """Coupler, gear or user constraint (issue 11)."""
+    if c.kind == "user":
+        return {"type": "user_constraint", "name": c.name, "expression": c.text}
+    (j1, d1), (j2, d2) = c.terms
+    d = {"type": c.kind, "name": c.name, "joint_1": j1.name, "joint_2": j2.name, "ratio": c.ratio}
+    _put(d, "dof_1", d1 if j1.kind == "cylindrical" else None)
+    return _put(d, "dof_2", d2 if j2.kind == "cylindrical" else None)
+
+
+def _sensor(s) -> dict:
+    if s.text is None:
+        raise ModelError(f"sensor '{s.name}'", "signal", "a Python callable cannot be stored in a model file "
+                         "(give the signal as an expression string)")
+    d = {"name": s.name, "signal": s.text, "value": s.value}
+    _put(d, "direction", s.direction, 0)
+    return _put(d, "action", s.action, "stop")

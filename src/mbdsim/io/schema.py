@@ -142,13 +142,13 @@ class _Pair(Spec):
 
 
 class AxisJointSpec(_Pair):
-    type: Literal["revolute", "translational", "cylindrical"]
+    type: Literal["revolute", "translational", "cylindrical", "inline"]
     point: V("m")
     axis: V("")
 
 
 class SphericalSpec(_Pair):
-    type: Literal["spherical"]
+    type: Literal["spherical", "atpoint"]
     point: V("m")
 
 
@@ -203,8 +203,10 @@ class PointOnCurveSpec(Spec):
     curve: CurveSpec
 
 
-JointSpec = Annotated[Union[AxisJointSpec, SphericalSpec, UniversalSpec, PlanarSpec, FixedSpec, PointOnCurveSpec],
-                      Field(discriminator="type")]
+from .schema_extra import EXTRA_JOINTS, ConstraintSpec, SensorSpec  # noqa: E402  (issue 11 specs)
+
+JointSpec = Annotated[Union[(AxisJointSpec, SphericalSpec, UniversalSpec, PlanarSpec, FixedSpec, PointOnCurveSpec,
+                             *EXTRA_JOINTS)], Field(discriminator="type")]
 
 
 # ----------------------------------------------------------------------------- motions
@@ -346,14 +348,18 @@ class ModelSpec(Spec):
 
     name: str = "model"
     gravity: V("m/s**2") = [0.0, 0.0, 0.0]
+    planar: Union[bool, V("")] = False     # True: a 2D mechanism in the xy plane (or its plane normal)
     bodies: list[BodySpec] = []
     particles: list[ParticleSpec] = []
     joints: list[JointSpec] = []
     motions: list[MotionSpec] = []
     forces: list[ElementSpec] = []
+    constraints: list[ConstraintSpec] = []   # couplers, gears, user constraints
+    sensors: list[SensorSpec] = []
 
 
-SECTIONS = {"bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element"}
+SECTIONS = {"bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
+            "constraints": "constraint", "sensors": "sensor"}
 
 
 def json_schema() -> dict:
