@@ -13,7 +13,7 @@ import numpy as np
 from ..errors import MbdsimError, SolverError
 from ..results.result import Result
 from ..system.compiled import Work, compile_system
-from . import fastdop
+from . import fastdop, fastdyn
 from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
@@ -31,9 +31,9 @@ CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for de
 class CompiledRun:
     """A compiled model and its work arrays for one analysis (immutable model, per-run state)."""
 
-    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False):
+    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False, state=None):
         self.sys, self.rows = sys, rows
-        self.cm = compile_system(sys, rows)
+        self.cm = compile_system(sys, rows, state)
         self.work = Work.for_model(self.cm)
         self.rtol, self.atol = float(rtol), float(atol)
         self.max_step = np.inf if not max_step else float(max_step)
@@ -47,13 +47,14 @@ class CompiledRun:
         every accepted step's start state and (t, h) are kept (self.checkpoints, within
         CHECKPOINT_BUDGET bytes, else None) for dense output on demand."""
         a, w = self.cm.arrays(), self.work.arrays()
-        n, nout = len(y0), len(tout)
-        Y = np.zeros((nout, n))
-        y, f = np.array(y0, dtype=float), np.zeros(n)
+        y, nout = self.state_of(y0), len(tout)
+        n = len(y)
+        Y = np.zeros((nout, len(y0)))
+        f = np.zeros(n)
         status = fastdop.rhs(a, w, t0, y, f)
         iout = 0
         if status == 0 and abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
-            Y[0] = y
+            Y[0] = y0
             iout = 1
         st = np.array([t0, 0.0])
         if status == 0:
@@ -79,7 +80,25 @@ class CompiledRun:
             status = INTERRUPTED
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
+        if self.joint_space:   # the last state as absolute coordinates (failure reports)
+            ymax = np.zeros(len(y0))
+            fastdyn.write_state(a, w, y, ymax, ymax[:0])
+            y = ymax
         return Y, iout, status, st[0], y
+
+    @property
+    def joint_space(self) -> bool:
+        """True when the model is integrated in joint coordinates (a tree of one-DOF joints)."""
+        return int(self.cm.dims[5]) == 1
+
+    def state_of(self, yrow):
+        """The integrator's state of an output row [q, v] (joint coordinates and rates for a tree)."""
+        yrow = np.asarray(yrow, dtype=float)
+        if not self.joint_space:
+            return yrow.copy()
+        y = np.zeros(2 * int(np.count_nonzero(self.cm.tree[7] >= 0)))
+        fastdyn.read_state(self.cm.arrays(), self.work.arrays(), yrow, y)
+        return y
 
     def outputs(self, times, Y):
         """(VD, LAM): accelerations and multipliers of the independent rows at the output states Y;
@@ -115,12 +134,13 @@ class CompiledRun:
         n = Y.shape[1]
         Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), self.sys.nv)), np.zeros((len(ts), self.sys.nc))
         a, w = self.cm.arrays(), self.work.arrays()
-        K, F, sc, f = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n)), np.zeros(n)
+        ns = len(self.state_of(Y[0]))
+        K, F, sc, f = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns)), np.zeros(ns)
         for j, t in enumerate(ts):
             k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
             tout = np.array([t]) if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)) else np.array([times[k], t])
             Yk, VDk, LAMk = np.zeros((len(tout), n)), np.zeros((len(tout), self.sys.nv)), np.zeros((len(tout), self.sys.nc))
-            status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), np.array(Y[k]), f, tout, Yk, VDk, LAMk,
+            status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), self.state_of(Y[k]), f, tout, Yk, VDk, LAMk,
                                      self.rtol, self.atol, self.max_step, self.max_steps, self.stats, K, F, sc)
             if m < len(tout):
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))
@@ -131,11 +151,11 @@ class CompiledRun:
 
     def _from_checkpoints(self, cp, ts, full=True):
         SY, ST = cp
-        n = SY.shape[1]
         sys = self.sys
+        n, ns = sys.nq + sys.nv, SY.shape[1]
         Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), sys.nv)), np.zeros((len(ts), sys.nc))
         a, w = self.cm.arrays(), self.work.arrays()
-        K, F, sc, f = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n)), np.zeros(n)
+        K, F, sc, f = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns)), np.zeros(ns)
         step = np.clip(np.searchsorted(ST[:, 0], ts, side="right") - 1, 0, len(ST) - 1)
         for j in np.unique(step):
             sel = np.flatnonzero(step == j)
@@ -164,7 +184,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     with the compiled DOP853 (raises NotCompiled when the model needs the reference path, and Stiff
     when stiff_check is set and the model is stiff). progress(t) is called with the time reached [s]
     every chunk of outputs; Ctrl-C ends the run with success=False and every output before it."""
-    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check)
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check, state=(rep.q, rep.v))
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress, True)
@@ -194,6 +214,8 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                  stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
                         "njev": 0, "factorizations": int(run.stats[2] + 2 * run.stats[3]),
                         "projections": int(run.stats[3]), "order": 8, "method": "DOP853 (compiled)",
+                        "formulation": "joint coordinates (articulated body)" if run.joint_space else
+                        "absolute coordinates (tree elimination)",
                         "assembly": rep}, accelerations=accelerations)
     res.error = error
     return res

@@ -17,7 +17,8 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from scipy.integrate._ivp import dop853_coefficients as _c
 
-from .fastdyn import MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs
+from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs,
+                      write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 
@@ -236,8 +237,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 if s_ != OK:
                     st[0], st[1] = t, h
                     return s_, iout
-                for i in range(n):
-                    Y[iout, i] = yo[i]
+                write_state(cm, wk, yo, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
                 iout += 1
                 written += 1
         for i in range(n):
@@ -277,8 +277,7 @@ def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps
     if status != OK:
         return status, 0
     if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
-        for i in range(n):
-            Y[0, i] = y[i]
+        write_state(cm, wk, y, Y[0], Y[0, :0])
         iout = 1
     st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
     while status == OK and iout < tout.shape[0]:
@@ -309,8 +308,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
         s_ = project(cm, wk, tq[k], yo[:nq], yo[nq:], 1e-12)
         if s_ != OK:
             return s_
-        for i in range(n):
-            Y[k, i] = yo[i]
-        if accelerations(cm, wk, tq[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], False) != OK:
+        write_state(cm, wk, yo, Y[k], Y[k, :0])
+        if accelerations(cm, wk, tq[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], cm[31][5] == 1) != OK:
             return SINGULAR
     return OK

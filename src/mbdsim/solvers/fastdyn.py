@@ -23,6 +23,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
         return 0.0
 from ..system.kernels import frames_into, quat_step, rows_kernel
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
+from . import fasttree
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
 
@@ -346,13 +347,61 @@ def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
 @njit(cache=True, _nrt=False)
 def rhs(cm, wk, t, y, ydot, refactor=True):
     """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded). refactor=False:
-    as in `accelerations`."""
+    as in `accelerations`. A joint-coordinate tree (dims[5] == 1) has y = [theta, theta_dot] and
+    ydot = [theta_dot, theta_ddot] from the articulated-body algorithm (solvers.fasttree)."""
+    if cm[31][5] == 1:
+        return tree_rhs(cm, wk, t, y, ydot)
     nq = cm[31][0]
     q = y[:nq]
     v = y[nq:]
     st = accelerations(cm, wk, t, q, v, ydot[nq:], wk[26], refactor)
     qdot_into(cm, q, v, ydot[:nq])
     return st
+
+
+@njit(cache=True, _nrt=False)
+def tree_rhs(cm, wk, t, y, ydot):
+    """Joint-coordinate right-hand side: frames by forward kinematics, loads, articulated-body solve."""
+    tw = wk[43]
+    nj = y.shape[0] // 2
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    fasttree.kinematics(cm[42], y, nj, r, A, rd, w, tw[10], tw[11])
+    F = wk[8]
+    loads_into(cm, wk, r, A, rd, w, F)
+    if not fasttree.aba(cm[42], y, nj, r, A, rd, w, tw[10], F, cm[9], cm[10], tw, ydot):
+        return SINGULAR
+    for i in range(ydot.shape[0]):
+        if not np.isfinite(ydot[i]):
+            return NONFINITE
+    return OK
+
+
+@njit(cache=True, _nrt=False)
+def write_state(cm, wk, y, yout, prev):
+    """The output row (absolute coordinates and velocities, system layout) of the integrator's state y:
+    a copy, or for a joint-coordinate tree the forward kinematics (Euler parameters continuous with prev,
+    the previous output row, when it has the same size)."""
+    if cm[31][5] != 1:
+        for i in range(y.shape[0]):
+            yout[i] = y[i]
+        return
+    tw = wk[43]
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    fasttree.kinematics(cm[42], y, y.shape[0] // 2, r, A, rd, w, tw[10], tw[11])
+    fasttree.to_maximal(cm[42], cm[1], cm[0], cm[2], cm[3], cm[4], r, A, rd, w, yout, prev)
+
+
+@njit(cache=True, _nrt=False)
+def read_state(cm, wk, yrow, y):
+    """The integrator's state y of an output row (inverse of `write_state`)."""
+    if cm[31][5] != 1:
+        for i in range(y.shape[0]):
+            y[i] = yrow[i]
+        return
+    nq = cm[31][0]
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    frames_into(yrow[:nq], yrow[nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
+    fasttree.from_maximal(cm[42], y.shape[0] // 2, r, A, rd, w, y)
 
 
 @njit(cache=True, _nrt=False)
@@ -395,7 +444,10 @@ def project(cm, wk, t, q, v, tol, exact_factor=True):
     Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`); with
     exact_factor=False the velocity step reuses the last Newton step's factorisation (positions a
     Newton step apart: the velocity residual is of the order of that step times the correction, far
-    below round-off of the constraints), for outputs, after which the factorisation is not reused."""
+    below round-off of the constraints), for outputs, after which the factorisation is not reused.
+    A joint-coordinate tree satisfies its constraints by construction: nothing to do."""
+    if cm[31][5] == 1:
+        return OK
     factored = False
     active = cm[32]
     x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]

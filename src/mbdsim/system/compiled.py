@@ -14,9 +14,12 @@ import numpy as np
 
 from ..model.element_specs import Bushing
 from ..model.forces import Force, SpringDamper, Torque
-from . import kernels
+from . import jointtree, kernels
 from .measures import locate
 from .topology import Topology, system_topology
+
+
+USE_TREE = True   # trees of revolute/translational/fixed joints in joint coordinates (False: absolute only)
 
 
 class NotCompiled(Exception):
@@ -58,11 +61,13 @@ class CompiledModel:
     sp_s: np.ndarray
     sp_par: np.ndarray
     topo: Topology
-    dims: np.ndarray          # (nq, nv, nc, nf, dense): dense = 1 when a body's mass matrix is singular
+    dims: np.ndarray          # (nq, nv, nc, nf, dense, mode): dense = 1 when a body's mass matrix is
+    #                           singular; mode = 1: joint-coordinate tree (state [theta, theta_dot])
     active: np.ndarray        # independent rows in force
     stack_size: int
     bushings: tuple = ()      # (frames (n, 2), marker points s_B (n, 2, 3), marker axes R_BM (n, 2, 3, 3),
     #                           stiffness, damping, preload (n, 6) each), see model.element_specs.Bushing
+    tree: tuple = ()          # joint-coordinate tree (system.jointtree) when dims[5] == 1, else empty arrays
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -73,7 +78,7 @@ class CompiledModel:
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
                 self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy(),
-                *self.bushings)
+                *self.bushings, self.tree)
 
 
 @dataclass
@@ -84,7 +89,7 @@ class Work:
 
     @classmethod
     def for_model(cls, cm: CompiledModel) -> "Work":
-        nq, nv, nc, nf, dense = (int(x) for x in cm.dims)
+        nq, nv, nc, nf, dense, _mode = (int(x) for x in cm.dims)
         nk = 6 * (nf - 1) + len(cm.active) if dense else 1   # dense augmented matrix (singular masses)
         t = cm.topo
         nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
@@ -94,7 +99,10 @@ class Work:
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
              z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z(nc), z((3, nd)), z(4),
              z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
-             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)))
+             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
+             # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
+             (z((nf, 6, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z(nf), z(nf), z((6, 6)),
+              z(6), z((nf, 3)), z((2, 3, 3))))
         return cls(a)
 
     def arrays(self) -> tuple:
@@ -152,8 +160,10 @@ def _loads(sys):
             arr([p[2] for p in sp], (m, 4)))
 
 
-def compile_system(sys, rows) -> CompiledModel:
-    """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported."""
+def compile_system(sys, rows, state=None) -> CompiledModel:
+    """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported.
+    With the assembled state=(q, v) a tree of one-degree-of-freedom joints gets its joint-coordinate
+    model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm)."""
     if getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows, sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
     if len(sys.aux_q_idx):
@@ -173,11 +183,13 @@ def compile_system(sys, rows) -> CompiledModel:
     bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
     dense = any(np.linalg.eigvalsh(M6[f]).min() <= 1e-12 * max(np.abs(M6[f]).max(), 1e-300) for f in range(1, nf))
+    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
+        jointtree.tree_arrays(sys, rows, *state)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
                          sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
                          sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          np.stack([v1, v2, v3]), drv, code, consts, tables, start, end, *loads,
-                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense)], np.int64),
-                         np.sort(rows), stack, bushings)
+                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
+                         np.sort(rows), stack, bushings, tree)
