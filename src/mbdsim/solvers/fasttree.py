@@ -133,13 +133,15 @@ def aba(tree, y, nj, r, A, rd, w, P, F, mass, inertia, tw, ydot):
         for i in range(6):
             for j in range(6):
                 IA[f, i, j] = 0.0
+        Ia = tw[8]   # scratch: A J, then A J A^T (symmetric)
         for i in range(3):
-            for j in range(3):
-                s = 0.0
-                for k in range(3):
-                    for m in range(3):
-                        s += A[f, i, k] * inertia[f, k, m] * A[f, j, m]
+            for m in range(3):
+                Ia[i, m] = A[f, i, 0] * inertia[f, 0, m] + A[f, i, 1] * inertia[f, 1, m] + A[f, i, 2] * inertia[f, 2, m]
+        for i in range(3):
+            for j in range(i + 1):
+                s = Ia[i, 0] * A[f, j, 0] + Ia[i, 1] * A[f, j, 1] + Ia[i, 2] * A[f, j, 2]
                 IA[f, i, j] = s
+                IA[f, j, i] = s
             IA[f, 3 + i, 3 + i] = mass[f]
         for i in range(3):
             pA[f, i] = -(A[f, i, 0] * F[f, 3] + A[f, i, 1] * F[f, 4] + A[f, i, 2] * F[f, 5])
