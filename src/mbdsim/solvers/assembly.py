@@ -6,6 +6,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._threads import blas_single_thread
 from ..errors import AssemblyError
 from ..system.assemble import System, assemble_system
 from ..system.equations import constraint_terms
@@ -80,6 +81,7 @@ def _fmt(x):
     return f"{x[0]:.9g}" if len(x) == 1 else "(" + ", ".join(f"{a:.9g}" for a in x) + ")"
 
 
+@blas_single_thread
 def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
     """Solve phi(q, t) = 0 and phi_q v = nu from the model's initial values.
 

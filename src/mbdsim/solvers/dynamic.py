@@ -13,6 +13,7 @@ import bisect
 import numpy as np
 from scipy import integrate
 
+from ._threads import blas_single_thread
 from ..errors import MbdsimError, ModelError, SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
@@ -33,6 +34,7 @@ DEFAULT_TOL = {"auto": (1e-8, 1e-10), "dop853": (1e-10, 1e-12), "high-accuracy":
                "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-5, 1e-7)}
 
 
+@blas_single_thread
 def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
              start_time=0.0, progress=None) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).

@@ -9,6 +9,7 @@ import warnings
 
 import numpy as np
 
+from ._threads import blas_single_thread
 from ..errors import AssemblyError, ModelError
 from ..results.result import Result
 from ..system.dynamics import applied_forces
@@ -27,6 +28,7 @@ class SingularConfigurationWarning(UserWarning):
     constraint Jacobian with drivers loses rank; the analysis keeps the branch by continuity."""
 
 
+@blas_single_thread
 def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ._threads import blas_single_thread
 from ..errors import SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
@@ -65,6 +66,7 @@ class StaticSolution:
         return not self.unstable
 
 
+@blas_single_thread
 def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
     """Static equilibrium at time t [s] (motions at their value at t, velocities zero).
 
@@ -82,6 +84,7 @@ def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
     return _result(sys, [sol], None, True, _summary(sol))
 
 
+@blas_single_thread
 def quasi_static(model, end_time, output_step=None, start_time=0.0, tol=1e-10, maxit=100) -> Result:
     """Quasi-static analysis: the static equilibrium at each output time from start_time to end_time [s]
     (every output_step [s]) of a mechanism whose motions move it; each solve starts from the previous one.
