@@ -218,3 +218,42 @@ def test_lost_tasks_are_reported_not_stored(tmp_path):
     assert list(df.status) == ["ok", "ok", "lost"] and "worker died" in df.message[2]
     assert sorted(pd.read_parquet(out).run) == [0, 1]
     assert study.run(workers=0, out=out).attrs["executed"] == 1
+
+
+def test_grid_refinement_matches_result_searches():
+    """studies.refine (a grid of times per dense-output call) against Result.maximum/minimum/crossings and
+    closed forms: slider x = r cos(wt) + sqrt(l^2 - r^2 sin^2(wt)), min l - r at t = pi/w; a smooth peak
+    takes at most 4 dense-output calls; a kink (min |x - 0.5|) is located to round-off."""
+    from scipy.optimize import brentq
+
+    from mbdsim.studies import refine
+    r, l, w = 0.2, 0.5, 7.3
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.simulate(slider_crank(crank=r, rod=l, speed=w), 1.0, 0.01, rtol=1e-6)
+    calls = []
+    at = res.at
+    res.at = lambda ts: calls.append(len(np.atleast_1d(ts))) or at(ts)
+    x = lambda q: q.position("slider")[:, 0]  # noqa: E731
+    signals = {"F": lambda q: np.linalg.norm(q.reaction_force("crank_rod"), axis=1),
+               "tau": lambda q: q.driver_effort("drive"), "x": x}
+    for name, sig in signals.items():
+        for sign in (+1, -1):
+            ref = (res.maximum if sign > 0 else res.minimum)(sig)
+            calls.clear()
+            got = refine.extremum(res, sig, sign)
+            assert got[1] == pytest.approx(ref[1], rel=1e-12, abs=1e-12), (name, sign)
+            assert got[0] == pytest.approx(ref[0], abs=1e-6), (name, sign)
+            assert len(calls) <= 4, (name, sign, calls)
+    t_min, x_min = refine.extremum(res, x, -1)
+    assert x_min == pytest.approx(l - r, abs=1e-12) and t_min == pytest.approx(math.pi / w, abs=1e-7)
+    v = lambda q: q.velocity("slider")[:, 0]  # noqa: E731
+    assert refine.first_crossing(res, v, 0.0, +1) == pytest.approx(math.pi / w, abs=1e-12)
+    assert refine.first_crossing(res, v, 0.0, -1) == pytest.approx(res.crossings(v, 0.0, -1)[0], abs=1e-12)
+    assert refine.first_crossing(res, v, 0.0, -1) == pytest.approx(2 * math.pi / w, abs=1e-11)
+    assert math.isnan(refine.first_crossing(res, x, 5.0))
+    exact = lambda t: r * math.cos(w * t) + math.sqrt(l**2 - (r * math.sin(w * t))**2) - 0.5  # noqa: E731
+    t_half = brentq(exact, 0.0, math.pi / w, xtol=1e-15)
+    t_k, v_k = refine.extremum(res, lambda q: np.abs(x(q) - 0.5), -1)
+    assert v_k < 1e-12 and t_k == pytest.approx(t_half, abs=1e-10)
+    assert refine.first_crossing(res, x, 0.5, -1) == pytest.approx(t_half, abs=1e-12)

@@ -9,9 +9,10 @@ Signals (arrays over the output times; SI units, ground axes unless a frame is g
     driver_effort(m), spring_length(s), spring_velocity(s), spring_force(s), kinetic_energy(),
     potential_energy()      (keywords as in Result: frame=, on=, relative_to=, kind=)
 Element-wise: x(v), y(v), z(v) (components of an (N, 3) signal), norm(v), abs, sqrt, sin, cos, degrees.
-Reductions to a scalar: max, min, peak (max |s|), time_of_max, time_of_min (refined on the dense output
-by Result.maximum/minimum), mean, rms, std, initial, final, integral (trapezoid over time),
-crossing(s, value, direction=0) (time of the first crossing, NaN when none).
+Reductions to a scalar: max, min, peak (max |s|), time_of_max, time_of_min (refined on the dense output,
+mbdsim.studies.refine: the conventions of Result.maximum/minimum, a grid of times per evaluation), mean,
+rms, std, initial, final, integral (trapezoid over time), crossing(s, value, direction=0) (time of the
+first crossing, refined like Result.crossings; NaN when none).
 Example: "max(norm(reaction_force('crank_rod')))", "peak(x(acceleration('slider')))".
 
 A callable output is called with the Result and must return a number.
@@ -29,6 +30,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import ModelError
+from . import refine
 
 __all__ = ["compile_output", "evaluate_outputs", "fill_template", "OutputError"]
 
@@ -158,8 +160,7 @@ class _Interpreter:
         if fn in REFINED and len(args) == 1:
             sign, which = REFINED[fn]
             signal = lambda r: _signal(self.ev(args[0], r), fn)  # noqa: E731
-            found = res.maximum(signal) if sign > 0 else res.minimum(signal)
-            return float(found[which])
+            return float(refine.extremum(res, signal, sign)[which])
         vals = [self.ev(a, res) for a in args]
         if fn in ("max", "min"):
             return (np.maximum if fn == "max" else np.minimum)(*vals)
@@ -178,9 +179,8 @@ class _Interpreter:
     def _crossing(self, args, vals, kw, res):
         if len(vals) != 2:
             raise ValueError("crossing(signal, value, direction=0) takes a signal and a level")
-        ts = res.crossings(lambda r: _signal(self.ev(args[0], r), "crossing"), float(vals[1]),
-                           int(kw.get("direction", 0)))
-        return float(ts[0]) if len(ts) else math.nan
+        return refine.first_crossing(res, lambda r: _signal(self.ev(args[0], r), "crossing"), float(vals[1]),
+                                     int(kw.get("direction", 0)))
 
 
 def compile_output(name: str, spec):
