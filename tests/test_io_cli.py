@@ -116,7 +116,7 @@ def test_help_is_fast_and_has_examples():
     out = subprocess.run([sys.executable, "-m", "mbdsim", "--help"], capture_output=True, text=True, check=True)
     assert time.perf_counter() - t0 < 3.0          # typically ~0.25 s; generous for a loaded 2-core machine
     assert "run" in out.stdout and "schema" in out.stdout
-    for cmd in ("run", "info", "schema"):
+    for cmd in ("run", "info", "schema", "plot", "animate", "validate", "study", "version"):
         assert "Example: mbdsim " + cmd in " ".join(invoke(cmd, "--help").output.split())
 
 
@@ -136,3 +136,26 @@ def test_round_trip_gives_identical_simulation(name, tmp_path):
     body = list(m1.bodies)[1]
     assert np.array_equal(r1.position(body), r2.position(body))
     assert np.array_equal(r1.angular_velocity(body), r2.angular_velocity(body))
+
+
+def test_warnings_are_one_line_each_without_source_paths(tmp_path):
+    """A model whose given velocity the joint cannot hold: the command line says so once, as one line."""
+    p = tmp_path / "ic.yaml"
+    p.write_text("name: ic\ngravity: [0, -9.81, 0]\nbodies:\n"
+                 "  - {name: rod, mass: 1, inertia: [0.01, 0.01, 0.01], position: [0.5, 0, 0], velocity: [1, 0, 0]}\n"
+                 "joints:\n  - {name: pin, type: revolute, body_i: ground, body_j: rod, point: [0, 0, 0], "
+                 "axis: [0, 0, 1]}\n")
+    out = subprocess.run([sys.executable, "-m", "mbdsim", "run", str(p), "--end", "0.1"], capture_output=True,
+                         text=True)
+    assert out.returncode == 0, out.stderr
+    lines = [ln for ln in out.stderr.splitlines() if "InitialConditionWarning" in ln]
+    assert len(lines) == 1 and lines[0].startswith("warning: InitialConditionWarning: ")
+    assert ".py:" not in out.stderr and "Traceback" not in out.stderr
+
+
+def test_example_files_leave_free_velocities_free():
+    """The slider-crank file gives no velocities: nothing to warn about (they are solved at assembly)."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mb.InitialConditionWarning)
+        mb.assemble(mb.load_model(EXAMPLES / "slider_crank.yaml"))

@@ -214,3 +214,31 @@ def test_parametric_curve_from_expressions_round_trips():
     with pytest.raises(mb.ModelFileError, match=r"joint 'ring'.curve: .*not allowed"):
         d["joints"][0]["curve"]["x"] = "__import__('os').getcwd()"
         model_from_dict(d)
+
+
+def test_velocities_left_out_of_a_file_are_free_as_in_the_api():
+    """A body without `velocity` / `angular_velocity` is solved at assembly (not held at zero): a driven
+    crank from a file assembles without an InitialConditionWarning, and w = 2 pi rad/s as driven."""
+    import warnings
+    d = {"name": "crank", "bodies": [{"name": "c", "mass": 1, "inertia": [0.01, 0.01, 0.01], "position": [0.1, 0, 0]},
+                                     {"name": "z", "mass": 1, "inertia": [0.01, 0.01, 0.01], "velocity": [0, 0, 0],
+                                      "position": [0, 1, 0]}],
+         "particles": [{"name": "p", "mass": 1, "position": [0, 2, 0]}],
+         "joints": [{"name": "pin", "type": "revolute", "body_i": "ground", "body_j": "c", "point": [0, 0, 0],
+                     "axis": [0, 0, 1]}],
+         "motions": [{"name": "drive", "joint": "pin", "displacement": "2*pi*t"}]}
+    m = model_from_dict(d)
+    c, z, p = m.bodies["c"], m.bodies["z"], m.bodies["p"]
+    assert not c.velocity_given and not c.angular_velocity_given and not p.velocity_given
+    assert z.velocity_given and not z.angular_velocity_given
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        rep = mb.assemble(m)
+        res = mb.simulate(m, 0.01, 0.01)
+    assert res.angular_velocity(c)[0] == pytest.approx([0, 0, 2 * math.pi], abs=1e-9)
+    assert res.velocity(c)[0] == pytest.approx([0, 0.2 * math.pi, 0], abs=1e-9) and rep.dof == 9
+    again = model_to_dict(model_from_dict(model_to_dict(m)))
+    bodies = {b["name"]: b for b in again["bodies"]}
+    assert "velocity" not in bodies["c"] and bodies["z"]["velocity"] == [0.0, 0.0, 0.0]
+    assert "angular_velocity" not in bodies["z"]
+    assert again == model_to_dict(m)

@@ -58,7 +58,9 @@ def _root(
 
 @app.command("version")
 def version_cmd() -> None:
-    """Print the mbdsim version."""
+    """Print the mbdsim version.
+
+    Example: mbdsim version"""
     typer.echo(f"mbdsim {_version()}")
 
 
@@ -100,7 +102,11 @@ def validate(
     ),
     no_report: bool = typer.Option(False, "--no-report", help="Do not write the report."),
 ) -> None:
-    """Run the validation cases, print the comparison table and write the report."""
+    """Run the validation cases, print the comparison table and write the report.
+
+    Example: mbdsim validate --case 1-5 --out validation-report --json results.json
+
+    Exit status: 0 every quantity passes, 1 a quantity fails or a case raised, 2 bad arguments."""
     from rich.console import Console
     from rich.progress import (BarColumn, MofNCompleteColumn, Progress, SpinnerColumn,
                                TextColumn, TimeElapsedColumn)
@@ -262,8 +268,20 @@ from mbdsim.cli import study_cmds as _study_cmds  # noqa: E402 - study (paramete
 _study_cmds.register(app)
 
 
+def show_warning(message, category, filename, lineno, file=None, line=None, _seen=set()) -> None:  # noqa: B006
+    """Warnings at the command line: one line "warning: <Category>: <message>" on stderr, each text once
+    (no source path or code line; ``--debug`` does not change this)."""
+    text = f"warning: {category.__name__}: {message}"
+    if text in _seen:
+        return
+    _seen.add(text)
+    print(text, file=sys.stderr if file is None else file)
+
+
 def main(argv: Optional[List[str]] = None) -> None:
     """Console-script entry point (``mbdsim = "mbdsim.cli.app:main"``)."""
+    import warnings
+    warnings.showwarning = show_warning
     app(args=argv, prog_name="mbdsim")
 
 

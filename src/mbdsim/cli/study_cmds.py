@@ -71,7 +71,11 @@ def study_cmd(
     plots: Optional[Path] = typer.Option(None, "--plots", help="Directory for main-effect, scatter and surface PNGs."),
     debug: bool = DEBUG_OPT,
 ) -> None:
-    """Run a parameter study: variants of a model file on Dask, one row per run in a Parquet file."""
+    """Run a parameter study: variants of a model file on Dask, one row per run in a Parquet file.
+
+    Example: mbdsim study examples/slider_crank_study.yaml --workers 2 --out s.parquet --plots plots
+
+    Exit status: 0 at least one run succeeded, 1 none did, 2 bad study or model file, 130 interrupted."""
     def go():
         import mbdsim as mb
         if not study_file.is_file():

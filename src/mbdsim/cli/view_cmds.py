@@ -48,7 +48,11 @@ def plot_cmd(
     x: Optional[str] = typer.Option(None, "--x", metavar="SIGNAL", help="Plot against this column instead of time."),
     out: Path = typer.Option(Path("fig.png"), "--out", "-o", metavar="FILE", help="Figure file: .png, .svg or .pdf."),
 ) -> None:
-    """Plot columns of a results file against time (or against --x) into a PNG/SVG/PDF figure."""
+    """Plot columns of a results file against time (or against --x) into a PNG/SVG/PDF figure.
+
+    Example: mbdsim plot r.parquet slider.x --x crank_pin.angle -o x.png
+
+    Exit status: 0 ok, 1 the figure could not be written, 2 bad input (unknown column, unreadable file)."""
     if out.suffix.lower() not in FIGURE_SUFFIXES:
         _fail(f"--out {str(out)!r}: expected a .png, .svg or .pdf file")
     df = read_results(results)
@@ -96,7 +100,11 @@ def animate_cmd(
     signal: Optional[str] = typer.Option(None, "--signal", metavar="SIGNAL",
                                          help="Column shown beside the 3D view (default: first joint coordinate)."),
 ) -> None:
-    """Write a self-contained HTML page (three.js inlined, no network) playing a model's motion."""
+    """Write a self-contained HTML page (three.js inlined, no network) playing a model's motion.
+
+    Example: mbdsim animate examples/slider_crank.yaml --end 2 --signal slider.x -o a.html
+
+    Exit status: 0 ok, 1 the run or the file failed, 2 bad input."""
     if out.suffix.lower() not in (".html", ".htm"):
         _fail(f"--out {str(out)!r}: expected an .html file")
     if not source.is_file():

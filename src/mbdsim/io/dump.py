@@ -11,7 +11,6 @@ import numpy as np
 
 from ..errors import ModelError
 
-ZERO3 = [0.0, 0.0, 0.0]
 
 
 def _vec(v) -> list:
@@ -78,15 +77,20 @@ def _markers(body) -> list:
     return out
 
 
+def _given(b, field):
+    """A body's velocity / angular_velocity when the user gave it (held at assembly), else None (free)."""
+    return _vec(getattr(b, field)) if getattr(b, field + "_given", True) else None
+
+
 def _body(b) -> dict:
     if b.is_particle:
         d = {"name": b.name, "mass": float(b.mass), "position": _vec(b.position)}
-        _put(d, "velocity", _vec(b.velocity), ZERO3)
+        _put(d, "velocity", _given(b, "velocity"))
     else:
         d = {"name": b.name, "mass": float(b.mass), "inertia": _inertia(b.inertia), "position": _vec(b.position)}
         _put(d, "orientation", _matrix(b.orientation))
-        _put(d, "velocity", _vec(b.velocity), ZERO3)
-        _put(d, "angular_velocity", _vec(b.angular_velocity), ZERO3)
+        _put(d, "velocity", _given(b, "velocity"))
+        _put(d, "angular_velocity", _given(b, "angular_velocity"))
     return _put(d, "markers", _markers(b), [])
 
 

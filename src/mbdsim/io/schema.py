@@ -121,8 +121,8 @@ class BodySpec(Spec):
     density: Optional[Q("kg/m**3")] = None
     position: V("m") = [0.0, 0.0, 0.0]
     orientation: Optional[Orientation] = None
-    velocity: V("m/s") = [0.0, 0.0, 0.0]
-    angular_velocity: V("rad/s") = [0.0, 0.0, 0.0]
+    velocity: Optional[V("m/s")] = None            # None: free, solved at assembly (as in the API)
+    angular_velocity: Optional[V("rad/s")] = None
     markers: list[MarkerSpec] = []
 
 
@@ -130,7 +130,7 @@ class ParticleSpec(Spec):
     name: Name
     mass: Mass
     position: V("m") = [0.0, 0.0, 0.0]
-    velocity: V("m/s") = [0.0, 0.0, 0.0]
+    velocity: Optional[V("m/s")] = None
     markers: list[MarkerSpec] = []
 
 
