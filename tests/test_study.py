@@ -257,3 +257,17 @@ def test_grid_refinement_matches_result_searches():
     t_k, v_k = refine.extremum(res, lambda q: np.abs(x(q) - 0.5), -1)
     assert v_k < 1e-12 and t_k == pytest.approx(t_half, abs=1e-10)
     assert refine.first_crossing(res, x, 0.5, -1) == pytest.approx(t_half, abs=1e-12)
+    # peak pin forces over a sample of geometries and speeds: Brent's value, three calls each
+    design = make_design([parse_parameter("crank", {"range": [0.15, 0.25]}), parse_parameter("rod", {"range": [0.4, 0.6]}),
+                          parse_parameter("speed", {"range": [3.0, 9.5]})], "lhs", 8, seed=4)
+    for p in design.to_dict("records"):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            res = mb.simulate(slider_crank(**p), 2.0, 0.01, rtol=1e-6)
+        at = res.at
+        res.at = lambda ts: calls.append(len(np.atleast_1d(ts))) or at(ts)
+        calls.clear()
+        got = refine.extremum(res, signals["F"], +1)
+        n_calls = len(calls)
+        ref = res.maximum(signals["F"])
+        assert got[1] == pytest.approx(ref[1], rel=1e-13) and n_calls <= 3, (p, got, ref, n_calls)

@@ -224,21 +224,27 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
 def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
-    rows, so that the determinate components are exact. All samples in one batched pseudo-inverse."""
+    rows, so that the determinate components are exact. All samples at once, with r x d and d x d solves
+    only (d dependent rows)."""
     if len(rows) == sys.nc or not len(times):
         return LAM
     from ..system.equations import jacobians
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows`
-    load = np.einsum("nri,nr->ni", J, LAM)
-    # J = C J_r (C = J J_r^T G^-1, G = J_r J_r^T): J^T lam = J_r^T lam_r  <=>  C^T lam = lam_r, whose
-    # least-norm solution is lam = C (C^T C)^-1 lam_r (r x r solves only)
     rows = np.asarray(rows)
-    Jr = J[:, rows]
+    dep = np.setdiff1d(np.arange(sys.nc), rows)
+    Jr, lam_r = J[:, rows], LAM[:, rows]
+    load = np.einsum("nri,nr->ni", Jr, lam_r)
     out = np.zeros_like(LAM)
     try:
-        Ct = np.linalg.solve(Jr @ np.transpose(Jr, (0, 2, 1)), Jr @ np.transpose(J, (0, 2, 1)))   # (N, r, nc)
-        w = np.linalg.solve(Ct @ np.transpose(Ct, (0, 2, 1)), LAM[:, rows][..., None])[..., 0]
-        out = np.einsum("nrc,nr->nc", Ct, w)
+        # J_d = C_d J_r (C_d = J_d J_r^T G^-1, G = J_r J_r^T), so J^T lam = J_r^T lam_r <=> lam[rows] + C_d^T lam[dep]
+        # = lam_r, whose least-norm solution is w = (I + C_d^T C_d)^-1 lam_r (Woodbury: a d x d solve),
+        # lam[rows] = w, lam[dep] = C_d w
+        JrT = np.transpose(Jr, (0, 2, 1))
+        Cd = np.transpose(np.linalg.solve(Jr @ JrT, Jr @ np.transpose(J[:, dep], (0, 2, 1))), (0, 2, 1))
+        S = np.eye(len(dep)) + Cd @ np.transpose(Cd, (0, 2, 1))
+        z = np.linalg.solve(S, np.einsum("ndr,nr->nd", Cd, lam_r)[..., None])[..., 0]
+        w = lam_r - np.einsum("ndr,nd->nr", Cd, z)
+        out[:, rows], out[:, dep] = w, np.einsum("ndr,nr->nd", Cd, w)
         bad = ~np.all(np.isfinite(out), axis=1)
     except np.linalg.LinAlgError:
         bad = np.ones(len(times), dtype=bool)

@@ -33,6 +33,7 @@ REFINE_HALF = 1.0 / 8     # half-width of the next window, in grid spacings of t
 MAX_LEVELS = 14
 FIT_RTOL = 1e-6          # a smooth peak: the value at the estimate as predicted, to this fraction of the
 #                          spread of the fitted values
+NOISE = 1e-14            # relative round-off of a signal's values on the dense output
 XTOL = 1e-14              # relative width [s / max(1, |t|)] below which a search stops
 
 
@@ -105,7 +106,8 @@ def extremum(res, signal, sign: int) -> tuple[float, float]:
             val = sign * float(_values(signal, res, np.array([est]))[0])
             if val > best_y:
                 best_t, best_y = est, val
-            if abs(val - found[1]) <= FIT_RTOL * found[2] + 4e-16 * abs(val) and val >= best_y:
+            slack = FIT_RTOL * found[2] + NOISE * abs(val)
+            if abs(val - found[1]) <= slack and val >= best_y - slack:
                 break                  # the polynomial predicted the value: a smooth peak, found
             est = None                 # a kink: the polynomial misleads, narrow around the best point
         if est is None:
