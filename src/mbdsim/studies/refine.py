@@ -6,15 +6,17 @@ thousands of runs, so here each level evaluates GRID times in ONE `res.at(times)
 of a step is redone once for all the times inside it), and a local polynomial through the grid values
 locates the extremum or the root far below the grid spacing:
 
-- extremum: level 1 spans [t_(k-1), t_(k+1)] around the best sample k; the vertex of the quartic through
-  the best grid point and its two neighbours on each side (a parabola at the window's edge) centres the
-  next level, a window of +-REFINE_HALF grid spacings.  Once two successive estimates agree within the
+- extremum: the vertex of the quartic through the best sample k and its two neighbours on each side (a
+  parabola at the ends) centres the first grid, +-REFINE_HALF of a sample step wide (the whole bracket
+  [t_(k-1), t_(k+1)] when that grid's best point is at its edge); then the vertex of the quartic through
+  the best grid point and its neighbours centres the next level, +-REFINE_HALF grid spacings wide.  Once two successive estimates agree within the
   finer spacing and the value there is the one the polynomial predicted (FIT_RTOL) and the best found,
-  the search ends: three calls for a smooth peak (value to round-off).  Otherwise (a kink, a poorly resolved peak) the window keeps narrowing
+  the search ends: two calls for a smooth, resolved peak (value to round-off).  Otherwise (a kink, a poorly resolved peak) the window keeps narrowing
   around the best point, +-1 grid spacing per level, to XTOL or MAX_LEVELS.
-- crossing: a bracket with a sign change is always kept; the cubic through the four grid points around
-  the first sign change estimates the root, the next level's grid is centred on it, and two successive
-  estimates within the finer spacing end the search (two calls when the signal is smooth).
+- crossing: a bracket with a sign change is always kept; the cubic through the four samples around the
+  first sign change estimates the root and centres the first grid (+-REFINE_HALF of the sample step),
+  the cubic through the four grid points around the sign change gives the next estimate, and two
+  successive estimates within the grid spacing end the search (one call when the signal is smooth).
 
 The best value ever evaluated wins, so a refinement is never worse than the samples; the conventions at
 plateaus, ends and exact hits are those of Result.maximum / Result.crossings, and the values agree with
@@ -90,13 +92,22 @@ def extremum(res, signal, sign: int) -> tuple[float, float]:
         return float(t[k]), float(sign * y[k])
     lo, hi = float(t[k - 1]), float(t[k + 1])
     best_t, best_y = float(t[k]), float(y[k])
-    centre, half, previous = best_t, 0.5 * (hi - lo), None
+    # level 0: the polynomial through the samples themselves; the first grid spans +-1/8 sample step
+    # around its vertex, or the whole bracket when the samples give no vertex or it proves wrong
+    found = _peak_estimate(t, y, k)
+    narrow = found is not None
+    centre, half, previous = (found[0], REFINE_HALF * min(best_t - lo, hi - best_t), found[0]) if narrow \
+        else (best_t, 0.5 * (hi - lo), None)
     for _ in range(MAX_LEVELS):
         ts = np.unique(np.clip(np.linspace(centre - half, centre + half, GRID), lo, hi))
         vals = sign * _values(signal, res, ts)
         j = int(np.argmax(vals))
         if vals[j] > best_y:
             best_t, best_y = float(ts[j]), float(vals[j])
+        if narrow and j in (0, len(ts) - 1):     # the samples' estimate was off: search the bracket
+            narrow, centre, half, previous = False, best_t, 0.5 * (hi - lo), None
+            continue
+        narrow = False
         spacing = float(np.min(np.diff(ts))) if len(ts) > 1 else 0.0
         if spacing <= XTOL * max(1.0, abs(best_t)):
             break
@@ -132,7 +143,8 @@ def first_crossing(res, signal, value: float, direction: int = 0) -> float:
         if a * b < 0 and (direction == 0 or np.sign(b - a) == np.sign(direction)):
             if getattr(res, "_evaluate", None) is None:
                 return float(t[k] - a * (t[k + 1] - t[k]) / (b - a))
-            return _bracketed_root(res, signal, value, float(t[k]), float(t[k + 1]), float(a), float(b))
+            return _bracketed_root(res, signal, value, float(t[k]), float(t[k + 1]), float(a), float(b),
+                                   _root_estimate(t, y, k))
     if len(y) > 1 and y[-1] == 0.0 and y[-2] != 0.0 and (direction == 0 or np.sign(-y[-2]) == np.sign(direction)):
         return float(t[-1])
     return math.nan
@@ -166,9 +178,10 @@ def _root_estimate(pts, fv, m):
     return float(x0 + r[0] * dt) if len(r) == 1 else secant
 
 
-def _bracketed_root(res, signal, value, a, b, fa, fb) -> float:
-    """Root of signal - value in [a, b] (fa, fb of opposite signs): grids centred on the estimate."""
-    centre, half, previous = 0.5 * (a + b), 0.5 * (b - a), None
+def _bracketed_root(res, signal, value, a, b, fa, fb, guess) -> float:
+    """Root of signal - value in [a, b] (fa, fb of opposite signs): grids centred on the estimate, the
+    first +-REFINE_HALF of the bracket around `guess` (from the samples)."""
+    centre, half, previous = guess, REFINE_HALF * (b - a), guess
     for _ in range(MAX_LEVELS):
         ts = np.unique(np.clip(np.linspace(centre - half, centre + half, GRID), a, b))
         ts = ts[(ts > a) & (ts < b)]
