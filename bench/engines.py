@@ -52,6 +52,11 @@ def mbdsim_model(p):
         model.add_translational("slide", model.ground, slider, B, (1, 0, 0))
         model.add_motion("drive", o, displacement=p.drive)
         return model, [crank, rod, slider]
+    if p.key == "heavy_top":
+        top = model.add_body("top", p.m, inertia=tuple(p.J_cm), position=p.cm0(), orientation=p.R0,
+                             velocity=np.cross(p.w0(), p.cm0()), angular_velocity=p.w0())
+        model.add_spherical("pivot", model.ground, top, (0, 0, 0))
+        return model, [top]
     bodies, prev = [], model.ground
     for k, r in enumerate(p.rods):
         b = model.add_body(f"b{k}", r.m, inertia=tuple(r.J), position=r.cm, orientation=r.R)

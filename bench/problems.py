@@ -332,5 +332,60 @@ class FreeSliderCrank(Problem):
         return {"t": self.times(), "cm": self.positions(s.y[0])[0]}
 
 
+class HeavyTop(Problem):
+    """Issue 8: heavy symmetric top on a ball joint at the origin (1 kg, CM 0.1 m from the pivot, moments
+    0.002 kg m^2 transverse about the CM and 0.004 axial), tilted 30 deg from the vertical and released
+    spinning at 100 rad/s about its axis with no precession, so it nutates; 2 s (gravity -y here: the
+    vertical is +y). Reference: Euler's equations about the pivot in body axes with the quaternion
+    kinematics (an independent formulation), scipy DOP853 at rtol 1e-13."""
+
+    key = "heavy_top"
+    title = "heavy top: 30 deg tilt, 100 rad/s spin, released without precession, 2 s"
+    t_end, out_dt = 2.0, 0.01
+    m, arm, Jt, J3, tilt, spin = 1.0, 0.1, 0.002, 0.004, np.radians(30.0), 100.0
+
+    def __init__(self):
+        self.scale = self.arm
+        # body axes: x, z transverse, y the symmetry axis; R0 tilts body y by 30 deg about ground z
+        c, s_ = np.cos(self.tilt), np.sin(self.tilt)
+        self.R0 = np.array([[c, -s_, 0.0], [s_, c, 0.0], [0.0, 0.0, 1.0]])
+        self.J_cm = np.array([self.Jt, self.J3, self.Jt])
+
+    def cm0(self):
+        return self.R0 @ np.array([0.0, self.arm, 0.0])
+
+    def w0(self):
+        return self.R0 @ np.array([0.0, self.spin, 0.0])
+
+    def reference(self):
+        Jp = self.J_cm + self.m * self.arm ** 2 * np.array([1.0, 0.0, 1.0])   # about the pivot
+        rc = np.array([0.0, self.arm, 0.0])
+        g = np.array([0.0, -G, 0.0])
+
+        def R_of(qv):
+            w, x, y, z = qv / np.linalg.norm(qv)
+            return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+                             [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+                             [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
+
+        def rhs(t, y):
+            qv, wb = y[:4], y[4:]
+            R = R_of(qv)
+            tau = np.cross(rc, R.T @ (self.m * g))
+            wd = (tau - np.cross(wb, Jp * wb)) / Jp
+            w, x, yy, z = qv
+            p, q_, r = wb
+            qd = 0.5 * np.array([-x * p - yy * q_ - z * r, w * p + yy * r - z * q_, w * q_ + z * p - x * r,
+                                 w * r + x * q_ - yy * p])
+            return np.concatenate([qd, wd])
+
+        a = self.tilt / 2
+        y0 = np.concatenate([[np.cos(a), 0.0, 0.0, np.sin(a)], [0.0, self.spin, 0.0]])
+        s = solve_ivp(rhs, (0, self.t_end), y0, method="DOP853", rtol=1e-13, atol=1e-15, t_eval=self.times())
+        cm = np.array([R_of(s.y[:4, i]) @ rc for i in range(s.y.shape[1])])[:, None, :]
+        return {"t": self.times(), "cm": cm}
+
+
 ISSUE7 = (PointPendulum(), FreeSliderCrank(), *(PlanarChain(n) for n in (2, 8, 32, 128)))
-PROBLEMS = {p.key: p for p in (RodPendulum(), DoublePendulum(), SliderCrank(), SphericalChain(), *ISSUE7)}
+PROBLEMS = {p.key: p for p in (RodPendulum(), DoublePendulum(), SliderCrank(), SphericalChain(), *ISSUE7,
+                                HeavyTop())}

@@ -34,6 +34,8 @@ from problems import PROBLEMS  # noqa: E402
 
 TARGETS = (1e-4, 1e-6, 1e-8)
 MBDSIM_DEFAULT = {"hht": 1e-5, "dop853": 1e-10, "auto": 1e-8}      # mbdsim's default rtol per method
+SCIPY_METHODS = ("rk45", "radau", "bdf")   # mbdsim's scipy-driven methods (issue 8's work-precision plots)
+ISSUE8_KEYS = ("pendulum_point", "slider_crank_free", "chain2d_8", "heavy_top")
 ISSUE7_KEYS = ("pendulum_point", "slider_crank_free", "chain2d_2", "chain2d_8", "chain2d_32", "chain2d_128",
                "chain")
 
@@ -47,16 +49,22 @@ def sweeps(key, quick):
         return {"mbdsim-kinematics": [None], "mbdsim-hht": [1e-3, 1e-5], "mbdsim-dop853": [1e-6, 1e-10]}
     if key in ISSUE7_KEYS and key != "chain":
         big = key in ("chain2d_32", "chain2d_128")
-        auto = [1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
+        auto = [1e-3, 1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-2, 3e-3, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11]
         mj = ([2, 5, 10, 20, 50] if big else [1, 2, 5, 10, 20, 50, 100]) if quick else \
             ([1, 2, 5, 10, 20, 50, 100] if big else [1, 2, 5, 10, 20, 50, 100, 200, 500])
         ex = [] if key in ("slider_crank_free", "chain2d_128") else ([1, 2, 5, 10] if quick else [1, 2, 5, 10, 20, 50])
         return {"mbdsim-auto": auto, "mbdsim-dop853": auto,
                 "mbdsim-hht": [] if big or quick else [1e-4, 1e-5, 1e-6],
+                **({f"mbdsim-{m}": [1e-4, 1e-6, 1e-8] for m in SCIPY_METHODS}
+                   if key in ISSUE8_KEYS and not quick else {}),
                 "mujoco-rk4": [p.out_dt / k for k in mj] if E.mujoco else [],
                 "exudyn-genalpha": [n_out * k for k in ex] if E.exu else []}
+    if key == "heavy_top":        # issue 8 only: mbdsim's methods against each other (no peer model)
+        auto = [1e-3, 1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10]
+        return {"mbdsim-auto": auto, "mbdsim-dop853": auto, "mbdsim-hht": [1e-3],
+                **{f"mbdsim-{m}": [1e-4, 1e-6] for m in SCIPY_METHODS}}
     hht = [1e-3, 1e-4, 1e-5, 1e-6] if quick else [1e-3, 3e-4, 1e-4, 3e-5, 1e-5, 3e-6, 1e-6, 3e-7]
-    dop = [1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
+    dop = [1e-3, 1e-4, 1e-6, 1e-8, 1e-10] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10, 1e-11, 1e-12]
     sub = [1, 2, 5, 10, 20, 50, 100] if quick else [1, 2, 5, 10, 20, 50, 100, 200, 500, 1000]
     if key == "chain":            # out_dt = 0.02 s: keep MuJoCo's dt <= 1e-2 s; bound Exudyn's cost
         mj = [2, 5, 10, 20, 50, 100, 200] if quick else [2, 5, 10, 20, 50, 100, 200, 500, 1000]
@@ -164,6 +172,8 @@ def prepare_references(quick, log, keys=None):
             out[key] = {"reference": "Pinocchio ABA (joint coordinates) + scipy DOP853 rtol 1e-12"}
         elif key == "pendulum_point":
             out[key] = {"reference": "scipy DOP853 rtol 1e-13 of theta'' = -m g a cos(theta) / (m a^2 + I)"}
+        elif key == "heavy_top":
+            out[key] = {"reference": "Euler's equations about the pivot + quaternion, scipy DOP853 rtol 1e-13"}
         elif key == "slider_crank_free":
             out[key] = {"reference": "one-DOF Lagrange equation (complex-step J', V') + scipy DOP853 rtol 1e-12"}
         else:
@@ -190,9 +200,9 @@ def warm_up():
             if key != "slider_crank":
                 E.run_mbdsim(p, "auto", 1e-6)
                 E.run_mbdsim(p, "dop853", 1e-6)
-                if E.mujoco:
+                if E.mujoco and key != "heavy_top":
                     E.run_mujoco(p, p.out_dt / 2)
-                if E.exu and key != "slider_crank_free":
+                if E.exu and key not in ("slider_crank_free", "heavy_top"):
                     E.run_exudyn(p, 4)
         finally:
             p.t_end = te
