@@ -41,6 +41,11 @@ def test_error_control_meets_tolerance_on_period():
     t_min, th_min = res.minimum(lambda r: r.joint_coordinate(pin))
     assert abs(t_min - half_period) < 1e-4
     assert abs(th_min + np.pi) < 1e-5
+    # modified Newton: the tangent (FD Jacobian) is reused across steps, one factorisation per step try
+    st = res.stats
+    assert st["order"] == 2 and 1 <= st["njev"] < st["steps"] / 5
+    assert st["steps"] <= st["factorizations"] <= st["steps"] + st["rejected"] + st["njev"]
+    assert st["nfev"] >= st["steps"]
     # positions stay on the constraint manifold (index-3 formulation)
     p = res.position(rod)
     assert np.max(np.abs(np.linalg.norm(p, axis=1) - 0.5)) < 1e-9

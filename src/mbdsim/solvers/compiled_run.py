@@ -212,8 +212,10 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                  evaluate=lambda ts: run.states_at(t_out, Y, ts), success=success,
                  status=0 if success else -1, message=message,
                  stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
-                        "njev": 0, "factorizations": int(run.stats[2] + 2 * run.stats[3]),
-                        "projections": int(run.stats[3]), "order": 8, "method": "DOP853 (compiled)",
+                        "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
+                        "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
+                        "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
+                        "method": "DOP853 (compiled)",
                         "formulation": "joint coordinates (articulated body)" if run.joint_space else
                         "absolute coordinates (tree elimination)",
                         "assembly": rep}, accelerations=accelerations)

@@ -103,7 +103,8 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
 
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)], evaluate=evaluate,
                  success=success, status=0 if success else -1, message=message,
-                 stats={"steps": len(steps) - 1, "rejected": nrej, "method": "HHT", "alpha": alpha,
+                 stats={"steps": len(steps) - 1, "rejected": nrej, "nfev": tan.nfev, "njev": tan.njev,
+                        "factorizations": tan.nlu, "order": 2, "method": "HHT", "alpha": alpha,
                         "assembly": rep})
     res.error = error
     return res
@@ -129,6 +130,7 @@ class _Tangent:
     def __init__(self):
         self.K = self.C = None
         self.fresh = False
+        self.njev = self.nlu = self.nfev = 0   # tangent evaluations, factorisations, force evaluations
 
 
 def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
@@ -143,6 +145,7 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
         q1 = increment(sys, cur.q, base_dq + h * h * beta * a)
         v1 = base_v + h * gamma * a
         Q = applied_forces(sys, body_frames(sys, q1, v1), t1, sf(t1, q1, v1) if sf else None)
+        tan.nfev += 1
         phi, J, _, _ = constraint_terms(sys, q1, v1, t1)
         J, phi = J[rows], phi[rows]
         r1 = sys.M @ a + (1 + alpha) * (J.T @ lam - Q) - alpha * cur.f
@@ -150,8 +153,11 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
         if tan.K is None:
             tan.K, tan.C = _tangent(sys, q1, v1, t1, lam, rows, sf)
             tan.fresh = True
+            tan.njev += 1
+            tan.nfev += 2 * nv + 1
         if lu is None:
             lu = _iteration_matrix(sys, tan, J, h, alpha, beta, gamma)
+            tan.nlu += 1
         try:
             d = sla.lu_solve(lu, -np.concatenate([r1, r2]))
         except (ValueError, sla.LinAlgError):
