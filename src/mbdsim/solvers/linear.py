@@ -308,13 +308,13 @@ def _kkt(sys, q, v, t, rows, sf, Qx, dgamma, multipliers=True):
 def _solve_eom(sys, J, Q, gamma):
     """vd of M vd + J^T lambda = Q, J vd = gamma: Schur complement (J M^-1 J^T) lambda = J M^-1 Q - gamma
     with M^-1 cached on the System (block diagonal), the full augmented solve when M is singular."""
-    Minv = sys.__dict__.get("_linear_Minv")
+    Minv = sys.derived.get("linear_Minv")
     if Minv is None:
         try:
             Minv = np.linalg.inv(sys.M) if np.linalg.cond(sys.M) < 1e12 else False
         except np.linalg.LinAlgError:
             Minv = False
-        sys.__dict__["_linear_Minv"] = Minv
+        sys.derived["linear_Minv"] = Minv
     if Minv is False or J.shape[0] == 0:
         return solve_kkt(sys.M, J, Q, gamma)[0] if Minv is False else Minv @ Q
     W = J @ Minv

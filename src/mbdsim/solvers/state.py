@@ -43,7 +43,7 @@ def _continued(sys, name, t, raw):
     """Angle [rad] closest to the reference in force at time t (the last anchor at or before t, 0 before
     any); an anchor (t, angle) is recorded on the System whenever the angle moves pi/4 from it, so the
     angle of a joint read by a load callable is continuous over the analysis (the System is per analysis)."""
-    hist = sys.__dict__.setdefault("_state_angles", {}).setdefault(name, [])
+    hist = sys.run_state.setdefault("angles", {}).setdefault(name, [])
     k = bisect.bisect_right(hist, (t, np.inf)) - 1
     ref = hist[k][1] if k >= 0 else 0.0
     x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi

@@ -76,10 +76,16 @@ def constraint_terms(sys, q, v, t, jacobian=True):
     return constraint_terms_numpy(sys, q, v, t, jacobian)
 
 
-def _terms_compiled(sys, q, v, t, jacobian):
-    packed = getattr(sys, "_packed", None)
+def _packed(sys):
+    """The System's constraint rows packed for the kernels (cached in sys.derived)."""
+    packed = sys.derived.get("packed")
     if packed is None:
-        packed = sys._packed = kernels.pack_rows(sys)
+        packed = sys.derived["packed"] = kernels.pack_rows(sys)
+    return packed
+
+
+def _terms_compiled(sys, q, v, t, jacobian):
+    packed = _packed(sys)
     kind, bi, bj, v1, v2, v3, drv, fns = packed
     fr = body_frames(sys, q, v)
     f = np.array([fn.value(t) for fn in fns], dtype=float)
@@ -98,9 +104,7 @@ def jacobians(sys, q) -> np.ndarray:
     q = np.atleast_2d(np.asarray(q, dtype=float))
     if not sys.nc or not sys.kernel_rows:
         return np.array([constraint_terms(sys, x, np.zeros(sys.nv), 0.0)[1] for x in q]).reshape(len(q), sys.nc, sys.nv)
-    packed = getattr(sys, "_packed", None)
-    if packed is None:
-        packed = sys._packed = kernels.pack_rows(sys)
+    packed = _packed(sys)
     kind, bi, bj, v1, v2, v3, drv, fns = packed
     return kernels.jacobian_batch(q, sys.r_idx, sys.p_idx, sys.rd_idx, sys.w_idx, sys.rigid_fid, sys.nbody + 1,
                                   kind, bi, bj, v1, v2, v3, drv, len(fns), sys.frame_v_adr, sys.frame_rigid,

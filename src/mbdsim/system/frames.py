@@ -24,6 +24,13 @@ class Frames:
     w: np.ndarray
     rdd: np.ndarray | None = None
     alpha: np.ndarray | None = None
+    # context some evaluators need, set by the caller when known: time(s) [s], the state the frames
+    # come from, and the auxiliary (path-parameter) coordinates and rates
+    t: np.ndarray | float | None = None
+    q: np.ndarray | None = None
+    v: np.ndarray | None = None
+    aux_q: np.ndarray | None = None
+    aux_v: np.ndarray | None = None
 
 
 def body_frames(sys, q, v=None, vd=None) -> Frames:

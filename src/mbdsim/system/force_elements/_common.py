@@ -36,7 +36,7 @@ def times_of(fr: Frames, t=None, n=1) -> np.ndarray:
 
 def element_state(sys, name) -> dict:
     """Per-simulation mutable state of a force element (kept on the System, so every analysis starts fresh)."""
-    store = sys.__dict__.setdefault("_element_state", {})
+    store = sys.run_state.setdefault("elements", {})
     return store.setdefault(name, {})
 
 

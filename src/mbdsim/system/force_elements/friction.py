@@ -157,12 +157,12 @@ def _multipliers(sys, fr, elem, t):
 
 def _base_rows(sys, q, v, t):
     """Independent rows among the always-active ones (as assembly picks them), cached on the System."""
-    rows = sys.__dict__.get("_friction_base_rows")
+    rows = sys.derived.get("friction_base_rows")
     if rows is None:
         from ...solvers.common import independent_rows
         from ..equations import constraint_terms
         J = constraint_terms(sys, q, v, t)[1]
-        rows = sys._friction_base_rows = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]
+        rows = sys.derived["friction_base_rows"] = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]
     return rows
 
 
