@@ -3,6 +3,9 @@
 Commands::
 
     mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--debug]
+
+``--out`` is written while the run goes (every few seconds, atomically; see mbdsim.results.stream), so
+an interrupted or killed run leaves a readable file with what it computed.
     mbdsim info MODEL [--debug]
     mbdsim schema [--out schema.json]
 
@@ -88,7 +91,8 @@ def run_cmd(
                                          help="auto (default), dop853, hht, rk45, radau or bdf."),
     rtol: Optional[float] = typer.Option(None, "--rtol", metavar="R", help="Relative tolerance (default 1e-8)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
-                                       help="Write the results table (res.to_dataframe()) to .parquet or .csv."),
+                                       help="Write the results table (res.to_dataframe()) to .parquet or .csv "
+                                       "as the run goes."),
     debug: bool = DEBUG_OPT,
 ) -> None:
     """Simulate a model file and print a summary; optionally write the results table.
@@ -117,7 +121,7 @@ def _run(path, end, step, method, rtol, out):
                   TimeElapsedColumn(), console=console, transient=True) as bar:
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)   # reported in the summary
         task = bar.add_task("run", total=end)
-        res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol,
+        res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol, out=_writable(out),
                           progress=lambda t: bar.update(task, completed=min(float(t), end)))
         bar.update(task, completed=float(res.time[-1]))
     wall = time.perf_counter() - t0
@@ -130,19 +134,25 @@ def _run(path, end, step, method, rtol, out):
             ("wall time", f"{wall:.3f} s"), ("success", f"{res.success} ({res.message})")]
     _print_table(f"mbdsim run: {m.name}", rows)
     if out is not None:
-        _write(res, out)
+        _console().print(f"results: {out} ({len(res.time)} rows; written as the run went)")
     if not res.success:
-        raise typer.Exit(EXIT_FAILED)
+        interrupted = "KeyboardInterrupt" in str(getattr(res, "error", ""))
+        raise typer.Exit(EXIT_INTERRUPTED if interrupted else EXIT_FAILED)
 
 
-def _write(res, out: Path) -> None:
-    df = res.to_dataframe()
+def _writable(out: Optional[Path]) -> Optional[Path]:
+    """`out` after checking that it can be written (exit 1 otherwise); the run writes it as it goes
+    (mbdsim.results.stream): an interrupted run leaves every output computed before the last write."""
+    if out is None:
+        return None
     try:
         out.parent.mkdir(parents=True, exist_ok=True)
-        df.to_parquet(out) if out.suffix.lower() == ".parquet" else df.to_csv(out, index=False)
+        probe = out.with_name(f".{out.name}.probe")
+        probe.write_bytes(b"")
+        probe.unlink()
     except OSError as exc:
         _fail(f"cannot write {str(out)!r}: {exc}", EXIT_FAILED)
-    _console().print(f"results: {out} ({len(df)} rows, {len(df.columns)} columns)")
+    return out
 
 
 def _print_table(title, rows, headers=("", "")):

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..errors import MbdsimError, SolverError
 from ..results.result import Result
+from ..results.stream import notify
 from ..system.compiled import Work, compile_system
 from . import fastdop, fastdyn
 from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
@@ -41,11 +42,12 @@ class CompiledRun:
         self.stats = np.zeros(6, dtype=np.int64)
         self.stiff_check = bool(stiff_check)
 
-    def integrate(self, t0, y0, tout, progress=None, checkpoints=False):
+    def integrate(self, t0, y0, tout, progress=None, checkpoints=False, partial=None):
         """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
         tout; accelerations and multipliers at them come from `outputs` (on demand). With `checkpoints`,
         every accepted step's start state and (t, h) are kept (self.checkpoints, within
-        CHECKPOINT_BUDGET bytes, else None) for dense output on demand."""
+        CHECKPOINT_BUDGET bytes, else None) for dense output on demand. After each chunk of outputs,
+        `notify(progress, t, build)` with build() = partial(Y, n_written) when `partial` is given."""
         a, w = self.cm.arrays(), self.work.arrays()
         y, nout = self.state_of(y0), len(tout)
         n = len(y)
@@ -74,8 +76,7 @@ class CompiledRun:
                 status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
                                            self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
                                            1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns)
-                if progress is not None:
-                    progress(float(st[0]))
+                notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
         if checkpoints:
@@ -187,7 +188,9 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check, state=(rep.q, rep.v))
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
-    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, np.asarray(times, float), progress, True)
+    times = np.asarray(times, float)
+    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
+    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial)
     if status == STIFF:
         raise Stiff(float(t_fail))
     if status != 0:
@@ -201,26 +204,30 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                             state=y_fail[:sys.nq])
         last = f"{times[n - 1]:.9g}" if n else "none"
         success, message = False, f"{error}; last good output at t = {last} s"
-    nq = sys.nq
-    t_out, Y = times[:n], Y[:n]
+    stats = {"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
+             "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
+             "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
+             "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
+             "method": "DOP853 (compiled)",
+             "formulation": "joint coordinates (articulated body)" if run.joint_space else
+             "absolute coordinates (tree elimination)", "assembly": rep}
+    res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
+    res.error = error
+    return res
 
-    def accelerations():   # on first use of vd / lambda_ (most runs are read for positions only)
+
+def _result(sys, rep, run, t_out, Y, success=True, message="ok", stats=None) -> Result:
+    """The Result of output states Y (positions and velocities) at t_out; accelerations and multipliers
+    computed on first use (most runs are read for positions only), dense output from the run."""
+    nq = sys.nq
+
+    def accelerations():
         VD, LAM = run.outputs(t_out, Y)
         return VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)
 
-    res = Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None,
-                 evaluate=lambda ts: run.states_at(t_out, Y, ts), success=success,
-                 status=0 if success else -1, message=message,
-                 stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
-                        "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
-                        "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
-                        "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
-                        "method": "DOP853 (compiled)",
-                        "formulation": "joint coordinates (articulated body)" if run.joint_space else
-                        "absolute coordinates (tree elimination)",
-                        "assembly": rep}, accelerations=accelerations)
-    res.error = error
-    return res
+    return Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None, evaluate=lambda ts: run.states_at(t_out, Y, ts),
+                  success=success, status=0 if success else -1, message=message, stats=stats,
+                  accelerations=accelerations)
 
 
 def _full_multipliers(sys, rows, times, Y, VD, LAM):

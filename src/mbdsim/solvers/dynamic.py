@@ -16,6 +16,7 @@ from scipy import integrate
 from ._threads import blas_single_thread
 from ..errors import MbdsimError, ModelError, SolverError
 from ..results.result import Result
+from ..results.stream import notify
 from ..system.assemble import assemble_system
 from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
@@ -38,7 +39,7 @@ TIGHT = 1e-6        # "auto" on a model the compiled core does not carry: below 
 
 @blas_single_thread
 def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
-             start_time=0.0, progress=None) -> Result:
+             start_time=0.0, progress=None, out=None) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
@@ -50,8 +51,17 @@ def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=Non
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations.
-    progress: optional callable progress(t) receiving the simulated time reached [s] now and then
-    (compiled runs; Ctrl-C there returns the partial Result with success=False)."""
+    progress: optional callable progress(t) receiving the simulated time reached [s] now and then;
+    Ctrl-C returns the partial Result with success=False (every output before it).
+    out: optional path of a .parquet or .csv file: `res.to_dataframe()` of the outputs so far is written
+    there while the run goes (every few seconds, atomically) and completely at the end, so an interrupted
+    run leaves what it computed (see mbdsim.results.stream)."""
+    from ..results.stream import run_writing
+    return run_writing(lambda p: _simulate(model, end_time, output_step, method, rtol, atol, max_step,
+                                           start_time, p), progress, out, "simulate")
+
+
+def _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress) -> Result:
     check_model(model)
     method = "auto" if method is None else method
     if not isinstance(method, str):
@@ -115,7 +125,7 @@ def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result
             raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
                              "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
                              "'bdf'); the HHT method cannot include it")
-        res = integrate_hht(sys, rep, times, rtol, atol, max_step)
+        res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res
     if method in COMPILED_METHODS and USE_COMPILED:
@@ -123,7 +133,7 @@ def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result
             return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
-    return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step)
+    return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step, progress)
 
 
 RTOL_FLOOR = 1e-14          # relative tolerances below this cannot be met in double precision
@@ -206,7 +216,7 @@ def consistent_state(sys, y, t, rows, sf):
     return q, v, vd, lam
 
 
-def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
+def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progress=None):
     rows, sf = rep.rows, state_factory(sys)
     nq = sys.nq
 
@@ -248,6 +258,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
             while nxt < len(times) and times[nxt] <= t_new + 1e-14 * max(1.0, abs(t_new)):
                 out.append(traj.state(min(times[nxt], t_new)))
                 nxt += 1
+            notify(progress, t_new, lambda n=len(out): _partial(sys, times, out[:n], rep))
             q, v = y_new[:nq], y_new[nq:]
             q, _, _ = project_positions(sys, normalize(sys, q), t_new, rows)
             v = project_velocities(sys, q, v, t_new, rows)
@@ -268,6 +279,9 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
                 solver.f = rhs(solver.t, y)
     except MbdsimError as exc:
         success, message, error = False, f"{exc}; last good output at t = {times[len(out) - 1]:.9g} s", exc
+    except KeyboardInterrupt:   # as in the compiled runs: every output before it is kept
+        success, message = False, f"interrupted (KeyboardInterrupt); last good output at t = {times[len(out) - 1]:.9g} s"
+        error = SolverError("interrupted (KeyboardInterrupt)", time=float(times[len(out) - 1]))
     n = len(out)
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
                  evaluate=traj.evaluate if traj.dense else None, success=success,
@@ -276,6 +290,12 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step):
     res.error = error
     res.sensor_events = list(events.sensor_events)
     return res
+
+
+def _partial(sys, times, out, rep) -> Result:
+    """The Result of the output states `out` so far (written to disk during a run)."""
+    return Result(sys, times[:len(out)], *[np.array([s[i] for s in out]) for i in range(4)],
+                  stats={"assembly": rep}, message="partial (run in progress)")
 
 
 def _weak_joints(sys, q, v, t, rows):

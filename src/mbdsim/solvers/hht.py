@@ -20,6 +20,7 @@ import scipy.linalg as sla
 
 from ..errors import MbdsimError, SolverError
 from ..results.result import Result
+from ..results.stream import notify
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
@@ -38,8 +39,9 @@ class _Step:
         self.t, self.q, self.v, self.a, self.lam, self.f = t, q, v, a, lam, f
 
 
-def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
-    """HHT-alpha integration over the output grid `times`; returns a Result."""
+def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=None):
+    """HHT-alpha integration over the output grid `times`; returns a Result. progress: see
+    mbdsim.results.stream.notify; Ctrl-C ends the run with success=False and every output before it."""
     rows, sf = rep.rows, state_factory(sys)
     beta, gamma = (1 - alpha) ** 2 / 4, 0.5 - alpha
     t0, t_end = float(times[0]), float(times[-1])
@@ -87,10 +89,15 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA):
             while nxt < len(times) and times[nxt] <= new.t + 1e-12 * max(1.0, abs(new.t)):
                 out.append(_dense(sys, cur, new, times[nxt], rows, sf))
                 nxt += 1
+            notify(progress, new.t, lambda n=len(out): Result(sys, times[:n], *[np.array([s[i] for s in out[:n]])
+                                                                                for i in range(4)], stats={"assembly": rep}))
             cur = new
             h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
     except MbdsimError as exc:
         success, message, error = False, f"{exc}; last good step at t = {cur.t:.9g} s", exc
+    except KeyboardInterrupt:
+        error = SolverError("interrupted (KeyboardInterrupt)", time=float(cur.t))
+        success, message = False, f"{error}; last good step at t = {cur.t:.9g} s"
     n = len(out)
 
     def evaluate(ts):

@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from ._threads import blas_single_thread
-from ..errors import AssemblyError, ModelError
+from ..errors import AssemblyError, ModelError, SolverError
 from ..results.result import Result
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
@@ -29,14 +29,25 @@ class SingularConfigurationWarning(UserWarning):
 
 
 @blas_single_thread
-def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
+def kinematics(model, end_time, output_step=None, start_time=0.0, progress=None, out=None) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
+
+    progress: optional callable progress(t) receiving the time reached [s] after each sample; Ctrl-C
+    returns the partial Result (success=False). out: optional .parquet / .csv path that
+    `res.to_dataframe()` is written to while the run goes and at the end (see mbdsim.results.stream).
 
     The conditioning of the constraint Jacobian (with drivers, columns weighted by the bodies' masses
     and inertias, rows normalised) is monitored: samples where it falls below SINGULAR_TOL are recorded
     in res.stats["singular"] (time [s], conditioning, joints involved) and each passage is warned
     (SingularConfigurationWarning); the branch is kept by continuity, every prediction coming from
     the last non-singular sample and the rates at a singular sample from that sample's extrapolation."""
+    from ..results.stream import run_writing
+    return run_writing(lambda p: _kinematics(model, end_time, output_step, start_time, p), progress, out,
+                       "kinematics")
+
+
+def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
+    from ..results.stream import notify
     from ..system.assemble import assemble_system
     check_model(model)
     sys = assemble_system(model)
@@ -62,11 +73,16 @@ def kinematics(model, end_time, output_step=None, start_time=0.0) -> Result:
             success, error = False, exc
             message = f"{exc}; last good state at t = {out[-1][0] if out else start_time:.9g} s"
             break
+        except KeyboardInterrupt:
+            success, error = False, SolverError("interrupted (KeyboardInterrupt)", time=float(t))
+            message = f"interrupted (KeyboardInterrupt); last good state at t = {out[-1][0] if out else start_time:.9g} s"
+            break
         out.append(state)
         flags.append(cond < SINGULAR_TOL)
         if cond >= SINGULAR_TOL:
             anchor = state
         _continue_angles(sys, state)
+        notify(progress, t, lambda n=len(out): _result(sys, out[:n], None, True, "partial (run in progress)"))
     _warn_singular(records)
     singular = np.array(flags, dtype=bool)
     ev = lambda ts: _evaluate(sys, out, singular, ts, sf)  # noqa: E731

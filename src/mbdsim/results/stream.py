@@ -1,0 +1,116 @@
+"""Results written to disk while a run goes (`mb.simulate(..., out=path)`, `mb.kinematics(..., out=path)`,
+`mbdsim run --out`).
+
+The file holds `res.to_dataframe()` of every output computed so far (.parquet through pyarrow, or .csv).
+It is rewritten as a whole, atomically (a temporary file beside it, then `os.replace`), at most every
+WRITE_INTERVAL seconds of wall time and never more often than every 4 times the duration of the last
+write (so writing costs at most about a fifth of the run), and once more at the end with the complete
+Result.  So a long run that is interrupted (Ctrl-C, a failure, a killed process) leaves a valid file
+with everything up to the last write, readable with pandas; the column names and values are those of
+`to_dataframe()` (continuous angles and quaternion signs need the samples before them, hence rewriting
+the whole table instead of appending independent chunks).
+
+Solvers report through `notify(progress, t, build)`: `progress(t)` for the user's callback, and, when
+`progress` is a RunMonitor, `build()` (a Result of the outputs so far) is called only when a write is due.
+"""
+from __future__ import annotations
+
+import os
+import time
+from pathlib import Path
+
+from ..errors import ModelError
+
+WRITE_INTERVAL = 2.0          # s of wall time between two writes, at least
+SUFFIXES = (".parquet", ".csv")
+
+
+def notify(progress, t, build=None) -> None:
+    """Tell `progress` (None, a callable of t [s], or a RunMonitor) the time reached and, for a RunMonitor,
+    offer `build` (a zero-argument callable returning the Result of the outputs so far)."""
+    if progress is None:
+        return
+    progress(float(t))
+    offer = getattr(progress, "offer", None)
+    if offer is not None and build is not None:
+        offer(build)
+
+
+class ResultFile:
+    """The results table of one run, rewritten on disk as the run goes (see the module docstring)."""
+
+    def __init__(self, path, entity="simulate"):
+        try:
+            self.path = Path(os.fspath(path))
+        except TypeError:
+            raise ModelError(entity, "out", f"expected a file path, got {path!r}") from None
+        if self.path.suffix.lower() not in SUFFIXES:
+            raise ModelError(entity, "out", f"{str(self.path)!r}: expected a .parquet or .csv file")
+        if self.path.is_dir():
+            raise ModelError(entity, "out", f"{str(self.path)!r} is a directory")
+        self.last, self.cost, self.build, self.writes = time.monotonic(), 0.0, None, 0
+
+    def offer(self, build) -> None:
+        """Remember the latest builder; write its Result when a write is due."""
+        self.build = build
+        if time.monotonic() - self.last >= max(WRITE_INTERVAL, 4.0 * self.cost):
+            self.write(build())
+
+    def write(self, res) -> None:
+        """Write `res.to_dataframe()` atomically (OSError when the file cannot be written)."""
+        t0 = time.monotonic()
+        df = res.to_dataframe()
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        tmp = self.path.with_name(f".{self.path.name}.partial")
+        if self.path.suffix.lower() == ".parquet":
+            df.to_parquet(tmp, index=False, engine="pyarrow")
+        else:
+            df.to_csv(tmp, index=False)
+        os.replace(tmp, self.path)
+        self.writes += 1
+        self.last = time.monotonic()
+        self.cost = self.last - t0
+
+    def salvage(self) -> None:
+        """After an exception ended the run: write the outputs offered last, if any (best effort)."""
+        if self.build is not None:
+            try:
+                self.write(self.build())
+            except Exception:  # noqa: BLE001 - the original exception is what the caller sees
+                pass
+
+
+class RunMonitor:
+    """What solvers receive as `progress` when a run writes its results as it goes: calls the user's
+    progress(t) and hands the outputs so far to a ResultFile."""
+
+    def __init__(self, progress, file: ResultFile, entity="simulate"):
+        if progress is not None and not callable(progress):
+            raise ModelError(entity, "progress", f"expected a callable progress(t), got {progress!r}")
+        self.progress, self.file = progress, file
+
+    def __call__(self, t) -> None:
+        if self.progress is not None:
+            self.progress(t)
+
+    def offer(self, build) -> None:
+        self.file.offer(build)
+
+
+def run_writing(run, progress, out, entity):
+    """`run(progress)` (an analysis taking a progress argument) with its results written to `out` as it goes
+    (None: just run it). The final file is the complete Result's table, also when the run stopped early."""
+    if out is None:
+        return run(progress)
+    file = ResultFile(out, entity)
+    monitor = RunMonitor(progress, file, entity)
+    try:
+        res = run(monitor)
+    except BaseException:
+        file.salvage()
+        raise
+    try:
+        file.write(res)
+    except OSError as exc:
+        raise ModelError(entity, "out", f"cannot write {str(file.path)!r}: {exc}") from None
+    return res
