@@ -11,7 +11,7 @@ O2, A, B, O4 = (0.0, 0.0, 0.0), (0.0, 0.1, 0.0), (0.3, 0.4, 0.0), (0.4, 0.0, 0.0
 
 def build() -> mb.Model:
     """Three moving links on revolute joints about z; the crank turns at 1 rev/s."""
-    model = mb.Model("four_bar", gravity=(0, -9.81, 0))
+    model = mb.Model("four_bar", gravity=(0, -9.81, 0), planar=True)   # 2D: no redundancy warning
     crank = model.add_body("crank", mass=0.5, inertia=(1.0e-4, 5.0e-4, 5.0e-4), position=(0.0, 0.05, 0.0))
     coupler = model.add_body("coupler", mass=1.0, inertia=(1.0e-4, 0.015, 0.015), position=(0.15, 0.25, 0.0))
     rocker = model.add_body("rocker", mass=0.8, inertia=(1.0e-4, 0.0113, 0.0113), position=(0.35, 0.2, 0.0))

@@ -10,7 +10,7 @@ R, L = 0.2, 0.4
 
 def build() -> mb.Model:
     """Crank about z at the origin, rod to the slider at x = 0.6 m, slider on a translational joint along x."""
-    model = mb.Model("slider_crank", gravity=(0, -9.81, 0))
+    model = mb.Model("slider_crank", gravity=(0, -9.81, 0), planar=True)   # 2D: no redundancy warning
     crank = model.add_body("crank", mass=1.0, inertia=(1.0e-4, 0.00343, 0.00343), position=(0.1, 0, 0))
     rod = model.add_body("rod", mass=2.0, inertia=(2.0e-4, 0.0267, 0.0267), position=(0.4, 0, 0))
     slider = model.add_body("slider", mass=1.5, inertia=(1.0e-3, 1.0e-3, 1.0e-3), position=(0.6, 0, 0))

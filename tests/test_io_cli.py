@@ -159,3 +159,21 @@ def test_example_files_leave_free_velocities_free():
     with warnings.catch_warnings():
         warnings.simplefilter("error", mb.InitialConditionWarning)
         mb.assemble(mb.load_model(EXAMPLES / "slider_crank.yaml"))
+
+
+def test_planar_models_are_counted_in_the_plane_and_not_called_redundant():
+    """Four-bar flagged planar: Kutzbach 3 (n - 1) - 2 j1 = 3*3 - 2*4 = 1, less the driver: 0; the three
+    dependent out-of-plane equations are said to be by design. Gears count one equation each."""
+    from mbdsim.io.summary import summarize
+    r = invoke("info", EXAMPLES / "four_bar.yaml")
+    text = " ".join(r.output.split())
+    assert r.exit_code == 0 and "(planar count: 0)" in text
+    assert "redundant constraints │ 0 (3 out-of-plane equations dependent by design" in text
+    m = mb.Model("gears")
+    a = m.add_body("a", 1.0, inertia=(0.1, 0.1, 0.1))
+    b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(1, 0, 0))
+    m.add_revolute("ja", m.ground, a, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("jb", m.ground, b, (1, 0, 0), (0, 0, 1))
+    m.add_gear("mesh", "ja", "jb", -2.0)
+    s = summarize(m)
+    assert s.gruebler_dof == 12 - 10 - 1 and s.planar_dof is None

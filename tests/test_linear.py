@@ -329,3 +329,21 @@ def test_bead_on_a_vertical_ring_path_constraint():
     lin = mb.linearize(model, at="equilibrium")
     assert np.allclose(lin.q[:3], [0.0, -R, 0.0], atol=1e-9)
     assert lin.modes()["frequency [Hz]"].iloc[0] == pytest.approx(hz(np.sqrt(G / R)), rel=1e-7)
+
+
+def test_outputs_named_by_result_columns():
+    """Outputs given as to_dataframe() column names (and a labelled pair): static gains of the hanging rod
+    to a torque: angle 1 / (m g L/2), CM x (L/2) / (m g L/2), CM y 0 (second order)."""
+    m, L = 2.0, 1.0
+    model, rod, pin = rod_pendulum(-np.pi / 2, m, L)
+    model.add_torque("motor", rod, (0.0, 0.0, 0.0))
+    lin = mb.linearize(model, inputs="motor.z",
+                       outputs=["pin.angle", "rod.x", ("cm height [m]", lambda r: r.position(rod)[:, 1])])
+    assert lin.output_names == ["pin.angle", "rod.x", "cm height [m]"]
+    gain = lin.D - lin.C @ np.linalg.solve(lin.A, lin.B)
+    k = m * G * L / 2
+    assert gain[:, 0] == pytest.approx([1 / k, (L / 2) / k, 0.0], abs=1e-9)
+    assert lin.y0 == pytest.approx([0.0, 0.0, -L / 2], abs=1e-12)        # the angle counts from as drawn
+    with pytest.raises(mb.ModelError) as err:
+        mb.linearize(model, outputs=["nothing.x"])
+    assert err.value.field == "outputs"

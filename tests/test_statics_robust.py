@@ -238,3 +238,30 @@ def test_double_pendulum_four_equilibria_only_one_stable():
             res = mb.equilibrium(double_pendulum(a1, a2))
         assert len(res.stats["unstable_directions"]) == n_bad and res.position("lower")[0, 1] == pytest.approx(y)
         assert np.sum(res.stats["stiffness_eigenvalues"] < 0) == n_bad
+
+
+@pytest.mark.parametrize("axis", [(0.3, -0.2, 1.0), (1.0, 0.0, 0.0)])
+def test_rod_on_an_oblique_revolute_from_every_start_hangs(axis):
+    """A rod on a pin whose axis is tilted from the horizontal: from 24 starts round the circle (all but the
+    top) the CM ends at the lowest point of its circle, L/2 along the in-plane component of gravity."""
+    ax = np.asarray(axis, float) / np.linalg.norm(axis)
+    u = np.cross(ax, [0.0, 1.0, 0.0])
+    u /= np.linalg.norm(u)
+    w = np.cross(ax, u)
+    down = np.array([0.0, -1.0, 0.0]) - np.dot([0.0, -1.0, 0.0], ax) * ax
+    down /= np.linalg.norm(down)
+    top = np.arctan2(np.dot(-down, w), np.dot(-down, u))
+    for th in np.linspace(-np.pi, np.pi, 24, endpoint=False) + 0.01:
+        if abs(np.angle(np.exp(1j * (th - top)))) < 1e-3:
+            continue
+        model = mb.Model("tilted", gravity=(0.0, -G, 0.0))
+        d = np.cos(th) * u + np.sin(th) * w
+        R0 = Rotation.from_matrix(np.column_stack([u, w, ax]))        # body x along u at th = 0
+        rod = model.add_body("rod", 1.5, inertia=(0.001, 0.02, 0.02), position=0.4 * d,
+                             orientation=Rotation.from_rotvec(ax * th) * R0)
+        model.add_revolute("pin", model.ground, rod, (0, 0, 0), ax)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            res = mb.equilibrium(model)
+        assert res.stats["stable"], th
+        assert np.allclose(res.position(rod)[0], 0.4 * down, atol=1e-8), th

@@ -105,7 +105,7 @@ _KINDS = {ast.Attribute: "attribute access", ast.Subscript: "subscript", ast.Lam
 _ARITY = {"atan2": (2, 2)}
 
 
-def parse(text: str, variables=("t",), *, tables=None) -> Expr:
+def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any] | None = None) -> Expr:
     """Parse ``text`` into an :class:`Expr` of ``variables`` (see the module docstring for the grammar).
 
     ``tables``: optional {name: table}, each callable as ``table(x, order=n)`` (e.g.
@@ -218,3 +218,8 @@ def parse(text: str, variables=("t",), *, tables=None) -> Expr:
 
 
 from .timefunctions import TimeFunction, double_integrated, integrated, time_function  # noqa: E402
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from typing import Sequence
+    from typing import Any

@@ -19,6 +19,11 @@ from math import factorial, pi
 
 import numpy as np
 from numpy.polynomial import polynomial as _P
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+    from typing import Any
 
 __all__ = [
     "step", "step5", "havsin", "poly", "shf", "impact", "bistop", "akispl",
@@ -63,7 +68,7 @@ def _poly_step(coef, x, x0, h0, x1, h1, order):
     return _out(out, x, x0, h0, x1, h1)
 
 
-def step(x, x0, h0, x1, h1, order=0):
+def step(x: ArrayLike, x0: ArrayLike, h0: ArrayLike, x1: ArrayLike, h1: ArrayLike, order: ArrayLike = 0) -> Any:
     """Adams STEP: cubic smooth step from h0 at x <= x0 to h1 at x >= x1 (C1).
 
     STEP = h0 + (h1 - h0) * s^2 * (3 - 2 s),  s = (x - x0)/(x1 - x0), for x0 < x < x1.
@@ -72,12 +77,12 @@ def step(x, x0, h0, x1, h1, order=0):
     return _poly_step(_STEP3, x, x0, h0, x1, h1, order)
 
 
-def step5(x, x0, h0, x1, h1, order=0):
+def step5(x: ArrayLike, x0: ArrayLike, h0: ArrayLike, x1: ArrayLike, h1: ArrayLike, order: ArrayLike = 0) -> Any:
     """Adams STEP5: quintic smooth step (C2): h0 + (h1 - h0) * (10 s^3 - 15 s^4 + 6 s^5), s as in STEP."""
     return _poly_step(_STEP5, x, x0, h0, x1, h1, order)
 
 
-def havsin(x, x0, h0, x1, h1, order=0):
+def havsin(x: ArrayLike, x0: ArrayLike, h0: ArrayLike, x1: ArrayLike, h1: ArrayLike, order: ArrayLike = 0) -> Any:
     """Adams HAVSIN: haversine step h0 + (h1 - h0) * (1 - cos(pi s)) / 2, s as in STEP (C1).
 
     Adams writes the same curve as (h0 + h1)/2 + (h1 - h0)/2 * sin(pi s - pi/2).
@@ -98,7 +103,7 @@ def havsin(x, x0, h0, x1, h1, order=0):
     return _out(out, x, x0, h0, x1, h1)
 
 
-def poly(x, x0, *coefficients, order=0):
+def poly(x: ArrayLike, x0: ArrayLike, *coefficients: ArrayLike, order: ArrayLike = 0) -> Any:
     """Adams POLY(x, x0, a0, a1, ..., an) = sum_j a_j (x - x0)^j (n <= 30 in Adams; any n here)."""
     order = _check_order(order)
     if not coefficients:
@@ -110,7 +115,8 @@ def poly(x, x0, *coefficients, order=0):
     return _out(out, x, x0, *coefficients)
 
 
-def shf(x, x0, a, w, phi, b, order=0):
+def shf(x: ArrayLike, x0: ArrayLike, a: ArrayLike, w: ArrayLike, phi: ArrayLike, b: ArrayLike,
+        order: ArrayLike = 0) -> Any:
     """Adams SHF (simple harmonic function): a * sin(w (x - x0) - phi) + b.
 
     w [rad per unit of x], phi [rad]. n-th derivative: a w^n sin(w (x - x0) - phi + n pi/2).
@@ -150,7 +156,8 @@ def impact_partials(x, xdot, x1, k, e, cmax, d):
     return tuple(_out(a, x, xdot, x1, k, e, cmax, d) for a in (f, dfdx, dfdv))
 
 
-def impact(x, xdot, x1, k, e, cmax, d):
+def impact(x: ArrayLike, xdot: ArrayLike, x1: ArrayLike, k: ArrayLike, e: ArrayLike, cmax: ArrayLike,
+           d: ArrayLike) -> Any:
     """Adams IMPACT: one-sided compliant contact force that acts when x < x1.
 
     IMPACT = max(0, k (x1 - x)^e - STEP(x, x1 - d, cmax, x1, 0) * xdot)  for x < x1,
@@ -179,7 +186,8 @@ def bistop_partials(x, xdot, x1, x2, k, e, cmax, d):
     return tuple(_out(a, x, xdot, x1, x2, k, e, cmax, d) for a in (f, dfdx, dfdv))
 
 
-def bistop(x, xdot, x1, x2, k, e, cmax, d):
+def bistop(x: ArrayLike, xdot: ArrayLike, x1: ArrayLike, x2: ArrayLike, k: ArrayLike, e: ArrayLike, cmax: ArrayLike,
+           d: ArrayLike) -> Any:
     """Adams BISTOP: two-sided gap element, free for x1 <= x <= x2.
 
     BISTOP = max(k (x1 - x)^e - STEP(x, x1 - d, cmax, x1, 0) * xdot, 0)   for x < x1,
@@ -204,7 +212,7 @@ class _Table:
         order = _check_order(order)
         return _out(self._interp(np.asarray(x, dtype=float), nu=order), x)
 
-    def derivative(self, order=1):
+    def derivative(self, order: int = 1) -> Any:
         """Callable x -> d^order y / dx^order."""
         return lambda x: self(x, order)
 
@@ -248,7 +256,7 @@ def _check_table(xs, ys):
         raise ValueError("table xs must be strictly increasing")
 
 
-def akispl(x, xs, ys, order=0):
+def akispl(x: ArrayLike, xs: ArrayLike, ys: ArrayLike, order: ArrayLike = 0) -> Any:
     """Adams AKISPL(x, 0, spline, iord): Akima interpolation of (xs, ys) at x; order 0, 1 or 2."""
     if order not in (0, 1, 2):
         raise ValueError(f"AKISPL order must be 0, 1 or 2, got {order!r}")

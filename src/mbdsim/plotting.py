@@ -22,6 +22,13 @@ from typing import Any, Callable, Sequence
 import numpy as np
 
 from .errors import ModelError
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ._types import Signal as SignalSpec
+    import pandas as pd
+    from matplotlib.axes import Axes
+    from .results.result import Result
 
 TIME_COLUMN = "time [s]"
 _UNIT_RE = re.compile(r"^(.*?)\s*\[([^\]]*)\]\s*$")
@@ -232,7 +239,8 @@ def _pyplot():
     return plt
 
 
-def plot(res, signal, x=None, ax=None, events=True, **kw):
+def plot(res: Result | pd.DataFrame, signal: SignalSpec | Sequence[SignalSpec], x: SignalSpec | None = None, ax: Axes | None = None,
+         events: bool = True, **kw: Any) -> Axes:
     """Plot one signal or a list of signals of a Result (or of a DataFrame from `res.to_dataframe()` /
     a results file) against time [s], or against the signal `x`; returns the matplotlib Axes.
 

@@ -83,6 +83,20 @@ def _rank_dof(model):
     return rep.dof, rep.system.nc - len(rep.rows), list(rep.redundant)
 
 
+def _mobility(summary, dof, n_redundant, redundant):
+    """Rows of the mobility table: Gruebler's count (and the planar count of a model flagged planar), the
+    DOF from the rank of the constraint Jacobian, the redundant equations (a planar model's dependent
+    out-of-plane equations are dropped by design and said so, not counted as redundant)."""
+    g = str(summary.gruebler_dof) + ("" if summary.planar_dof is None else f" (planar count: {summary.planar_dof})")
+    if redundant:
+        red = f"{n_redundant} among {', '.join(redundant)}"
+    elif n_redundant:
+        red = f"0 ({n_redundant} out-of-plane equations dependent by design: planar model)"
+    else:
+        red = "0"
+    return [("DOF (Gruebler)", g), ("DOF (rank)", str(dof)), ("redundant constraints", red)]
+
+
 def run_cmd(
     model: Path = MODEL_ARG,
     end: float = typer.Option(..., "--end", "-e", metavar="T", help="End time in s."),
@@ -126,9 +140,7 @@ def _run(path, end, step, method, rtol, out):
         bar.update(task, completed=float(res.time[-1]))
     wall = time.perf_counter() - t0
     stats = res.stats or {}
-    rows = [("model", f"{m.name} ({path})"), ("DOF (Gruebler)", str(summary.gruebler_dof)),
-            ("DOF (rank)", str(dof)),
-            ("redundant constraints", f"{n_redundant}" + (f" among {', '.join(redundant)}" if redundant else "")),
+    rows = [("model", f"{m.name} ({path})"), *_mobility(summary, dof, n_redundant, redundant),
             ("method", str(stats.get("method", method or "auto"))), ("steps", str(stats.get("steps", "?"))),
             ("simulated", f"{res.time[0]:.6g} .. {res.time[-1]:.6g} s, {len(res.time)} samples"),
             ("wall time", f"{wall:.3f} s"), ("success", f"{res.success} ({res.message})")]
@@ -187,9 +199,7 @@ def _info(path):
     if s.elements:
         _print_table("force elements", s.elements, ("name", "kind"))
     dof, n_redundant, redundant = _rank_dof(m)   # assembles: may fail after the tables are out
-    _print_table("mobility", [("DOF (Gruebler)", str(s.gruebler_dof)), ("DOF (rank)", str(dof)),
-                              ("redundant constraints", str(n_redundant) + (f" among {', '.join(redundant)}"
-                                                                            if redundant else ""))])
+    _print_table("mobility", _mobility(s, dof, n_redundant, redundant))
 
 
 def schema_cmd(out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",

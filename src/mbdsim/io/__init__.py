@@ -18,6 +18,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import ModelFileError
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
+    from .._types import PathLike
 
 __all__ = ["load_model", "save_model", "model_from_dict", "model_to_dict", "json_schema", "ModelFileError"]
 
@@ -53,14 +58,14 @@ def model_to_dict(model) -> dict:
     return dump(model)
 
 
-def load_model(path):
+def load_model(path: PathLike) -> Model:
     """Read a model file (.yaml/.yml or .json) and build the Model; errors are ModelFileError."""
     from .files import read
     data, marks, source = read(path)
     return model_from_dict(data, source, marks)
 
 
-def save_model(model, path) -> Path:
+def save_model(model: Model, path: PathLike) -> Path:
     """Write `model` to `path` as YAML or JSON (by extension) in SI units; returns the path.
 
     Raises ModelError naming the element when the model holds a Python callable."""

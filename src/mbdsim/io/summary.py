@@ -5,12 +5,18 @@ from dataclasses import dataclass, field
 
 # constraints a joint removes between two rigid bodies, and its translational part (what a particle feels)
 TRANSLATION_CONSTRAINTS = {"revolute": 3, "translational": 2, "cylindrical": 2, "spherical": 3, "universal": 3,
-                           "planar": 1, "fixed": 3}
+                           "planar": 1, "fixed": 3, "inline": 2, "inplane": 1, "orientation": 0, "parallel_axes": 0,
+                           "perpendicular": 0, "atpoint": 3, "screw": 2, "constant_velocity": 3}
+# in-plane freedoms a joint leaves in a model flagged planar (3 per rigid body: two slides, one turn);
+# kinds whose in-plane freedom depends on how they are placed are left out (no planar count then)
+PLANAR_DOF = {"revolute": 1, "translational": 1, "fixed": 0, "spherical": 1, "atpoint": 1, "planar": 3}
 
 
 @dataclass
 class ModelSummary:
-    """Entity counts and Gruebler's (Kutzbach's) mobility 6 n_rigid + 3 n_particles - constraints."""
+    """Entity counts and Gruebler's (Kutzbach's) mobility 6 n_rigid + 3 n_particles - constraints (couplers
+    and user constraints count one equation each); for a model flagged planar, `planar_dof` is the planar
+    count 3 n_rigid + 2 n_particles - in-plane constraints (None when a joint kind has no fixed planar count)."""
 
     name: str
     bodies: list = field(default_factory=list)       # (name, kind, mass [kg])
@@ -18,6 +24,7 @@ class ModelSummary:
     drivers: list = field(default_factory=list)      # (name, joint, kind, expression text)
     elements: list = field(default_factory=list)     # (name, kind)
     gruebler_dof: int = 0
+    planar_dof: int | None = None
 
 
 def joint_constraints(kind: str, particle: bool) -> int:
@@ -42,10 +49,30 @@ def summarize(model) -> ModelSummary:
     for p in getattr(model, "path_constraints", {}).values():
         s.joints.append((p.name, "point_on_curve", p.marker.body.name, p.body.name, 2))   # 3 rows, 1 new coordinate
         mobility -= 2
+    for c in getattr(model, "coord_constraints", {}).values():
+        s.joints.append((c.name, c.kind, ", ".join(j.name for j, _ in c.terms), "", 1))
+        mobility -= 1
     for m in model.motions.values():
         s.drivers.append((m.name, m.joint.name, m.kind, m.function.description))
         mobility -= 1
     for e in model.forces.values():
         s.elements.append((e.name, type(e).__name__))
     s.gruebler_dof = mobility
+    if getattr(model, "planar", None) is not None:
+        s.planar_dof = planar_mobility(model)
     return s
+
+
+def planar_mobility(model) -> int | None:
+    """3 per rigid body and 2 per particle, less each joint's in-plane constraints, couplers and drivers
+    (None when a joint's in-plane freedom depends on its placement, or the model has curve paths)."""
+    if getattr(model, "path_constraints", {}):
+        return None
+    mobility = sum(2 if b.is_particle else 3 for b in model.bodies.values() if not b.is_ground)
+    for j in model.joints.values():
+        if j.kind not in PLANAR_DOF:
+            return None
+        particle = j.body_i.is_particle or j.body_j.is_particle
+        mobility -= (1 if j.kind == "translational" else 0 if j.kind == "planar" else 2) if particle \
+            else 3 - PLANAR_DOF[j.kind]
+    return mobility - len(getattr(model, "coord_constraints", {})) - len(model.motions)

@@ -8,6 +8,10 @@ import numpy as np
 from ..errors import ModelError
 from ..math.rotation import as_matrix
 from ._check import inertia_matrix, scalar, vec3
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import Orientation, Vector
 
 
 @dataclass(eq=False)
@@ -56,7 +60,7 @@ class Body:
     velocity_given: bool = False
     angular_velocity_given: bool = False
 
-    def add_marker(self, name: str, point=None, orientation=None) -> Marker:
+    def add_marker(self, name: str, point: Vector | None = None, orientation: Orientation = None) -> Marker:
         """Add a frame fixed on this body; point [m] and orientation (marker->ground) in ground at t=0."""
         entity = f"marker '{self.name}.{name}'"
         if name in self.markers:

@@ -14,6 +14,10 @@ from typing import Any
 from ..errors import ModelError
 from ._check import scalar
 from .joints import Joint
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import JointRef
 
 COUPLED_KINDS = {"revolute": ("rotation",), "translational": ("translation",),
                  "cylindrical": ("rotation", "translation"), "screw": ("rotation",)}
@@ -42,7 +46,8 @@ class CoordConstraint:
 class CouplersMixin:
     """add_coupler, add_gear, add_user_constraint."""
 
-    def add_coupler(self, name, joint_1, joint_2, ratio, dof_1=None, dof_2=None) -> CoordConstraint:
+    def add_coupler(self, name: str, joint_1: JointRef, joint_2: JointRef, ratio: float, dof_1: str | None = None,
+                    dof_2: str | None = None) -> CoordConstraint:
         """Coupler: x_2 = ratio * x_1 between the coordinates of two joints (Adams COUPLER).
 
         Two revolutes: a gear pair, ratio = -r_1 / r_2 for external gears (pitch radii r).  A revolute
@@ -66,7 +71,7 @@ class CouplersMixin:
         c.ratio = r
         return c
 
-    def add_gear(self, name, joint_1, joint_2, ratio) -> CoordConstraint:
+    def add_gear(self, name: str, joint_1: JointRef, joint_2: JointRef, ratio: float) -> CoordConstraint:
         """Gear pair (a coupler of two revolute joints): theta_2 = ratio * theta_1, ratio = -r_1 / r_2
         for external gears, +r_1 / r_2 for an internal (ring) gear; pitch radii r [m]."""
         for k, jt in ((1, joint_1), (2, joint_2)):
@@ -78,7 +83,7 @@ class CouplersMixin:
         c.kind = "gear"
         return c
 
-    def add_user_constraint(self, name, expression) -> CoordConstraint:
+    def add_user_constraint(self, name: str, expression: str) -> CoordConstraint:
         """General constraint expression(...) = 0 written in joint coordinates by joint name, e.g.
         "crank - 2*rocker" or "sin(j1) - 0.5*j2", and time t [s] (safe whitelist parser, never eval'd;
         its Jacobian and acceleration terms come from exact symbolic derivatives).  Joints: revolute,

@@ -26,6 +26,10 @@ from scipy.interpolate import CubicSpline
 
 from ..errors import ModelError
 from ._check import scalar
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import Array, Vector
 
 ENTITY = "curve"
 
@@ -72,17 +76,17 @@ class Curve:
         self._check(d1, d2, probe)
 
     # ------------------------------------------------------------------ evaluation
-    def point(self, s) -> np.ndarray:
+    def point(self, s: float) -> np.ndarray:
         """C(s) [m], ground axes at t=0."""
         return np.asarray(self._f(s), dtype=float).reshape(3)
 
-    def derivatives(self, s):
+    def derivatives(self, s: float) -> tuple[Array, Array, Array]:
         """(C, dC/ds, d2C/ds2) at the parameter s."""
         d1 = np.asarray(self._d1(s), dtype=float).reshape(3)
         d2 = self._d2(s) if self._d2 is not None else _richardson(self._d1, s, self.h)
         return self.point(s), d1, np.asarray(d2, dtype=float).reshape(3)
 
-    def nearest(self, p) -> float:
+    def nearest(self, p: Vector) -> float:
         """Parameter of the curve point nearest to p [m] (sampling plus bounded refinement)."""
         import scipy.optimize as so
         a, b = self.s_range
@@ -164,10 +168,10 @@ class Spline(Curve):
         self.s_range, self.closed, self.h = (0.0, float(u[-1])), closed, float(u[-1]) * 1e-4
         self._f, self._d1, self._d2 = self._cs, self._c1, self._c2
 
-    def point(self, s) -> np.ndarray:
+    def point(self, s: float) -> np.ndarray:
         return self._cs(s)
 
-    def derivatives(self, s):
+    def derivatives(self, s: float) -> tuple[Array, Array, Array]:
         return self._cs(s), self._c1(s), self._c2(s)
 
     def __repr__(self) -> str:

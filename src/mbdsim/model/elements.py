@@ -11,12 +11,19 @@ from ..errors import ModelError
 from ._check import scalar, vector
 from .element_specs import Bushing, Contact, Stop, TorsionSpring
 from .shapes import attach
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import JointRef, Location
+    from numpy.typing import ArrayLike
+    from typing import Any
 
 
 class ForceElementsMixin:
     """add_torsion_spring, add_bushing, add_contact, add_stop (see issue 3)."""
 
-    def add_torsion_spring(self, name, joint, stiffness, damping=0.0, free_angle=0.0, preload=0.0) -> TorsionSpring:
+    def add_torsion_spring(self, name: str, joint: JointRef, stiffness: float, damping: float = 0.0,
+                           free_angle: float = 0.0, preload: float = 0.0) -> TorsionSpring:
         """Rotational spring-damper on a revolute or cylindrical joint axis.
 
         Torque on body_j about the axis = -(stiffness (theta - free_angle) + damping theta_dot + preload),
@@ -31,8 +38,8 @@ class ForceElementsMixin:
                              scalar(entity, "free_angle", free_angle), scalar(entity, "preload", preload))
         return self.add_element(spec)
 
-    def add_bushing(self, name, marker_i, marker_j, stiffness=(0.0,) * 6, damping=(0.0,) * 6,
-                    preload=(0.0,) * 6) -> Bushing:
+    def add_bushing(self, name: str, marker_i: Location, marker_j: Location, stiffness: ArrayLike = (0.0,) * 6,
+                    damping: ArrayLike = (0.0,) * 6, preload: ArrayLike = (0.0,) * 6) -> Bushing:
         """Bushing between two markers (a Marker or (body, point in ground at t=0)), Adams BUSHING semantics.
 
         stiffness (kx, ky, kz [N/m], ktx, kty, ktz [N m/rad]), damping (cx, cy, cz [N s/m], ctx, cty, ctz
@@ -45,8 +52,8 @@ class ForceElementsMixin:
         c = _six(entity, "damping", damping, minimum=0.0)
         return self.add_element(Bushing(name, mi, mj, k, c, _six(entity, "preload", preload)))
 
-    def add_contact(self, name, shape_i, shape_j, stiffness, exponent, damping, penetration, mu=0.0,
-                    friction_velocity=1e-3) -> Contact:
+    def add_contact(self, name: str, shape_i: Any, shape_j: Any, stiffness: float, exponent: float, damping: float,
+                    penetration: float, mu: float = 0.0, friction_velocity: float = 1e-3) -> Contact:
         """Compliant contact between an mb.Sphere and an mb.Plane or two spheres (Adams IMPACT law).
 
         stiffness k [N/m^e] >= 0, exponent e > 0, damping c_max [N s/m] >= 0 reached at `penetration`
@@ -66,8 +73,9 @@ class ForceElementsMixin:
                        scalar(entity, "friction_velocity", friction_velocity, minimum=0.0, strict=True))
         return self.add_element(spec)
 
-    def add_stop(self, name, joint, lower=None, upper=None, stiffness=None, exponent=1.5, damping=0.0,
-                 penetration=1e-3, dof=None) -> Stop:
+    def add_stop(self, name: str, joint: JointRef, lower: float | None = None, upper: float | None = None,
+                 stiffness: float | None = None, exponent: float = 1.5, damping: float = 0.0, penetration: float = 1e-3,
+                 dof: str | None = None) -> Stop:
         """One- or two-sided stop on a translational, revolute or cylindrical joint coordinate.
 
         lower/upper [m or rad] (None: open), in the coordinates of Result.joint_coordinate (0 at the

@@ -13,6 +13,11 @@ from ._check import scalar
 from .body import Body, Marker
 from .curves import Curve
 from .joints import Joint
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import BodyRef, JointRef, Location
+    from typing import Any
 
 # model parameters per joint kind: name -> (unit, meaning); all optional, None = term omitted
 FRICTION_PARAMETERS = {
@@ -61,7 +66,8 @@ class PointOnCurve:
 class FrictionPathMixin:
     """add_friction, add_point_on_curve (see issue 3)."""
 
-    def add_friction(self, name, joint, mu_static, mu_dynamic, **model_parameters) -> JointFriction:
+    def add_friction(self, name: str, joint: JointRef, mu_static: float, mu_dynamic: float,
+                     **model_parameters: float) -> JointFriction:
         """Coulomb friction in a translational or revolute joint with event-driven stick/slip.
 
         mu_static >= mu_dynamic >= 0.  Friction load = mu * N with N from the joint's reaction on
@@ -112,7 +118,7 @@ class FrictionPathMixin:
             raise ModelError(entity, "pin_radius", "revolute friction needs pin_radius [m] > 0")
         return out
 
-    def add_point_on_curve(self, name, marker, body, curve) -> PointOnCurve:
+    def add_point_on_curve(self, name: str, marker: Location, body: BodyRef, curve: Any) -> PointOnCurve:
         """Constrain the origin of `marker` (a Marker, or (body, point in ground at t=0)) to `curve`
         (mb.Curve or mb.Spline, given in ground at t=0) fixed on `body` (a rigid body or ground).
 

@@ -13,6 +13,10 @@ from ..errors import ModelError
 from ._check import scalar, vec3
 from .body import Body, Marker
 from .joints import Joint
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import BodyRef, Vector
 
 
 class JointsExtraMixin:
@@ -20,27 +24,30 @@ class JointsExtraMixin:
     add_screw, add_constant_velocity."""
 
     # ------------------------------------------------------------- joint primitives
-    def add_inline(self, name, body_i, body_j, point=None, axis=None) -> Joint:
+    def add_inline(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                   axis: Vector | None = None) -> Joint:
         """Inline primitive: the joint point of body_j stays on the line through `point` along `axis`
         fixed on body_i (2 equations; with markers: the J origin on the I marker's z line)."""
         return self._joint(name, "inline", body_i, body_j, point, axis)
 
-    def add_inplane(self, name, body_i, body_j, point=None, normal=None) -> Joint:
+    def add_inplane(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                    normal: Vector | None = None) -> Joint:
         """Inplane primitive: the joint point of body_j stays in the plane through `point` with `normal`
         fixed on body_i (1 equation; with markers: the J origin in the I marker's xy plane)."""
         return self._joint(name, "inplane", body_i, body_j, point, normal)
 
-    def add_orientation(self, name, body_i, body_j) -> Joint:
+    def add_orientation(self, name: str, body_i: BodyRef, body_j: BodyRef) -> Joint:
         """Orientation primitive: body_j keeps its attitude relative to body_i, translations free
         (3 equations; with markers: the markers' axes coincide)."""
         return self._joint(name, "orientation", body_i, body_j, self._cm_point(body_i, body_j), _z())
 
-    def add_parallel_axes(self, name, body_i, body_j, axis=None) -> Joint:
+    def add_parallel_axes(self, name: str, body_i: BodyRef, body_j: BodyRef, axis: Vector | None = None) -> Joint:
         """Parallel-axes primitive: `axis` (ground, t=0) fixed on each body stays parallel on both
         (2 equations; with markers: the z axes stay parallel)."""
         return self._joint(name, "parallel_axes", body_i, body_j, self._cm_point(body_i, body_j), axis)
 
-    def add_perpendicular(self, name, body_i, body_j, axis_i=None, axis_j=None) -> Joint:
+    def add_perpendicular(self, name: str, body_i: BodyRef, body_j: BodyRef, axis_i: Vector | None = None,
+                          axis_j: Vector | None = None) -> Joint:
         """Perpendicular primitive: `axis_i` fixed on body_i stays perpendicular to `axis_j` fixed on
         body_j (ground, t=0, perpendicular then within 1e-6 rad; 1 equation; with markers: the z axes)."""
         from .model import _universal_axis_j
@@ -58,14 +65,16 @@ class JointsExtraMixin:
             raise
         return j
 
-    def add_atpoint(self, name, body_i, body_j, point=None) -> Joint:
+    def add_atpoint(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None) -> Joint:
         """Atpoint primitive: the points of body_i and body_j at `point` (ground, t=0) coincide; rotations
         free (3 equations, a spherical joint's; with markers: the origins coincide)."""
         return self._joint(name, "atpoint", body_i, body_j, point, _z())
 
     # ------------------------------------------------------------- screw, constant velocity
-    def add_screw(self, name, body_i, body_j, point=None, axis=None, lead=None, initial_displacement=None,
-                  initial_velocity=None) -> Joint:
+    def add_screw(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                  axis: Vector | None = None, lead: float | None = None,
+                  initial_displacement: float | Vector | None = None,
+                  initial_velocity: float | Vector | None = None) -> Joint:
         """Screw joint along `axis` through `point` (ground, t=0, or two markers: the I marker's z axis).
 
         `lead` [m per revolution]: body_j advances lead * angle / (2 pi) along the axis as it turns by
@@ -81,7 +90,8 @@ class JointsExtraMixin:
         j.lead = lead
         return j
 
-    def add_constant_velocity(self, name, body_i, body_j, point=None, axis_i=None, axis_j=None) -> Joint:
+    def add_constant_velocity(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                              axis_i: Vector | None = None, axis_j: Vector | None = None) -> Joint:
         """Constant-velocity joint (Adams CVJOINT) at `point`: the shafts `axis_i` (fixed on body_i) and
         `axis_j` (on body_j), ground at t=0, turn by equal angles about their own axes; the two bending
         freedoms are left.  With two markers: their z axes are the shafts and the angles are counted

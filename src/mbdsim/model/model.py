@@ -15,6 +15,11 @@ from .joints import Joint, Motion, joint_initial
 from .couplers import CouplersMixin
 from .joints_extra import JointsExtraMixin
 from .sensors import SensorsMixin
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import (BodyRef, FrameRef, Inertia, JointRef, Load, Location, MassShape, Orientation,
+                          TimeFunction, Vector)
 
 
 class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
@@ -38,8 +43,10 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self._names: set[str] = {"ground"}
 
     # ----------------------------------------------------------------- bodies
-    def add_body(self, name, mass=None, inertia=None, position=(0, 0, 0), orientation=None,
-                 velocity=None, angular_velocity=None, shape=None, density=None) -> Body:
+    def add_body(self, name: str, mass: float | None = None, inertia: Inertia = None, position: Vector = (0, 0, 0),
+                 orientation: Orientation = None, velocity: Vector | None = None,
+                 angular_velocity: Vector | None = None, shape: MassShape | None = None,
+                 density: float | None = None) -> Body:
         """Add a rigid body: mass [kg], inertia about the CM in body axes [kg m^2] (3 values or 3x3, default 0),
         CM position [m], orientation (body->ground), CM velocity [m/s] and angular velocity [rad/s] in ground.
 
@@ -58,7 +65,8 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self.bodies[name] = b
         return b
 
-    def add_particle(self, name, mass, position=(0, 0, 0), velocity=None) -> Body:
+    def add_particle(self, name: str, mass: float, position: Vector = (0, 0, 0),
+                     velocity: Vector | None = None) -> Body:
         """Add a point mass [kg] at position [m] with velocity [m/s] (None: free, solved at assembly), both
         in ground; it has no rotation."""
         self._claim(name, "particle")
@@ -78,21 +86,24 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
     # angles and slides (motions, joint_coordinate) are then zero where the markers' axes coincide.
     # initial_displacement / initial_velocity: joint coordinates (from as drawn) and rates held at
     # assembly, a number for a one-coordinate joint, else in the order of Result.joint_coordinate.
-    def add_revolute(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
-                     initial_velocity=None) -> Joint:
+    def add_revolute(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                     axis: Vector | None = None, initial_displacement: float | Vector | None = None,
+                     initial_velocity: float | Vector | None = None) -> Joint:
         """Revolute joint at `point` [m] about `axis`, both in ground at t=0 (or two markers); coordinate:
         the angle [rad] of body_j about the axis."""
         return self._joint(name, "revolute", body_i, body_j, point, axis, initial_displacement, initial_velocity)
 
-    def add_translational(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
-                          initial_velocity=None) -> Joint:
+    def add_translational(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                          axis: Vector | None = None, initial_displacement: float | Vector | None = None,
+                          initial_velocity: float | Vector | None = None) -> Joint:
         """Translational (prismatic) joint sliding along `axis` through `point` (ground, t=0, or two
         markers); coordinate: the slide [m]."""
         return self._joint(name, "translational", body_i, body_j, point, axis, initial_displacement,
                            initial_velocity)
 
-    def add_cylindrical(self, name, body_i, body_j, point=None, axis=None, initial_displacement=None,
-                        initial_velocity=None) -> Joint:
+    def add_cylindrical(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                        axis: Vector | None = None, initial_displacement: float | Vector | None = None,
+                        initial_velocity: float | Vector | None = None) -> Joint:
         """Cylindrical joint: rotation about and sliding along `axis` through `point` (ground, t=0).
 
         Its coordinates are (angle [rad], slide [m]); every call that takes `dof=` on it (add_motion,
@@ -100,14 +111,17 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         return self._joint(name, "cylindrical", body_i, body_j, point, axis, initial_displacement,
                            initial_velocity)
 
-    def add_spherical(self, name, body_i, body_j, point=None, initial_displacement=None,
-                      initial_velocity=None) -> Joint:
+    def add_spherical(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                      initial_displacement: float | Vector | None = None,
+                      initial_velocity: float | Vector | None = None) -> Joint:
         """Spherical (ball) joint at `point` [m] in ground at t=0 (or two markers); coordinates: the
         relative rotation vector [rad] and relative angular velocity [rad/s] in body_i axes."""
         return self._joint(name, "spherical", body_i, body_j, point, _Z, initial_displacement, initial_velocity)
 
-    def add_universal(self, name, body_i, body_j, point=None, axis_i=None, axis_j=None,
-                      initial_displacement=None, initial_velocity=None) -> Joint:
+    def add_universal(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                      axis_i: Vector | None = None, axis_j: Vector | None = None,
+                      initial_displacement: float | Vector | None = None,
+                      initial_velocity: float | Vector | None = None) -> Joint:
         """Universal joint at `point`; `axis_i` fixed on body_i, `axis_j` on body_j, perpendicular at t=0
         (within 1e-6 rad: then axis_j is orthogonalised and the AssemblyReport notes it).  With two
         markers the axes are their z axes.  Coordinates as a spherical joint's (rotation vector)."""
@@ -125,8 +139,10 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
             raise
         return j
 
-    def add_planar(self, name, body_i, body_j, point=None, normal=None, u_axis=None, initial_displacement=None,
-                   initial_velocity=None) -> Joint:
+    def add_planar(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None,
+                   normal: Vector | None = None, u_axis: Vector | None = None,
+                   initial_displacement: float | Vector | None = None,
+                   initial_velocity: float | Vector | None = None) -> Joint:
         """Planar joint: body_j moves in the plane through `point` with `normal` fixed on body_i.
 
         Its coordinates (Result.joint_coordinate) are [u, v, angle]: the joint point of body_j along the
@@ -150,7 +166,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
             (_default_u_axis(j.axis) if u is None else u)
         return j
 
-    def add_fixed(self, name, body_i, body_j, point=None) -> Joint:
+    def add_fixed(self, name: str, body_i: BodyRef, body_j: BodyRef, point: Vector | None = None) -> Joint:
         """Fixed joint welding body_j to body_i (at `point`, default body_j's CM; or two markers, which
         assembly makes coincide, axes included)."""
         bj = self.bodies.get(body_j) if isinstance(body_j, str) else body_j   # a body may be given by name
@@ -162,8 +178,9 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self._names.discard(name)
 
     # ----------------------------------------------------------------- drivers
-    def add_motion(self, name, joint, displacement=None, velocity=None, acceleration=None,
-                   initial_displacement=0.0, initial_velocity=0.0, dof=None) -> Motion:
+    def add_motion(self, name: str, joint: JointRef, displacement: TimeFunction | None = None,
+                   velocity: TimeFunction | None = None, acceleration: TimeFunction | None = None,
+                   initial_displacement: float = 0.0, initial_velocity: float = 0.0, dof: str | None = None) -> Motion:
         """Drive a joint coordinate [rad or m] as a function of time t [s].
 
         Give exactly one of displacement, velocity (with initial_displacement) or acceleration (with
@@ -208,7 +225,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         return m
 
     # ----------------------------------------------------------------- loads
-    def add_force(self, name, at, force, frame=None) -> Force:
+    def add_force(self, name: str, at: Location, force: Load, frame: FrameRef = None) -> Force:
         """Force [N] at a point: `at` is a Marker or (body, point in ground at t=0 [m]).
 
         `force` is a constant 3-vector or a callable (t, state) -> 3-vector, in ground axes when
@@ -226,7 +243,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self.forces[name] = f
         return f
 
-    def add_torque(self, name, body, torque, frame=None) -> Torque:
+    def add_torque(self, name: str, body: BodyRef, torque: Load, frame: FrameRef = None) -> Torque:
         """Pure torque [N m] on a body; constant 3-vector or callable (t, state); axes as add_force."""
         entity = f"torque '{name}'"
         self._claim(name, "torque")
@@ -243,8 +260,8 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self.forces[name] = t
         return t
 
-    def add_spring_damper(self, name, at_i, at_j, stiffness, damping=0.0, free_length=None,
-                          preload=0.0) -> SpringDamper:
+    def add_spring_damper(self, name: str, at_i: Location, at_j: Location, stiffness: float, damping: float = 0.0,
+                          free_length: float | None = None, preload: float = 0.0) -> SpringDamper:
         """Translational spring-damper between two points (Marker or (body, point in ground at t=0)).
 
         stiffness [N/m], damping [N s/m], free_length [m] (None = initial distance), preload [N]:
@@ -265,7 +282,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         return s
 
     # ----------------------------------------------------------------- helpers
-    def add_element(self, element) -> Any:
+    def add_element(self, element: Any) -> Any:
         """Register a force element built elsewhere (must have a unique `name`)."""
         self._claim(element.name, type(element).__name__)
         self.forces[element.name] = element

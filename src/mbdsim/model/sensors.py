@@ -13,6 +13,10 @@ from typing import Any
 
 from ..errors import ModelError
 from ._check import scalar
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import Signal
 
 ACTIONS = ("stop", "record")
 
@@ -37,7 +41,8 @@ class Sensor:
 class SensorsMixin:
     """add_sensor."""
 
-    def add_sensor(self, name, signal, value=0.0, direction=0, action="stop", threshold=None) -> Sensor:
+    def add_sensor(self, name: str, signal: Signal, value: float = 0.0, direction: int = 0, action: str = "stop",
+                   threshold: float | None = None) -> Sensor:
         """Sensor on `signal` reaching `value` (alias `threshold`) in `direction` (+1 rising, -1 falling,
         0 either); action "stop" ends the simulation at that instant (the Result's last sample), "record"
         notes it.  The times are in `Result.sensor_events`.  Sensors run on the reference (scipy DOP853)

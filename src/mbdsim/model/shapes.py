@@ -12,6 +12,10 @@ import numpy as np
 
 from ..errors import ModelError
 from ._check import scalar, vec3
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import Array
 
 
 @dataclass(eq=False, init=False)
@@ -29,7 +33,7 @@ class Sphere:
         self.radius = scalar(entity, "radius", radius, minimum=0.0, strict=True)
         self.center = None if center is None else vec3(entity, "center", center)
 
-    def mass_properties(self, density):
+    def mass_properties(self, density: float) -> tuple[float, Array]:
         """(mass [kg], inertia about the centre 3x3 [kg m^2]) of a solid sphere of `density` [kg/m^3]."""
         m = _density(self, density) * 4.0 / 3.0 * np.pi * self.radius ** 3
         return float(m), np.eye(3) * (0.4 * m * self.radius ** 2)
@@ -49,7 +53,7 @@ class Box:
         if np.any(self.size <= 0):
             raise ModelError("box", "size", f"edge lengths must be > 0, got {tuple(self.size)}")
 
-    def mass_properties(self, density):
+    def mass_properties(self, density: float) -> tuple[float, Array]:
         """(mass [kg], inertia about the centre in body axes 3x3 [kg m^2]) for `density` [kg/m^3]."""
         a, b, c = self.size
         m = _density(self, density) * a * b * c
@@ -74,7 +78,7 @@ class Cylinder:
             raise ModelError("cylinder", "axis", f"must be 'x', 'y' or 'z', got {axis!r}")
         self.axis = axis
 
-    def mass_properties(self, density):
+    def mass_properties(self, density: float) -> tuple[float, Array]:
         """(mass [kg], inertia about the centre in body axes 3x3 [kg m^2]) for `density` [kg/m^3]."""
         r, L = self.radius, self.length
         m = _density(self, density) * np.pi * r * r * L

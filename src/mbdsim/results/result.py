@@ -17,6 +17,14 @@ from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
 from ..system.frames import Frames, body_frames
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from scipy.spatial.transform import Rotation
+    from .._types import Array, BodyRef, FrameRef, JointRef, PathLike, Signal, Target
+    from numpy.typing import ArrayLike
+    from typing import Any
+    import pandas as pd
 
 
 class Result:
@@ -78,7 +86,7 @@ class Result:
             self._fr.t = self.time   # sample times, for time-dependent element measures
         return self._fr
 
-    def at(self, t) -> "Result":
+    def at(self, t: float | ArrayLike) -> "Result":
         """The same Result API at time(s) t [s], evaluated from the solver's dense output."""
         ts = np.atleast_1d(np.asarray(t, dtype=float))
         lo, hi = self.time[0], self.time[-1]
@@ -123,12 +131,12 @@ class Result:
 
     # ------------------------------------------------------------ points and bodies
     # A target or frame is a Body (its CM), a Marker, or the name of one: "rod", "rod.tip".
-    def position(self, target, frame=None):
+    def position(self, target: Target, frame: FrameRef = None) -> Array:
         """Position [m] (N, 3) of a body's CM or a marker origin; in ground, or measured from `frame`'s
         origin and expressed in its axes."""
         return ms.position(self.system, self.frames, target, frame)
 
-    def velocity(self, target, frame=None, relative_to=None):
+    def velocity(self, target: Target, frame: FrameRef = None, relative_to: FrameRef = None) -> Array:
         """Velocity [m/s] (N, 3) of a body's CM or a marker origin, in ground axes or `frame` axes.
 
         Absolute by default; with `relative_to=f` the time derivative, taken in frame f, of the position
@@ -140,7 +148,7 @@ class Result:
             v = kin.relative_point_motion(self.system, self.frames, target, relative_to).v_rel
         return self._express(v, frame)
 
-    def acceleration(self, target, frame=None, relative_to=None):
+    def acceleration(self, target: Target, frame: FrameRef = None, relative_to: FrameRef = None) -> Array:
         """Acceleration [m/s^2] (N, 3) of a body's CM or a marker origin, in ground axes or `frame` axes.
 
         Absolute by default; with `relative_to=f` the second derivative taken in frame f, so that
@@ -152,18 +160,18 @@ class Result:
             a = kin.relative_point_motion(self.system, self.frames, target, relative_to).a_rel
         return self._express(a, frame)
 
-    def orientation(self, target):
+    def orientation(self, target: Target) -> Array:
         """Rotation matrices (N, 3, 3) mapping the axes of `target` to ground: the body's orientation
         times the marker's (a body name or Body gives the body's own axes)."""
         return kin.orientation(self.system, self.frames, target)
 
-    def rotation(self, target):
+    def rotation(self, target: Target) -> Rotation:
         """`scipy.spatial.transform.Rotation` stack (N rotations) of `orientation(target)`: use its
         as_quat() (scalar last), as_euler(seq) (any sequence), as_rotvec(), as_matrix()."""
         from scipy.spatial.transform import Rotation
         return Rotation.from_matrix(self.orientation(target))
 
-    def angular_velocity(self, target, frame=None, relative_to=None):
+    def angular_velocity(self, target: Target, frame: FrameRef = None, relative_to: FrameRef = None) -> Array:
         """Angular velocity [rad/s] (N, 3) of the body of `target` (a marker stands for its body), in
         ground or `frame` axes; with `relative_to=f`, w - w_f."""
         if relative_to is None:
@@ -172,7 +180,7 @@ class Result:
             w = kin.relative_angular_motion(self.system, self.frames, target, relative_to)[0]
         return self._express(w, frame)
 
-    def angular_acceleration(self, target, frame=None, relative_to=None):
+    def angular_acceleration(self, target: Target, frame: FrameRef = None, relative_to: FrameRef = None) -> Array:
         """Angular acceleration [rad/s^2] (N, 3), in ground or `frame` axes; with `relative_to=f` the
         derivative, taken in f, of w - w_f: alpha - alpha_f - w_f x (w - w_f)."""
         self._need_acc("angular_acceleration")
@@ -193,7 +201,7 @@ class Result:
     def _joint(self, joint) -> Joint:
         return jm.joint_of(self, joint)
 
-    def joint_coordinate(self, joint, kind=None):
+    def joint_coordinate(self, joint: JointRef, kind: str | None = None) -> Array:
         """Joint coordinate, zero in the built configuration, continuous in time (N,) or (N, k):
         revolute angle [rad], translational slide [m], cylindrical [angle, slide], planar [u, v, angle]
         (u, v [m] along the plane axes of `add_planar`, angle [rad] about the normal); spherical,
@@ -202,24 +210,24 @@ class Result:
         cross about axis_i relative to body_i, angle2 of body_j about axis_j relative to the cross)."""
         return jm.coordinate(self, joint, kind)
 
-    def joint_velocity(self, joint, kind=None):
+    def joint_velocity(self, joint: JointRef, kind: str | None = None) -> Array:
         """Rate of the joint coordinate [rad/s or m/s]; for spherical, universal and fixed joints the
         angular velocity of j relative to i [rad/s] in body_i axes; `kind="angles"`: yoke angle rates."""
         return jm.velocity(self, joint, kind)
 
-    def joint_acceleration(self, joint, kind=None):
+    def joint_acceleration(self, joint: JointRef, kind: str | None = None) -> Array:
         """Second derivative of the joint coordinate [rad/s^2 or m/s^2] (planar: [u'', v'', angle''];
         spherical, universal, fixed: the derivative, in body_i axes, of the relative angular velocity;
         `kind="angles"`: yoke angle accelerations)."""
         self._need_acc("joint_acceleration")
         return jm.acceleration(self, joint, kind)
 
-    def reaction_force(self, joint, on=None, frame=None):
+    def reaction_force(self, joint: JointRef, on: BodyRef | None = None, frame: FrameRef = None) -> Array:
         """Force [N] (N, 3) the joint exerts on body `on` (a body, marker or name; default body_j), in
         ground or `frame` axes."""
         return self._reaction(joint, on, frame)[0]
 
-    def reaction_torque(self, joint, on=None, frame=None):
+    def reaction_torque(self, joint: JointRef, on: BodyRef | None = None, frame: FrameRef = None) -> Array:
         """Torque [N m] (N, 3) the joint exerts on body `on`, reduced to the joint point, in ground or
         `frame` axes."""
         return self._reaction(joint, on, frame)[1]
@@ -243,14 +251,14 @@ class Result:
     def sensor_events(self, events):
         self.__dict__["_sensor_events"] = sorted(events, key=lambda e: e.time)
 
-    def coupler_load(self, coupler):
+    def coupler_load(self, coupler: str | Any) -> Array:
         """Load (N, k) a coupler, gear or user constraint transmits along each joint coordinate it couples
         (in the order given): torque [N m] about a rotation's axis, force [N] along a translation's,
         on that joint's body_j.  A gear's tooth force is the torque on a gear over its pitch radius."""
         from ..system.constraints.coupler import coupler_load
         return coupler_load(self, getattr(coupler, "name", coupler))
 
-    def driver_effort(self, motion):
+    def driver_effort(self, motion: str | Any) -> Array:
         """Effort [N m for a rotation, N for a translation] (N,) of a motion driver: the torque about /
         force along the driven joint axis that the driver applies to body_j."""
         if self.lambda_ is None:
@@ -265,19 +273,19 @@ class Result:
             raise ModelError(f"force element {name!r}", "spring", "is not part of the analysed model")
         return forces[name]
 
-    def spring_length(self, spring):
+    def spring_length(self, spring: str | Any) -> Array:
         """Spring length [m] (translational) or angle [rad] (torsional), (N,)."""
         el = self._element(spring)
         return evaluator(el).measure(self.system, self.frames, el)[0] if hasattr(evaluator(el), "measure") \
             else _spring(self, el)[0]
 
-    def spring_velocity(self, spring):
+    def spring_velocity(self, spring: str | Any) -> Array:
         """Rate of spring length [m/s] or angle [rad/s], (N,)."""
         el = self._element(spring)
         return evaluator(el).measure(self.system, self.frames, el)[1] if hasattr(evaluator(el), "measure") \
             else _spring(self, el)[1]
 
-    def spring_force(self, spring):
+    def spring_force(self, spring: str | Any) -> Array:
         """Spring force [N] (tension > 0) or torque [N m], (N,)."""
         el = self._element(spring)
         ev = evaluator(el)
@@ -287,11 +295,11 @@ class Result:
         L, Ld = self.spring_length(el), self.spring_velocity(el)
         return ev.tension(el, L, Ld)
 
-    def kinetic_energy(self):
+    def kinetic_energy(self) -> Array:
         """Total kinetic energy [J], (N,)."""
         return ms.kinetic_energy(self.system, self.frames)
 
-    def potential_energy(self):
+    def potential_energy(self) -> Array:
         """Gravity plus every elastic element's potential energy [J], (N,)."""
         V = ms.gravity_potential(self.system, self.frames)
         for el in self.system.model.forces.values():
@@ -300,24 +308,24 @@ class Result:
                 V = V + ev.potential(self.system, self.frames, el)
         return V
 
-    def dissipated_energy(self):
+    def dissipated_energy(self) -> Array:
         """Energy dissipated by damping, friction and contact since the first sample [J], (N,)."""
         from .energy import dissipated_energy
         return dissipated_energy(self)
 
-    def friction_force(self, friction):
+    def friction_force(self, friction: str | Any) -> Array:
         """Joint friction force [N] (translational) or torque [N m] (revolute) on body_j along / about the
         joint axis, (N,); it opposes the joint's motion (or the impending motion while sticking)."""
         from ..system.force_elements.friction import friction_force
         return friction_force(self, friction)
 
-    def friction_events(self, friction):
+    def friction_events(self, friction: str | Any) -> list[Any]:
         """Stick/slip history of a joint friction element: [(time [s], "stick" or "slip", direction)]."""
         from ..system.force_elements.friction import friction_events
         return friction_events(self, friction)
 
     # ------------------------------------------------------------ events and extrema
-    def crossings(self, signal, value, direction=0):
+    def crossings(self, signal: Signal, value: float, direction: int = 0) -> Array:
         """Times [s] where signal(res) (N,) reaches `value`: direction +1 rising, -1 falling, 0 both.
 
         A sign change between two samples is refined on the dense output (brentq on `at()`); a sample
@@ -339,11 +347,11 @@ class Result:
             out.append(self.time[-1])
         return np.array(sorted(set(out)))
 
-    def maximum(self, signal):
+    def maximum(self, signal: Signal) -> tuple[float, float]:
         """(time [s], value) of the maximum of signal(res), refined on the dense output."""
         return self._extremum(signal, +1)
 
-    def minimum(self, signal):
+    def minimum(self, signal: Signal) -> tuple[float, float]:
         """(time [s], value) of the minimum of signal(res), refined on the dense output."""
         return self._extremum(signal, -1)
 
@@ -370,7 +378,7 @@ class Result:
         return (t, val) if better else (float(self.time[k]), float(sign * y[k]))
 
     # ------------------------------------------------------------ export
-    def to_dataframe(self, markers=False, euler=None):
+    def to_dataframe(self, markers: bool = False, euler: str | None = None) -> pd.DataFrame:
         """Wide pandas DataFrame, one row per output time, SI units in the column names
         ("crank.x [m]", "pin.angle [rad]", "pin.Fx [N]"): body positions, orientations (Euler parameters
         "<body>.qw [-]" ..., and Euler angles "<body>.ZYX_1 [rad]" ... when `euler` names a scipy
@@ -380,11 +388,11 @@ class Result:
         from .export import to_dataframe
         return to_dataframe(self, markers=markers, euler=euler)
 
-    def to_parquet(self, path, markers=False, euler=None):
+    def to_parquet(self, path: PathLike, markers: bool = False, euler: str | None = None) -> None:
         """Write `to_dataframe(markers, euler)` to a Parquet file (pyarrow); read back with pandas."""
         self.to_dataframe(markers=markers, euler=euler).to_parquet(path, index=False)
 
-    def to_csv(self, path, markers=False, euler=None):
+    def to_csv(self, path: PathLike, markers: bool = False, euler: str | None = None) -> None:
         """Write `to_dataframe(markers, euler)` to a CSV file (header = column names, no index)."""
         self.to_dataframe(markers=markers, euler=euler).to_csv(path, index=False)
 

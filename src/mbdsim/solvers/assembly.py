@@ -14,6 +14,10 @@ from .common import (DENSE_LIMIT, active_rows, dependent_owners, increment, inde
                      project_velocities)
 from .held import (changed_items, joint_position_items, kinetic_metric, length_scale, lexi_solve,
                    position_metric, velocity_items)
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
 
 
 class RedundantConstraintWarning(UserWarning):
@@ -82,7 +86,7 @@ def _fmt(x):
 
 
 @blas_single_thread
-def assemble(model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
+def assemble(model: Model, t: float = 0.0, tol: float = 1e-12) -> AssemblyReport:
     """Solve phi(q, t) = 0 and phi_q v = nu from the model's initial values.
 
     Given values (joint initial displacements and velocities, body velocities, drivers) are held exactly

@@ -26,6 +26,11 @@ from .common import _worst_joints, accelerations, normalize, project_positions, 
 from .events import EventTracker
 from .kinematic import check_model, time_grid
 from .state import state_factory
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from .._types import PathLike, Progress
+    from ..model.model import Model
 
 SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, "rk45": integrate.RK45,
                  "radau": integrate.Radau, "bdf": integrate.BDF}
@@ -38,8 +43,9 @@ TIGHT = 1e-6        # "auto" on a model the compiled core does not carry: below 
 
 
 @blas_single_thread
-def simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
-             start_time=0.0, progress=None, out=None) -> Result:
+def simulate(model: Model, end_time: float, output_step: float | None = None, method: str | None = None,
+             rtol: float | None = None, atol: float | None = None, max_step: float | None = None,
+             start_time: float = 0.0, progress: Progress = None, out: PathLike | None = None) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
@@ -280,7 +286,8 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
     except MbdsimError as exc:
         success, message, error = False, f"{exc}; last good output at t = {times[len(out) - 1]:.9g} s", exc
     except KeyboardInterrupt:   # as in the compiled runs: every output before it is kept
-        success, message = False, f"interrupted (KeyboardInterrupt); last good output at t = {times[len(out) - 1]:.9g} s"
+        success = False
+        message = f"interrupted (KeyboardInterrupt); last good output at t = {times[len(out) - 1]:.9g} s"
         error = SolverError("interrupted (KeyboardInterrupt)", time=float(times[len(out) - 1]))
     n = len(out)
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],

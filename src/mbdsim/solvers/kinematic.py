@@ -18,6 +18,11 @@ from ..system.frames import body_frames
 from .assembly import assemble_state
 from .common import DENSE_LIMIT, increment, project_positions
 from .state import state_factory
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
+    from .._types import PathLike, Progress
 
 
 SINGULAR_TOL = 1e-4   # relative conditioning of the scaled constraint Jacobian flagged as singular
@@ -29,7 +34,8 @@ class SingularConfigurationWarning(UserWarning):
 
 
 @blas_single_thread
-def kinematics(model, end_time, output_step=None, start_time=0.0, progress=None, out=None) -> Result:
+def kinematics(model: Model, end_time: float, output_step: float | None = None, start_time: float = 0.0,
+               progress: Progress = None, out: PathLike | None = None) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
 
     progress: optional callable progress(t) receiving the time reached [s] after each sample; Ctrl-C
@@ -75,7 +81,8 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
             break
         except KeyboardInterrupt:
             success, error = False, SolverError("interrupted (KeyboardInterrupt)", time=float(t))
-            message = f"interrupted (KeyboardInterrupt); last good state at t = {out[-1][0] if out else start_time:.9g} s"
+            last = out[-1][0] if out else start_time
+            message = f"interrupted (KeyboardInterrupt); last good state at t = {last:.9g} s"
             break
         out.append(state)
         flags.append(cond < SINGULAR_TOL)

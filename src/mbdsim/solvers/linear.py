@@ -55,6 +55,14 @@ from .common import increment, independent_rows, project_positions
 from .linear_modes import mode_shape_table, modes_table
 from .reduced import Chart, length_scale, min_norm, tangent_basis, velocity_scale
 from .state import state_factory
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
+    from .._types import Signal
+    from typing import Sequence
+    from typing import Any
+    import pandas as pd
 
 FD_REL = 1e-5
 
@@ -102,7 +110,7 @@ class Linearization:
         lam = np.linalg.eigvals(A) if A.size else np.zeros(0, complex)
         return lam[np.argsort(np.abs(lam), kind="stable")]
 
-    def modes(self, zero_tol=None):
+    def modes(self, zero_tol: float | None = None) -> pd.DataFrame:
         """pandas DataFrame, one row per mode, by increasing frequency: `eigenvalue` [rad/s],
         `frequency [Hz]` (undamped natural |lambda| / 2 pi), `damped frequency [Hz]` (|Im lambda| / 2 pi),
         `damping ratio` (-Re lambda / |lambda|: 0 undamped, 1 critically or over-damped real root, < 0
@@ -111,20 +119,21 @@ class Linearization:
         rigid-body modes at zero frequency (a free coordinate has a double zero eigenvalue)."""
         return modes_table(self, zero_tol)[0]
 
-    def mode_shape(self, i, zero_tol=None):
+    def mode_shape(self, i: int, zero_tol: float | None = None) -> pd.DataFrame:
         """Motion of every body in mode i (row i of `modes()`): DataFrame indexed by body, columns
         x, y, z [m] (CM displacement) and rx, ry, rz [rad] (rotation vector), ground axes, complex
         (magnitude and phase), scaled so that the largest entry is 1 (rotations count with the model's
         length scale)."""
         return mode_shape_table(self, i, zero_tol)
 
-    def to_scipy(self):
+    def to_scipy(self) -> Any:
         """The state-space model as a `scipy.signal.StateSpace`."""
         from scipy.signal import StateSpace
         return StateSpace(self.A, self.B, self.C, self.D)
 
 
-def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
+def linearize(model: Model, at: None | str | Result | tuple[Result, float] = None, inputs: str | Sequence[str] = (),
+              outputs: Signal | Sequence[Signal] | dict[str, Signal] = ()) -> Linearization:
     """Linearize the equations of motion of `model` about an operating point.
 
     at: None (the assembled initial state at t = 0), "equilibrium" (static equilibrium first,
@@ -132,8 +141,9 @@ def linearize(model, at=None, inputs=(), outputs=()) -> Linearization:
     inputs: names of `add_force` / `add_torque` elements ("f" for its three components, "f.x" for one; in
     the element's axes, ground when it has none) [N, N m], or of motions (the acceleration [rad/s^2 or
     m/s^2] added to the driven coordinate; each adds two states, the displacement and rate offsets, after
-    the mechanical ones). outputs: callables of a Result returning one sample (e.g.
-    `lambda r: r.position(tip)[:, 1]`), or a dict name -> callable. See the module docstring for the
+    the mechanical ones). outputs: Result measures: callables of a Result returning one sample (e.g.
+    `lambda r: r.position(tip)[:, 1]`), column names of `res.to_dataframe()` ("tip.y", "pin.angle"; matched
+    as by `mb.plot`) or ("label [unit]", callable) pairs, in a sequence or a dict name -> measure. See the module docstring for the
     coordinates and the finite-difference steps."""
     sys, q0, v0, t0 = _operating_point(model, at)
     _, J, _, _ = constraint_terms(sys, q0, v0, t0)
@@ -371,16 +381,36 @@ def _unit_load(sys, fr, t, inp, size=1.0):
 
 # ----------------------------------------------------------------------------- outputs
 def _outputs(outputs):
-    if callable(outputs):
+    """(callables of a Result, names) of the outputs: callables, column names of `res.to_dataframe()`
+    ("slider.x", matched as by mb.plot) or ("label [unit]", callable) pairs, in a sequence or a dict."""
+    if callable(outputs) or isinstance(outputs, str) or _is_pair(outputs):
         outputs = (outputs,)
     if isinstance(outputs, dict):
         items = list(outputs.items())
     else:
-        items = [(f"y{k}", f) for k, f in enumerate(outputs)]
+        items = [(f if isinstance(f, str) else f[0] if _is_pair(f) else f"y{k}", f) for k, f in enumerate(outputs)]
+    fns = []
     for name, f in items:
-        if not callable(f):
-            raise ModelError("linearize", "outputs", f"output {name!r} must be a callable of a Result, got {f!r}")
-    return [f for _, f in items], [n for n, _ in items]
+        if isinstance(f, str) or _is_pair(f):
+            fns.append(lambda r, spec=f: _signal(r, spec))
+        elif callable(f):
+            fns.append(f)
+        else:
+            raise ModelError("linearize", "outputs", f"output {name!r} must be a callable of a Result, a column "
+                             f"name of res.to_dataframe() or a ('label [unit]', callable) pair, got {f!r}")
+    return fns, [n for n, _ in items]
+
+
+def _is_pair(f) -> bool:
+    return isinstance(f, tuple) and len(f) == 2 and isinstance(f[0], str) and callable(f[1])
+
+
+def _signal(res, spec):
+    from ..plotting import resolve
+    try:
+        return resolve(res, spec).values
+    except ModelError as exc:
+        raise ModelError("linearize", "outputs", str(exc)) from None
 
 
 def _measure(sys, t, fns, st):

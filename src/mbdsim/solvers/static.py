@@ -39,6 +39,10 @@ from .assembly import assemble_state
 from .common import project_positions
 from .reduced import Chart, describe_direction, length_scale, tangent_basis, tangent_residual, velocity_scale
 from .state import state_factory
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
 
 DELTA_MAX = 1.0     # largest trust radius: 1 rad of rotation or L of translation per step
 FD_STEP = 1e-6      # central-difference step of the reduced stiffness (dimensionless z)
@@ -67,7 +71,7 @@ class StaticSolution:
 
 
 @blas_single_thread
-def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
+def equilibrium(model: Model, t: float = 0.0, tol: float = 1e-10, maxit: int = 100) -> Result:
     """Static equilibrium at time t [s] (motions at their value at t, velocities zero).
 
     Starts from the assembled initial configuration and descends to a stable equilibrium (see the module
@@ -85,7 +89,8 @@ def equilibrium(model, t=0.0, tol=1e-10, maxit=100) -> Result:
 
 
 @blas_single_thread
-def quasi_static(model, end_time, output_step=None, start_time=0.0, tol=1e-10, maxit=100) -> Result:
+def quasi_static(model: Model, end_time: float, output_step: float | None = None, start_time: float = 0.0,
+                 tol: float = 1e-10, maxit: int = 100) -> Result:
     """Quasi-static analysis: the static equilibrium at each output time from start_time to end_time [s]
     (every output_step [s]) of a mechanism whose motions move it; each solve starts from the previous one.
 

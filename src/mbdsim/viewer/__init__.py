@@ -12,6 +12,14 @@ from ..errors import ModelError
 from .page import THREE_VERSION, build_page
 from ..plotting import TIME_COLUMN, match_column
 from .scene import MAX_FRAMES, Scene, build_scene, scene_from_table
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from ..model.model import Model
+    from .._types import PathLike
+    from typing import Any
+    import pandas as pd
+    from ..results.result import Result
 
 __all__ = ["animate", "build_page", "build_scene", "Scene", "MAX_FRAMES", "THREE_VERSION", "default_signal"]
 
@@ -52,8 +60,9 @@ def _end_time(end_time) -> float:
     return end
 
 
-def animate(res_or_model, path="anim.html", signal="auto", end_time=None, geometry=None,
-            max_frames: int = MAX_FRAMES, title: str | None = None) -> Path:
+def animate(res_or_model: Result | Model | pd.DataFrame, path: PathLike = "anim.html", signal: str | None = "auto",
+            end_time: float | None = None, geometry: dict[str, Any] | None = None, max_frames: int = MAX_FRAMES,
+            title: str | None = None) -> Path:
     """Write a self-contained HTML page playing a Result (a Model is simulated first, over `end_time` [s],
     default 2 s, 1000 output steps; a DataFrame from `res.to_dataframe()` shows its bodies' centres of mass
     as spheres) and return its path.
