@@ -47,8 +47,9 @@ def test_info_lists_bodies_joints_dof_drivers_and_elements():
         assert words in r.output
     lines = {ln.split("│")[1].strip(): ln.split("│")[2].strip() for ln in r.output.splitlines()
              if ln.count("│") == 3}
-    assert lines["DOF (Gruebler)"] == "-3" and lines["DOF (rank)"] == "0"   # planar loop of 3D revolutes
-    assert lines["redundant constraints"].startswith("3")
+    # planar loop of 3D revolutes, flagged planar: 6*3 - 5*4 - 1 = -3 in space, 3*3 - 2*4 - 1 = 0 in the plane
+    assert lines["DOF (Gruebler)"] == "-3 (planar count: 0)" and lines["DOF (rank)"] == "0"
+    assert lines["redundant constraints"].startswith("0 (3 out-of-plane")
     r = invoke("info", EXAMPLES / "quarter_car.yaml")
     assert "suspension" in r.output and "SpringDamper" in r.output
 
