@@ -178,3 +178,13 @@ def test_planar_models_are_counted_in_the_plane_and_not_called_redundant():
     m.add_gear("mesh", "ja", "jb", -2.0)
     s = summarize(m)
     assert s.gruebler_dof == 12 - 10 - 1 and s.planar_dof is None
+
+
+def test_cold_kernel_cache_is_announced(tmp_path, monkeypatch):
+    from mbdsim import _jitcache
+    from mbdsim.cli.run_cmds import _kernels_cold
+    monkeypatch.setattr(_jitcache, "CACHE_DIR", str(tmp_path))
+    assert _kernels_cold()
+    (tmp_path / "solvers_abc").mkdir()
+    (tmp_path / "solvers_abc" / "fastdop.run-145.py311.nbi").write_bytes(b"")
+    assert not _kernels_cold()

@@ -127,6 +127,9 @@ def _run(path, end, step, method, rtol, out):
 
     from mbdsim.io.summary import summarize
     m = _load(path)
+    if _kernels_cold():
+        _console().print("note: first run of this mbdsim version: compiling its numba kernels (once, cached "
+                         "on disk; a few minutes on a slow machine)")
     summary = summarize(m)
     dof, n_redundant, redundant = _rank_dof(m)
     console = _console()
@@ -150,6 +153,15 @@ def _run(path, end, step, method, rtol, out):
     if not res.success:
         interrupted = "KeyboardInterrupt" in str(getattr(res, "error", ""))
         raise typer.Exit(EXIT_INTERRUPTED if interrupted else EXIT_FAILED)
+
+
+def _kernels_cold() -> bool:
+    """True when the on-disk cache of this version's compiled kernels is empty (mbdsim._jitcache)."""
+    try:
+        from mbdsim import _jitcache
+        return not any(Path(_jitcache.CACHE_DIR).rglob("*.nbi"))
+    except Exception:  # noqa: BLE001 - only a notice
+        return False
 
 
 def _writable(out: Optional[Path]) -> Optional[Path]:

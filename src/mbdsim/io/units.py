@@ -31,8 +31,10 @@ class UnitError(ValueError):
 def registry():
     """The one pint UnitRegistry of mbdsim (created lazily; 'rpm' is revolutions per minute)."""
     import pint
-    ureg = pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
-    return ureg
+    try:    # pint's parsed definitions cached on disk (~/.cache/pint): about 10x faster after the first time
+        return pint.UnitRegistry(autoconvert_offset_to_baseunit=True, cache_folder=":auto:")
+    except Exception:  # noqa: BLE001 - no writable cache (or an older pint): parse the definitions
+        return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
 def dimension_name(unit: str) -> str:
