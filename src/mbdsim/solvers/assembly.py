@@ -112,7 +112,8 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     except AssemblyError:
         _overdriven_failure(sys, q0, t, rows_all, tol)
         raise
-    J = constraint_terms(sys, q, v0, t)[1][rows_all]
+    terms = constraint_terms(sys, q, np.zeros(sys.nv), t)   # phi, phi_q and nu do not depend on v
+    J = terms[1][rows_all]
     rows = independent_rows(J, sys=sys)
     _check_overdriven(sys, J, rows, t, q)
     redundant = dependent_owners(sys, J, rows)
@@ -126,7 +127,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
                       "indeterminate reaction components are returned as the minimum-norm solution.",
                       RedundantConstraintWarning, stacklevel=3)
     if v0 is sys.v0:
-        v, vchanged = velocities(sys, q, t, rows)
+        v, vchanged = velocities(sys, q, t, rows, terms)
         changed += vchanged
         vmoved = {e.split("'")[1]: float(np.linalg.norm(u - g)) for e, f, g, u in vchanged if e.startswith("body")}
     else:
@@ -136,7 +137,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         warnings.warn("initial values not consistent with the joints and drivers were changed (kinetic-"
                       "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)}"
                                                   for e, f, g, u in changed), InitialConditionWarning, stacklevel=3)
-    phi = constraint_terms(sys, q, v, t, False)[0][rows_all]
+    phi = terms[0][rows_all]
     notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
     notes += [planar_note] if planar_note else []
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
@@ -255,10 +256,11 @@ def _check_overdriven(sys, J, rows, t, q):
 
 
 # ------------------------------------------------------------------------------ velocities
-def velocities(sys, q, t, rows):
+def velocities(sys, q, t, rows, terms=None):
     """Velocities holding the given values (fitted in the kinetic-energy metric when inconsistent),
-    the rest of least kinetic energy.  Returns (v, changed items)."""
-    _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
+    the rest of least kinetic energy; `terms`: constraint_terms at (q, t) when already computed.
+    Returns (v, changed items)."""
+    _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t) if terms is None else terms
     rows = active_rows(sys, rows, t)
     items = velocity_items(sys, q)
     if sys.nv > DENSE_LIMIT:
@@ -285,6 +287,8 @@ def _velocities_sparse(sys, q, t, rows, J, nu, items):
 
 def _moved(sys, q0, q):
     """{body name: (CM shift [m], rotation angle [rad])} of the bodies assembly moved (beyond 1e-10)."""
+    if q is q0:   # Newton took no step
+        return {}
     L = length_scale(sys)
     dr = np.sqrt(((q[sys.r_idx] - q0[sys.r_idx]) ** 2).sum(-1))
     da = np.zeros(len(sys.bodies))

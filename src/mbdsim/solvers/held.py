@@ -42,6 +42,23 @@ class Held:
 
 
 # ------------------------------------------------------------------------------ metrics
+def _cached(name):
+    """Memoise a function of the System alone in sys.derived (arrays returned read-only)."""
+    def deco(fn):
+        def wrapper(sys):
+            out = sys.derived.get(name)
+            if out is None:
+                out = fn(sys)
+                if isinstance(out, np.ndarray):
+                    out.setflags(write=False)
+                sys.derived[name] = out
+            return out
+        wrapper.__name__, wrapper.__doc__ = fn.__name__, fn.__doc__
+        return wrapper
+    return deco
+
+
+@_cached("length_scale")
 def length_scale(sys) -> float:
     """Characteristic length of the model [m]: the largest distance of a joint point or marker from
     its body's CM, else the largest CM distance from the origin, else 1."""
@@ -55,6 +72,7 @@ def length_scale(sys) -> float:
     return float(d.max()) if len(d) else 1.0
 
 
+@_cached("position_metric")
 def position_metric(sys) -> np.ndarray:
     """Diagonal weights (nv,) of a position increment: each body's mass for its CM shift [kg] and its
     principal-axis moments (floored at 1e-2 m L^2) for its rotation [kg m^2]; massless bodies weigh
@@ -72,6 +90,7 @@ def position_metric(sys) -> np.ndarray:
     return D
 
 
+@_cached("kinetic_metric")
 def kinetic_metric(sys) -> np.ndarray:
     """The mass matrix, with the position weights standing in where it has no mass (massless bodies,
     zero moments of slender rods, curve parameters), so that it is positive definite."""

@@ -47,9 +47,9 @@ def _why_not(sys, rows) -> str | None:
         return "joints other than revolute, translational and fixed"
     if len(model.joints) != len(sys.bodies):
         return "not a tree of joints (loops or free bodies)"
-    for k, b in enumerate(sys.bodies):
-        if np.linalg.eigvalsh(np.asarray(b.inertia, float)).min() <= 0 or b.mass <= 0:
-            return "a body without positive mass and inertia"
+    if sys.bodies and (min(b.mass for b in sys.bodies) <= 0 or
+                       np.linalg.eigvalsh(np.array([b.inertia for b in sys.bodies], float)).min() <= 0):
+        return "a body without positive mass and inertia"
     return None
 
 
