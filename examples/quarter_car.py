@@ -13,9 +13,11 @@ M_BODY, M_WHEEL, K_SUSP, C_SUSP, K_TYRE, G = 250.0, 35.0, 16000.0, 1000.0, 16000
 def build() -> mb.Model:
     """z up; road platform at z = 0, wheel centre at 0.3 m, body at 0.7 m."""
     model = mb.Model("quarter_car", gravity=(0, 0, -G))
-    road = model.add_body("road", mass=10.0, inertia=(1.0, 1.0, 1.0), position=(0, 0, 0))
-    wheel = model.add_body("wheel", mass=M_WHEEL, inertia=(1.0, 1.5, 1.0), position=(0, 0, 0.3))
-    body = model.add_body("body", mass=M_BODY, inertia=(20.0, 20.0, 30.0), position=(0, 0, 0.7))
+    # inertias of solid boxes (drawn so by the viewer): road plate 0.4 x 0.4 x 0.05 m, wheel 0.44 x 0.2 x
+    # 0.44 m, body 0.6 x 0.6 x 0.3 m; every joint is translational, so rotation plays no part
+    road = model.add_body("road", mass=10.0, inertia=(0.135417, 0.135417, 0.266667), position=(0, 0, 0))
+    wheel = model.add_body("wheel", mass=M_WHEEL, inertia=(0.681333, 1.129333, 0.681333), position=(0, 0, 0.3))
+    body = model.add_body("body", mass=M_BODY, inertia=(9.375, 9.375, 15.0), position=(0, 0, 0.7))
     for name, b in (("road_guide", road), ("wheel_guide", wheel), ("body_guide", body)):
         model.add_translational(name, model.ground, b, point=b.position, axis=(0, 0, 1))
     model.add_motion("road_profile", "road_guide", displacement="0.05*STEP(t, 0.5, 0, 0.6, 1)")
