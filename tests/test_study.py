@@ -214,6 +214,7 @@ def test_lost_tasks_are_reported_not_stored(tmp_path):
     first, second = chunks_of(study.design, 2)
     sink.add(run_chunk(study.plan, first))
     sink.add(_lost_rows(study, second, RuntimeError("worker died three times")), keep=False)
+    sink.close()
     df = sink.frame(study)
     assert list(df.status) == ["ok", "ok", "lost"] and "worker died" in df.message[2]
     assert sorted(pd.read_parquet(out).run) == [0, 1]
@@ -271,3 +272,30 @@ def test_grid_refinement_matches_result_searches():
         n_calls = len(calls)
         ref = res.maximum(signals["F"])
         assert got[1] == pytest.approx(ref[1], rel=1e-13) and n_calls <= 2, (p, got, ref, n_calls)
+
+
+def test_row_store_journal_keeps_every_finished_row(tmp_path):
+    """Rows go to the journal at once and to the Parquet file every FLUSH_INTERVAL: a study killed between
+    two Parquet writes (close never called) loses no row; a half-written journal line is skipped; close
+    folds the journal into the Parquet file and removes it."""
+    from mbdsim.studies.store import RowStore, journal_path, load_rows
+    out = tmp_path / "r.parquet"
+    row = lambda k: pd.DataFrame([{"run": k, "x": 0.1 * k, "y": math.nan if k == 2 else k**2,  # noqa: E731
+                                   "status": "ok", "message": "ok", "study_id": "abc"}])
+    store = RowStore(out, None, interval=3600.0)
+    for k in range(4):
+        store.append(row(k))
+    assert not out.exists() and journal_path(out).exists()               # nothing rewritten yet
+    with open(journal_path(out), "a") as fh:
+        fh.write('{"run": 9, "x": 0.')                                    # killed mid-line
+    got = load_rows(out, "abc")
+    assert list(got.run) == [0, 1, 2, 3] and got.x.tolist() == [0.0, 0.1, 0.2, 0.1 * 3]
+    assert math.isnan(got.y[2]) and got.y[3] == 9.0
+    with pytest.raises(ModelError, match="another study"):
+        load_rows(out, "other")
+    store2 = RowStore(out, got, interval=3600.0)                           # the resumed run
+    assert len(pd.read_parquet(out)) == 4 and journal_path(out).stat().st_size == 0   # journal folded in
+    store2.append(row(4))
+    assert list(load_rows(out, "abc").run) == [0, 1, 2, 3, 4]
+    store2.close()
+    assert not journal_path(out).exists() and list(load_rows(out, "abc").run) == [0, 1, 2, 3, 4]

@@ -4,7 +4,7 @@
                             [--chunk N] [--plots DIR] [--debug]
 
 Runs every variant (a LocalCluster of N worker processes, default 2; --workers 0 runs in this process;
---scheduler uses a running Dask scheduler), writes the rows to the Parquet file as they arrive (default
+--scheduler uses a running Dask scheduler), journals the rows as they arrive and writes the Parquet file (default
 STUDY_results.parquet; a re-run with the same file does only the missing runs), then prints the status
 counts, each output's range and the sensitivity table (standardised regression coefficients).
 Exit status: 0 at least one run succeeded, 1 none did, 2 bad study or model file, 130 interrupted.

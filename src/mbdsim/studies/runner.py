@@ -1,16 +1,18 @@
-"""Running a study: chunks of variants as dask.distributed tasks (or in this process), rows written to
-Parquet as they arrive, finished runs skipped on a re-run, lost tasks reported instead of crashing."""
+"""Running a study: chunks of variants as dask.distributed tasks (or in this process), rows journaled as
+they arrive and written to Parquet (mbdsim.studies.store), finished runs skipped on a re-run, lost tasks
+reported instead of crashing."""
 from __future__ import annotations
 
 import logging
 import math
+import os
 import sys
 from contextlib import contextmanager
 
 import pandas as pd
 
 from ..errors import ModelError
-from .store import STUDY_COLUMN, load_rows, write_rows
+from .store import STUDY_COLUMN, RowStore, load_rows
 from .variant import run_chunk
 
 __all__ = ["execute", "chunks_of", "default_chunk_size"]
@@ -27,9 +29,26 @@ def chunks_of(design: pd.DataFrame, size: int) -> list[list]:
     return [records[k:k + size] for k in range(0, len(records), size)]
 
 
+def start_method() -> str:
+    """How a LocalCluster started by a study makes its worker processes: 'fork' on Linux, so that each
+    worker inherits this process's imports and loaded kernels (seconds per worker otherwise, more on
+    shared cores), else Dask's setting; the environment variable MBDSIM_STUDY_START_METHOD ('spawn',
+    'fork' or 'forkserver') overrides."""
+    import dask
+    env = os.environ.get("MBDSIM_STUDY_START_METHOD", "").strip()
+    if env:
+        if env not in ("spawn", "fork", "forkserver"):
+            raise ModelError("study", "MBDSIM_STUDY_START_METHOD", f"expected spawn, fork or forkserver, got {env!r}")
+        return env
+    if sys.platform.startswith("linux"):
+        return "fork"
+    return dask.config.get("distributed.worker.multiprocessing-method")
+
+
 @contextmanager
 def _client(client, workers):
     """A Client: the given one, one connected to an address, or a LocalCluster for this run (closed after)."""
+    import dask
     from distributed import Client, LocalCluster
     if client is not None and not isinstance(client, str):
         yield client
@@ -38,20 +57,27 @@ def _client(client, workers):
         with Client(client, timeout="30s") as c:
             yield c
         return
-    n = 2 if workers is None else int(workers)
-    if n < 1:
-        raise ModelError("study", "workers", f"expected a positive number of workers (0: no Dask), got {workers!r}")
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
-                      silence_logs=logging.ERROR) as cluster, Client(cluster) as c:
+    n = _local_workers(workers)
+    with dask.config.set({"distributed.worker.multiprocessing-method": start_method()}), \
+            LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+                         silence_logs=logging.ERROR) as cluster, Client(cluster) as c:
         yield c
 
 
+def _local_workers(workers) -> int:
+    n = 2 if workers is None else int(workers)
+    if n < 1:
+        raise ModelError("study", "workers", f"expected a positive number of workers (0: no Dask), got {workers!r}")
+    return n
+
+
 class _Sink:
-    """Collects rows; rewrites the output file after each chunk (atomic) when there is one."""
+    """Collects rows; stores those of finished runs (not 'lost' ones) through a RowStore."""
 
     def __init__(self, study, out, previous):
-        self.study_id, self.out = study.study_id, out
+        self.study_id = study.study_id
         self.frames = [] if previous is None else [previous]
+        self.store = RowStore(out, previous)
         self.executed = 0
 
     def add(self, rows: list[dict], keep: bool = True):
@@ -59,9 +85,11 @@ class _Sink:
         df[STUDY_COLUMN] = self.study_id
         self.frames.append(df)
         self.executed += len(rows)
-        if self.out is not None and keep:
-            write_rows(self.out, pd.concat([f for f in self.frames if f["status"].ne("lost").all()],
-                                           ignore_index=True))
+        if keep:
+            self.store.append(df)
+
+    def close(self):
+        self.store.close()
 
     def frame(self, study) -> pd.DataFrame:
         cols = ["run", *study.design.columns, *study.plan.outputs, "status", "message", "wall_time", "worker"]
@@ -98,20 +126,32 @@ def execute(study, client=None, workers=None, out=None, chunk_size=None, progres
     sink = _Sink(study, out, previous)
     bar, task = _progress(progress, len(study.design), len(study.design) - len(pending))
     serial = workers == 0 and client is None
-    with bar:
-        if len(pending) == 0:
-            pass
-        elif serial:
-            for chunk in chunks_of(pending, chunk_size or 1):
-                sink.add(run_chunk(study.plan, chunk))
-                bar.advance(task, len(chunk))
-        else:
-            _run_dask(study, pending, client, workers, chunk_size, sink, lambda n: bar.advance(task, n))
+    try:
+        with bar:
+            if len(pending) == 0:
+                pass
+            elif serial:
+                for chunk in chunks_of(pending, chunk_size or 1):
+                    sink.add(run_chunk(study.plan, chunk))
+                    bar.advance(task, len(chunk))
+            else:
+                _run_dask(study, pending, client, workers, chunk_size, sink, lambda n: bar.advance(task, n))
+    finally:
+        sink.close()       # every finished row into the Parquet file, also after Ctrl-C or an error
     return sink.frame(study)
 
 
 def _run_dask(study, pending, client, workers, chunk_size, sink, advance):
     from distributed import as_completed
+    if client is None and start_method() == "fork":
+        _local_workers(workers)
+        # the first run here, before the workers are forked: they inherit its imports and loaded kernels
+        first = chunks_of(pending.iloc[:1], 1)[0]
+        sink.add(run_chunk(study.plan, first))
+        advance(1)
+        pending = pending.iloc[1:]
+        if not len(pending):
+            return
     with _client(client, workers) as c:
         n_workers = max(1, len(c.scheduler_info().get("workers", {})) or (workers or 1))
         chunks = chunks_of(pending, chunk_size or default_chunk_size(len(pending), n_workers))

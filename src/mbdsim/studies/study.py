@@ -157,8 +157,10 @@ class Study:
 
         client: a dask.distributed Client or a scheduler address ('tcp://host:8786'); None starts a
         LocalCluster of `workers` processes (default 2) for this run.  workers=0 runs in this process
-        without Dask.  out: a Parquet file the rows are written to as they arrive; when it already holds
-        rows of this study, those runs are skipped (a killed study resumes).  progress: a progress bar
+        without Dask.  out: a Parquet file for the rows: each row is appended to its journal
+        ('.NAME.journal' beside it) as it arrives, the file is rewritten every few seconds and at the end;
+        when the file (or a journal left by a killed run) already holds rows of this study, those runs are
+        skipped (a killed study resumes, losing no finished run).  progress: a progress bar
         on stderr (default: when stderr is a terminal).  df.attrs['executed'] counts the runs done now."""
         from .runner import execute
         return execute(self, client=client, workers=workers, out=out,
