@@ -347,3 +347,20 @@ def test_outputs_named_by_result_columns():
     with pytest.raises(mb.ModelError) as err:
         mb.linearize(model, outputs=["nothing.x"])
     assert err.value.field == "outputs"
+
+
+def test_a_row_of_modes_gives_real_numbers():
+    """I th'' + c th' + k th = 0 on a torsion spring: each row's frequency and damping ratio are floats."""
+    import math
+    I, k, c = 0.2, 50.0, 0.8
+    model = mb.Model("torsion")
+    disk = model.add_body("disk", 3.0, inertia=(0.1, 0.1, I))
+    model.add_revolute("axle", model.ground, disk, (0, 0, 0), (0, 0, 1))
+    model.add_torsion_spring("ks", "axle", k, damping=c)
+    df = mb.linearize(model).modes()
+    row = df.iloc[0]
+    assert isinstance(row["frequency [Hz]"], float) and isinstance(row["damping ratio"], float)
+    assert math.isclose(row["frequency [Hz]"], hz(np.sqrt(k / I)), rel_tol=1e-8)
+    assert math.isclose(row["damping ratio"], c / (2 * np.sqrt(k * I)), rel_tol=1e-8)
+    assert row["eigenvalue"] == pytest.approx(complex(-c / (2 * I), np.sqrt(k / I - (c / (2 * I)) ** 2)), rel=1e-8)
+    assert df["frequency [Hz]"].dtype == float

@@ -63,6 +63,9 @@ def modes_table(lin, zero_tol=None):
                      "damped frequency [Hz]": abs(lam.imag) / (2 * np.pi),
                      "damping ratio": _clean(-lam.real / wn) if wn > 0 else np.nan})
     df = pd.DataFrame(rows, columns=["eigenvalue", "frequency [Hz]", "damped frequency [Hz]", "damping ratio"])
+    # complex eigenvalues as Python objects: a row (df.iloc[i]) then keeps real floats for the other
+    # columns instead of upcasting them all to complex
+    df["eigenvalue"] = pd.Series([complex(x) for x in df["eigenvalue"]], index=df.index, dtype=object)
     df.index.name = "mode"
     return df, ml
 
