@@ -148,3 +148,50 @@ def test_remote_scheduler_and_a_killed_worker(tmp_path):
             except subprocess.TimeoutExpired:
                 p.kill()
         log.close()
+
+
+KILLED_RUN = """
+import sys, warnings
+import numpy as np
+import mbdsim as mb
+from mbdsim.studies.models import slider_crank
+warnings.simplefilter("ignore")
+cranks = list(np.linspace(0.1, 0.2, 199)) + [0.5]
+study = mb.Study(slider_crank, {"crank": cranks}, %r, analysis=%r)
+study.run(workers=2, out=sys.argv[1], chunk_size=4, progress=False)
+"""
+
+
+def test_200_variants_two_workers_failing_row_killed_resumed_identical_to_serial(tmp_path):
+    """The issue's demonstration: 200 slider-cranks on a LocalCluster of 2 workers, one of them (crank 0.5 m >
+    rod 0.4 m) locking up; the study is killed mid-way (SIGKILL of the process and its workers) and re-run
+    with the same file: only the missing runs execute, the table is complete, the failing variant is a
+    row with its error, and every output equals a serial run of the same variants bit for bit."""
+    analysis = {"end_time": 0.3, "output_step": 0.01, "rtol": 1e-6}
+    out = tmp_path / "r.parquet"
+    proc = subprocess.Popen([sys.executable, "-c", KILLED_RUN % (OUT, analysis), str(out)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    cranks = list(np.linspace(0.1, 0.2, 199)) + [0.5]
+    study = mb.Study(slider_crank, {"crank": cranks}, OUT, analysis=analysis)
+    try:
+        deadline = time.time() + 300
+        while len(_stored(out)) < 30 and time.time() < deadline and proc.poll() is None:
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)       # the study and its forked workers
+        proc.wait(10)
+    before = _stored(out, study.study_id)
+    assert 30 <= len(before) < 200, "the study was not killed mid-way"
+    df = study.run(workers=2, out=out, progress=False)
+    assert df.attrs["executed"] == 200 - len(before) and list(df.run) == list(range(200))
+    assert len(pd.read_parquet(out)) == 200
+    kept = df.set_index("run").loc[before.run]
+    assert kept.wall_time.tolist() == before.wall_time.tolist()          # not run again
+    bad = df[df.crank == 0.5]
+    assert len(bad) == 1 and bad.status.iloc[0] == "failed" and "joints involved" in bad.message.iloc[0]
+    assert (df[df.crank < 0.5].status == "ok").all()
+    serial = study.run(workers=0, progress=False)
+    cols = [c for c in SAME if c != "rod"]
+    pd.testing.assert_frame_equal(df[cols], serial[cols])
+    r, w = df.crank[df.crank < 0.5], 2 * np.pi
+    assert np.allclose(df.amax[df.crank < 0.5], r * w**2 * (1 + r / 0.4), rtol=1e-8)
