@@ -107,9 +107,8 @@ def test_bad_mass_properties_name_body_and_field(kwargs, field):
     assert err.value.entity == "body 'blk'" and err.value.field == field
 
 
-def test_impossible_inertia_warns_in_the_api_and_fails_in_a_file():
-    from mbdsim.model._check import InertiaWarning
-    with pytest.warns(InertiaWarning, match=r"body 'blk'.inertia: principal moments 1, 1, 2.5"):
+def test_impossible_inertia_fails_in_the_api_and_in_a_file():
+    with pytest.raises(ModelError, match=r"body 'blk'.inertia: principal moments 1, 1, 2.5"):
         mb.Model().add_body("blk", mass=1.0, inertia=(1.0, 1.0, 2.5))
     with pytest.raises(mb.ModelFileError, match=r"body 'blk'.inertia: .*triangle inequality"):
         model_from_dict({"bodies": [{"name": "blk", "mass": 1, "inertia": [1, 1, 2.5]}]})

@@ -40,3 +40,16 @@ class AssemblyError(_TimedError):
 
 class SolverError(_TimedError):
     """A solver failed (lock-up, singular equations, step size underflow)."""
+
+
+class EvaluationError(SolverError):
+    """A user function or expression failed during an analysis (raised, returned a non-number or a
+    non-finite value): names the element (`entity`), its `field` and the time [s]."""
+
+    def __init__(self, entity: str, field: str, message: str, time: float | None = None):
+        self.entity, self.field = entity, field
+        super().__init__(f"{entity}.{field}: {message}", time=time)
+
+
+class AnalysisInterrupted(SolverError):
+    """The analysis was interrupted (KeyboardInterrupt): the Result keeps every output before it."""

@@ -31,6 +31,23 @@ __all__ = ["ExpressionError", "Expr", "parse", "FUNCTIONS", "LIBRARY_FUNCTIONS",
            "TimeFunction", "time_function", "integrated", "double_integrated"]
 
 MAX_LENGTH, MAX_DEPTH, MAX_ORDER = 10_000, 200, 20
+MAX_NODES = 20_000   # operations of an expression or of its derivatives: evaluation cost stays bounded
+
+
+def tree_size(node, limit: int = MAX_NODES) -> int:
+    """Operations in the expression tree `node` counted as evaluated (shared sub-trees count every time
+    they occur), stopping once past `limit`: linear in the number of distinct nodes."""
+    memo: dict[int, int] = {}
+    stack = [(node, False)]
+    while stack:
+        n, done = stack.pop()
+        kids = (n.a, n.b) if hasattr(n, "b") else (n.a,) if hasattr(n, "a") else tuple(getattr(n, "args", ()))
+        if done:
+            memo[id(n)] = min(limit + 1, 1 + sum(memo[id(k)] for k in kids))
+        elif id(n) not in memo:
+            stack.append((n, True))
+            stack.extend((k, False) for k in kids if id(k) not in memo)
+    return memo[id(node)]
 
 
 # ----------------------------------------------------------------------------- Expr
@@ -75,8 +92,13 @@ class Expr:
     __call__ = evaluate
 
     def derivative(self, var: str = "t") -> "Expr":
-        """Exact symbolic derivative d(self)/d(var), simplified."""
-        return Expr(_diff(self.node, var), self.variables)
+        """Exact symbolic derivative d(self)/d(var), simplified; ExpressionError when it would take more
+        than MAX_NODES operations to evaluate (deeply nested expressions)."""
+        d = _diff(self.node, var)
+        if tree_size(d) > MAX_NODES:
+            raise ExpressionError(f"its derivative needs more than {MAX_NODES} operations (nesting too deep "
+                                  "or expression too large): simplify or split it", self.text[:200])
+        return Expr(d, self.variables)
 
     def depends_on(self, var: str = "t") -> bool:
         return _depends(self.node, var)

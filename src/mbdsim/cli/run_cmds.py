@@ -2,10 +2,12 @@
 
 Commands::
 
-    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--debug]
+    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--resume] [--debug]
 
-``--out`` is written while the run goes (every few seconds, atomically; see mbdsim.results.stream), so
-an interrupted or killed run leaves a readable file with what it computed.
+``--out`` is written while the run goes, so an interrupted or killed run leaves a readable file with what it
+computed: a .parquet output of the compiled core is a Parquet dataset streamed in parts with checkpoints
+(bounded memory; ``--resume`` continues it bit-identically, see mbdsim.solvers.stream), otherwise the file
+is rewritten every few seconds, atomically (mbdsim.results.stream).
     mbdsim info MODEL [--debug]
     mbdsim schema [--out schema.json]
 
@@ -74,13 +76,21 @@ def _load(path: Path):
     return mb.load_model(path)
 
 
-def _rank_dof(model):
-    """(DOF by the rank of the constraint Jacobian, independent rows dropped, joints in redundant rows)."""
+def _rank_dof(model, with_report=False):
+    """(DOF by the rank of the constraint Jacobian, independent rows dropped, joints in redundant rows)
+    [+ the reaction determinacy report of redundant sets at the assembled state]."""
     import mbdsim as mb
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
         rep = mb.assemble(model)
-    return rep.dof, rep.system.nc - len(rep.rows), list(rep.redundant)
+    out = (rep.dof, rep.system.nc - len(rep.rows), list(rep.redundant))
+    if not with_report:
+        return out
+    report = []
+    if out[2]:   # redundant joints (not a planar model's out-of-plane equations, dependent by design)
+        from mbdsim.system.determinacy import determinacy_report
+        report = determinacy_report(rep.system, rep.q, rep.t if hasattr(rep, "t") else 0.0)
+    return out + (report,)
 
 
 def _mobility(summary, dof, n_redundant, redundant):
@@ -106,7 +116,9 @@ def run_cmd(
     rtol: Optional[float] = typer.Option(None, "--rtol", metavar="R", help="Relative tolerance (default 1e-8)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
                                        help="Write the results table (res.to_dataframe()) to .parquet or .csv "
-                                       "as the run goes."),
+                                       "as the run goes (.parquet: a Parquet dataset streamed in parts)."),
+    resume: bool = typer.Option(False, "--resume", help="Continue the run streamed to --out (.parquet) from its "
+                                                        "last checkpoint (bit-identical to an uninterrupted run)."),
     debug: bool = DEBUG_OPT,
 ) -> None:
     """Simulate a model file and print a summary; optionally write the results table.
@@ -118,13 +130,17 @@ def run_cmd(
         _fail(f"--out {str(out)!r}: expected a .parquet or .csv file", EXIT_BAD_INPUT)
     if not end > 0:
         _fail(f"--end must be > 0, got {end!r}", EXIT_BAD_INPUT)
-    _guard(lambda: _run(model, end, step, method, rtol, out), debug)
+    stream = out is not None and out.suffix.lower() == ".parquet"
+    if resume and not stream:
+        _fail("--resume needs --out FILE.parquet (the streamed run to continue)", EXIT_BAD_INPUT)
+    _guard(lambda: _run(model, end, step, method, rtol, out, stream, resume), debug)
 
 
-def _run(path, end, step, method, rtol, out):
+def _run(path, end, step, method, rtol, out, stream=False, resume=False):
     import mbdsim as mb
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from mbdsim.errors import AnalysisInterrupted
     from mbdsim.io.summary import summarize
     m = _load(path)
     if _kernels_cold():
@@ -139,17 +155,19 @@ def _run(path, end, step, method, rtol, out):
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)   # reported in the summary
         task = bar.add_task("run", total=end)
         res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol, out=_writable(out),
-                          progress=lambda t: bar.update(task, completed=min(float(t), end)))
+                          progress=lambda t: bar.update(task, completed=min(float(t), end)), resume=resume)
         bar.update(task, completed=float(res.time[-1]))
     wall = time.perf_counter() - t0
     stats = res.stats or {}
     rows = [("model", f"{m.name} ({path})"), *_mobility(summary, dof, n_redundant, redundant),
             ("method", str(stats.get("method", method or "auto"))), ("steps", str(stats.get("steps", "?"))),
-            ("simulated", f"{res.time[0]:.6g} .. {res.time[-1]:.6g} s, {len(res.time)} samples"),
+            ("simulated", f"{res.time[0]:.6g} .. {res.time[-1]:.6g} s, {stats.get('samples', len(res.time))} samples"),
             ("wall time", f"{wall:.3f} s"), ("success", f"{res.success} ({res.message})")]
     _print_table(f"mbdsim run: {m.name}", rows)
     if out is not None:
-        _console().print(f"results: {out} ({len(res.time)} rows; written as the run went)")
+        _console().print(f"results: {out} ({stats.get('samples', len(res.time))} rows; written as the run went)")
+    if isinstance(getattr(res, "error", None), AnalysisInterrupted):
+        raise typer.Exit(EXIT_INTERRUPTED)
     if not res.success:
         interrupted = "KeyboardInterrupt" in str(getattr(res, "error", ""))
         raise typer.Exit(EXIT_INTERRUPTED if interrupted else EXIT_FAILED)
@@ -210,8 +228,12 @@ def _info(path):
         _print_table("drivers", [(n, j, k, d) for n, j, k, d in s.drivers], ("name", "joint", "kind", "function"))
     if s.elements:
         _print_table("force elements", s.elements, ("name", "kind"))
-    dof, n_redundant, redundant = _rank_dof(m)   # assembles: may fail after the tables are out
+    dof, n_redundant, redundant, report = _rank_dof(m, True)   # assembles: may fail after the tables are out
     _print_table("mobility", _mobility(s, dof, n_redundant, redundant))
+    if report:   # Wojtyra-Fraczek: which reaction components the rigid model determines (ground axes, on body_j)
+        _print_table("reaction determinacy (redundant constraints; ground axes, on body_j, at assembly)",
+                     [(n, " ".join(d) or "-", " ".join(i) or "-") for n, d, i in report],
+                     ("joint", "determinate", "indeterminate (minimum-norm split reported)"))
 
 
 def schema_cmd(out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",

@@ -61,13 +61,13 @@ class InertiaWarning(UserWarning):
     """Principal moments that no mass distribution has (the triangle inequality I1 + I2 >= I3 fails)."""
 
 
-def inertia_matrix(entity: str, value, strict: bool = False) -> np.ndarray:
+def inertia_matrix(entity: str, value, strict: bool = True) -> np.ndarray:
     """Inertia about the centre of mass in body axes: (ixx, iyy, izz) or a symmetric 3x3 [kg m^2].
 
     Checked: finite, symmetric, positive semi-definite (a slender rod may have a zero axial moment)
     and the triangle inequality of the principal moments (I1 + I2 >= I3, relative tolerance 1e-6),
-    which every real mass distribution satisfies: a violation is a ModelError when `strict` (model
-    files), else an InertiaWarning naming the body (some existing scripts use such test values)."""
+    which every real mass distribution satisfies: a violation is a ModelError (strict=False, for
+    callers that knowingly model such values, only warns with InertiaWarning)."""
     if _has_bool(value):
         raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got a boolean in {value!r}")
     try:

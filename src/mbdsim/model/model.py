@@ -205,6 +205,9 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
                     raise ModelError(entity, "joint", f"the {dof} of joint '{jt.name}' is already driven by "
                                      f"motion '{other.name}'; a coordinate takes one motion")
             try:
+                if callable(f) and not hasattr(f, "d1"):
+                    from ..system.guard import check_time_callable
+                    check_time_callable(entity, kind, f)
                 tf = time_function(f)
                 x0 = scalar(entity, "initial_displacement", initial_displacement)
                 v0 = scalar(entity, "initial_velocity", initial_velocity)
@@ -234,7 +237,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
         self._claim(name, "force")
         try:
             mk = self._location(entity, "at", at)
-            val = force if callable(force) else vec3(entity, "force", force)
+            val = _load_callable(entity, "force", force) if callable(force) else vec3(entity, "force", force)
             self._check_frame(entity, frame)
         except ModelError:
             self._names.discard(name)
@@ -251,7 +254,7 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
             b = self._lookup(body, self.bodies, entity, "body")
             if b.is_particle:
                 raise ModelError(entity, "body", f"{b.name!r} is a particle: it has no rotation for a torque to act on")
-            val = torque if callable(torque) else vec3(entity, "torque", torque)
+            val = _load_callable(entity, "torque", torque) if callable(torque) else vec3(entity, "torque", torque)
             self._check_frame(entity, frame)
         except ModelError:
             self._names.discard(name)
@@ -408,3 +411,10 @@ def _default_u_axis(normal) -> np.ndarray:
     e = np.eye(3)[1 if abs(normal[0]) > 0.9 else 0]
     u = e - (e @ normal) * normal
     return u / np.linalg.norm(u)
+
+
+def _load_callable(entity, field, fn):
+    """A load callable f(t, state) -> 3-vector, its signature checked now (values at run time)."""
+    from ..system.guard import check_load_callable
+    check_load_callable(entity, field, fn)
+    return fn

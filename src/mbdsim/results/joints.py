@@ -39,6 +39,9 @@ def joint_of(res, joint) -> Joint:
         joint = res.system.model.joints.get(joint, joint)
     if not isinstance(joint, Joint) or joint.name not in res.system.geoms:
         raise ModelError(f"joint {getattr(joint, 'name', joint)!r}", "joint", "is not a joint of the analysed model")
+    if res.system.model.joints.get(joint.name) is not joint:   # same name, another model's object
+        raise ModelError(f"joint '{joint.name}'", "joint", "is a joint of another model (same name, different "
+                         f"object) than the analysed model '{res.system.model.name}'")
     return joint
 
 
@@ -262,6 +265,9 @@ def driver_effort(res, motion):
     if name not in motions or name not in res.system.owner_rows:
         raise ModelError(f"motion {name!r}", "motion", "is not a motion driver of the analysed model")
     m = motions[name]
+    if not isinstance(motion, str) and m is not motion:   # same name, another model's object
+        raise ModelError(f"motion {name!r}", "motion", "is a motion of another model (same name, different "
+                         "object) than the analysed model")
     g = res.system.geoms[m.joint.name]
     F, T = joint_reaction(res.system, res.q, res.lambda_, name)
     h = np.einsum("nij,j->ni", res.frames.A[:, g.bi], g.h_i)

@@ -44,6 +44,7 @@ class Result:
         self._fr = None
         self._parent = None
         self.error = None   # the MbdsimError that stopped a failed run (time, joints, last good state)
+        self.diagnostics = None   # run monitors (mbdsim.results.diagnostics.Diagnostics), set by simulate
 
     # ------------------------------------------------------------ basics
     def __len__(self):
@@ -224,13 +225,42 @@ class Result:
 
     def reaction_force(self, joint: JointRef, on: BodyRef | None = None, frame: FrameRef = None) -> Array:
         """Force [N] (N, 3) the joint exerts on body `on` (a body, marker or name; default body_j), in
-        ground or `frame` axes."""
-        return self._reaction(joint, on, frame)[0]
+        ground or `frame` axes. With redundant constraints, components the rigid model cannot determine
+        (Wojtyra-Fraczek, mbdsim.system.determinacy) are flagged: the array's `.indeterminate` (N, 3)
+        booleans, and an IndeterminateReactionWarning naming them (their values are the minimum-norm split,
+        one of infinitely many)."""
+        return self._flagged(joint, on, frame, 0)
 
     def reaction_torque(self, joint: JointRef, on: BodyRef | None = None, frame: FrameRef = None) -> Array:
         """Torque [N m] (N, 3) the joint exerts on body `on`, reduced to the joint point, in ground or
-        `frame` axes."""
-        return self._reaction(joint, on, frame)[1]
+        `frame` axes; indeterminate components flagged as in reaction_force."""
+        return self._flagged(joint, on, frame, 1)
+
+    def reaction_determinacy(self, joint, on=None, frame=None):
+        """(N, 6) booleans, True where (Fx, Fy, Fz, Tx, Ty, Tz) of the joint's reaction (axes as
+        reaction_force) is *indeterminate* at each sample; all False without redundant constraints."""
+        from ..system.determinacy import indeterminate_components
+        rep = self.stats.get("assembly") if self.stats else None
+        if rep is not None and len(getattr(rep, "rows", ())) == self.system.nc:
+            return np.zeros((len(self.time), 6), dtype=bool)
+        jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
+        body = None if on is None else ms.resolve_body(self.system, on, "on")
+        return indeterminate_components(self.system, self.q, jt, body,
+                                        None if frame is None else (lambda x: self._express(x, frame)))
+
+    def _flagged(self, joint, on, frame, which):
+        import warnings
+        from ..system.determinacy import IndeterminateReactionWarning, ReactionArray
+        value = self._reaction(joint, on, frame)[which]
+        ind = self.reaction_determinacy(joint, on, frame)[:, 3 * which:3 * which + 3]
+        out = ReactionArray(value, ind)
+        if ind.any():
+            name = getattr(joint, "name", joint)
+            comps = [("F" if which == 0 else "T") + "xyz"[k] for k in range(3) if ind[:, k].any()]
+            warnings.warn(f"joint '{name}': reaction components {', '.join(comps)} are indeterminate (redundant "
+                          "constraints): the values are the minimum-norm split, not determined by the rigid model",
+                          IndeterminateReactionWarning, stacklevel=3)
+        return out
 
     def _reaction(self, joint, on, frame):
         from ..system.reactions import joint_reaction
@@ -271,6 +301,9 @@ class Result:
         name = spring if isinstance(spring, str) else getattr(spring, "name", None)
         if name not in forces:
             raise ModelError(f"force element {name!r}", "spring", "is not part of the analysed model")
+        if not isinstance(spring, str) and forces[name] is not spring:   # same name, another model's object
+            raise ModelError(f"force element {name!r}", "spring", "is an element of another model (same name, "
+                             "different object) than the analysed model")
         return forces[name]
 
     def spring_length(self, spring: str | Any) -> Array:

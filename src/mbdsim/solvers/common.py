@@ -182,3 +182,16 @@ def _worst_joints(sys, J, rows):
         if abs(weak[k]) > 1e-3 and sys.row_owner[rows[k]] not in names:
             names.append(sys.row_owner[rows[k]])
     return names
+
+
+def analysis_error(exc: BaseException, t) -> Exception:
+    """The mbdsim error that ends an analysis for exception `exc` caught at about time t [s]: mbdsim errors
+    as they are, KeyboardInterrupt as AnalysisInterrupted, anything else (numpy/LAPACK failures, a bug
+    in a user function not caught by system.guard) as a SolverError naming its type and the time."""
+    from ..errors import AnalysisInterrupted, MbdsimError
+    if isinstance(exc, MbdsimError):
+        return exc
+    t = None if t is None else float(t)
+    if isinstance(exc, KeyboardInterrupt):
+        return AnalysisInterrupted("interrupted (KeyboardInterrupt)", time=t)
+    return SolverError(f"{type(exc).__name__}: {exc}", time=t)

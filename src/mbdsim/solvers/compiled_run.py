@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import MbdsimError, SolverError
+from ..errors import AnalysisInterrupted, MbdsimError, SolverError
 from ..results.result import Result
 from ..results.stream import notify
 from ..system.compiled import Work, compile_system
@@ -200,8 +200,9 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                                                                    rep.rows)
         except (MbdsimError, np.linalg.LinAlgError, ValueError):
             joints = []
-        error = SolverError(_MESSAGES.get(status, "integration failed"), time=float(t_fail), joints=joints,
-                            state=y_fail[:sys.nq])
+        cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
+        error = cls(_MESSAGES.get(status, "integration failed"), time=float(t_fail), joints=joints,
+                    state=y_fail[:sys.nq])
         last = f"{times[n - 1]:.9g}" if n else "none"
         success, message = False, f"{error}; last good output at t = {last} s"
     stats = {"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),

@@ -9,6 +9,7 @@ the drift at the Newton tolerance (~1e-12).  "hht" is the implicit HHT-alpha met
 from __future__ import annotations
 
 import bisect
+import os
 
 import numpy as np
 from scipy import integrate
@@ -22,7 +23,8 @@ from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
 from .assembly import assemble_state
 from .compiled_run import Stiff, integrate_compiled
-from .common import _worst_joints, accelerations, normalize, project_positions, project_velocities, qdot
+from .common import _worst_joints, accelerations, analysis_error, normalize, project_positions, project_velocities, qdot
+from .checks import check_initial_contacts
 from .events import EventTracker
 from .kinematic import check_model, time_grid
 from .state import state_factory
@@ -45,7 +47,8 @@ TIGHT = 1e-6        # "auto" on a model the compiled core does not carry: below 
 @blas_single_thread
 def simulate(model: Model, end_time: float, output_step: float | None = None, method: str | None = None,
              rtol: float | None = None, atol: float | None = None, max_step: float | None = None,
-             start_time: float = 0.0, progress: Progress = None, out: PathLike | None = None) -> Result:
+             start_time: float = 0.0, progress: Progress = None, out: PathLike | None = None,
+             resume: bool = False, monitor: bool = True) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
@@ -57,17 +60,55 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations.
-    progress: optional callable progress(t) receiving the simulated time reached [s] now and then;
-    Ctrl-C returns the partial Result with success=False (every output before it).
-    out: optional path of a .parquet or .csv file: `res.to_dataframe()` of the outputs so far is written
-    there while the run goes (every few seconds, atomically) and completely at the end, so an interrupted
-    run leaves what it computed (see mbdsim.results.stream)."""
+    progress: optional callable progress(t) receiving the simulated time reached [s] now and then.
+    Every failure during the run (solver, a user function raising or returning a non-number or a
+    non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
+    element, field and time (EvaluationError, SolverError, AnalysisInterrupted), the Result holding
+    every output before it; bad arguments raise ModelError before any work.
+    out: optional path of a .parquet or .csv file written while the run goes, so that an interrupted or
+    killed run leaves what it computed. A ".parquet" path on the compiled DOP853 (method "auto" or
+    "dop853" on a model the kernels carry) is a Parquet dataset directory streamed in parts as they are
+    computed, with checkpoints: bounded memory whatever the length (the returned Result holds every
+    output while they fit STREAM_KEEP bytes, else the last part; res.stats["out"], ["samples"]) and
+    resume=True continues it from its last checkpoint, bit-identical to an uninterrupted run
+    (mbdsim.solvers.stream). Otherwise `res.to_dataframe()` of the outputs so far is rewritten every few
+    seconds, atomically, and completely at the end (mbdsim.results.stream); `pandas.read_parquet(out)`
+    reads either.
+    monitor=True (default): constraint violation, energy balance and contact penetration are checked on
+    the output samples (after the run, or after every part of a streamed run); the first exceedance of
+    each warns (MonitorWarning naming time, quantity and element) and `res.diagnostics` keeps the history
+    (mbdsim.results.diagnostics)."""
+    from ..results.diagnostics import monitor as run_monitors
     from ..results.stream import run_writing
-    return run_writing(lambda p: _simulate(model, end_time, output_step, method, rtol, atol, max_step,
-                                           start_time, p), progress, out, "simulate")
+    if not isinstance(resume, bool):
+        raise ModelError("simulate", "resume", f"expected True or False, got {resume!r}")
+    res = None
+    if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith(".parquet") and \
+            (method is None or str(method).lower() in ("auto",) + COMPILED_METHODS) and USE_COMPILED:
+        try:
+            res = _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress, out,
+                            resume, monitor)
+        except NotStreamable:
+            pass
+    if res is None:
+        if resume:
+            raise ModelError("simulate", "resume", "resuming needs out= a .parquet path and the compiled DOP853 "
+                             "(method 'auto' or 'dop853' on a model the compiled kernels carry)")
+        res = run_writing(lambda p: _simulate(model, end_time, output_step, method, rtol, atol, max_step,
+                                              start_time, p, None, False, monitor), progress, out, "simulate")
+    if monitor and res.diagnostics is None:
+        res.diagnostics = run_monitors(res)
+    return res
 
 
-def _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress) -> Result:
+class NotStreamable(Exception):
+    """simulate(out=...parquet): the compiled core does not carry this model (the whole-file writer runs)."""
+
+
+def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
+              start_time=0.0, progress=None, out=None, resume=False, monitor=True) -> Result:
+    """The analysis of `simulate` (its docstring has the arguments), without the monitors; with `out`, the
+    streamed compiled run (NotStreamable when the model needs another path)."""
     check_model(model)
     method = "auto" if method is None else method
     if not isinstance(method, str):
@@ -80,13 +121,20 @@ def _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_
     if user_rtol is not None and user_rtol < RTOL_FLOOR:
         raise ModelError("simulate", "rtol", f"{rtol!r} is below what double precision can deliver "
                          f"(at least {RTOL_FLOOR:g})")
+    if method == "hht" and user_rtol is not None and user_rtol < HHT_RTOL_FLOOR:
+        raise ModelError("simulate", "rtol", f"{rtol!r} is below what the HHT method resolves (its Newton "
+                         f"tolerance; at least {HHT_RTOL_FLOOR:g}): use method='dop853' for tighter tolerances")
     user_atol = None if atol is None else _positive("atol", atol)
     max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
     start_time = _number("start_time", start_time)
-    _check_budget(model, start_time, end_time, output_step)
+    if out is None:
+        _check_budget(model, start_time, end_time, output_step)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
+    check_initial_contacts(sys, rep.q, rep.v)
+    if out is not None:
+        return _streamed(sys, rep, times, method, user_rtol, user_atol, max_step, progress, out, resume, monitor)
     if method == "auto":
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
@@ -105,10 +153,27 @@ def _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_
         if method == "hht" and user_rtol is not None and user_rtol < TIGHT and not reason.startswith("stiff"):
             method = "dop853"   # a second-order method cannot reach tight tolerances in reasonable time
             user_rtol, user_atol = AUTO_LOCAL * rt, AUTO_LOCAL * at
+        elif method == "hht" and user_rtol is not None:
+            user_rtol = max(user_rtol, HHT_RTOL_FLOOR)   # stiff hand-over: HHT's own floor
         res = _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
         res.stats["method"] = f"auto: {res.stats.get('method', method)} ({reason})"
         return res
     return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
+
+
+def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
+    """simulate(out=...parquet): the compiled DOP853 streamed to disk in parts (mbdsim.solvers.stream);
+    NotStreamable when the model needs another path (nothing written yet)."""
+    from . import stream
+    if method not in ("auto",) + COMPILED_METHODS:
+        raise NotStreamable(method)
+    rt, at = _tolerances(method, rtol, atol)
+    if method == "auto":   # as in memory: rtol targets the outputs' global error (local 0.1 rtol)
+        rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
+    try:
+        return stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume, monitor)
+    except NotCompiled as exc:
+        raise NotStreamable(str(exc)) from None
 
 
 def _tolerances(method, rtol, atol):
@@ -142,6 +207,7 @@ def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result
     return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step, progress)
 
 
+HHT_RTOL_FLOOR = 1e-10     # HHT's Newton iterations converge to ~1e-12: its error estimate means nothing below
 RTOL_FLOOR = 1e-14          # relative tolerances below this cannot be met in double precision
 RESULT_BUDGET = 4 * 2**30   # bytes of output arrays an analysis may allocate
 
@@ -283,12 +349,9 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
             solver.y = y
             if hasattr(solver, "f"):
                 solver.f = rhs(solver.t, y)
-    except MbdsimError as exc:
+    except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
+        exc = analysis_error(exc, traj.t_end[-1] if traj.t_end else t0)
         success, message, error = False, f"{exc}; last good output at t = {times[len(out) - 1]:.9g} s", exc
-    except KeyboardInterrupt:   # as in the compiled runs: every output before it is kept
-        success = False
-        message = f"interrupted (KeyboardInterrupt); last good output at t = {times[len(out) - 1]:.9g} s"
-        error = SolverError("interrupted (KeyboardInterrupt)", time=float(times[len(out) - 1]))
     n = len(out)
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
                  evaluate=traj.evaluate if traj.dense else None, success=success,

@@ -24,7 +24,7 @@ from ..results.stream import notify
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
-from .common import accelerations, increment, project_positions
+from .common import accelerations, analysis_error, increment, project_positions
 from .dynamic import consistent_state
 from .events import EventTracker
 from .state import state_factory
@@ -75,6 +75,10 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
             if err > 1.0:
                 nrej += 1
                 h *= max(0.2, 0.9 * err ** (-1 / 3))
+                if h < 1e-14 * max(1.0, abs(cur.t)):   # the tolerance cannot be met: a floor, not a hang
+                    raise SolverError(f"HHT step size underflow: the error estimate stays above the tolerance "
+                                      f"(rtol {rtol:g}, atol {atol:g}) at steps below {h:.3g} s", time=cur.t,
+                                      joints=_names(sys, rows), state=cur.q)
                 continue
             if not to_event and events.items:
                 hit = events.check(cur.t, new.t, lambda t, a=cur, b=new: _hermite_y(sys, a, b, t))
@@ -93,7 +97,8 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
                                                                                 for i in range(4)], stats={"assembly": rep}))
             cur = new
             h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
-    except MbdsimError as exc:
+    except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
+        exc = analysis_error(exc, cur.t)
         success, message, error = False, f"{exc}; last good step at t = {cur.t:.9g} s", exc
     except KeyboardInterrupt:
         error = SolverError("interrupted (KeyboardInterrupt)", time=float(cur.t))

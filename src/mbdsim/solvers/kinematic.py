@@ -55,7 +55,10 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
 def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
     from ..results.stream import notify
     from ..system.assemble import assemble_system
+    from .dynamic import _check_budget, _number
     check_model(model)
+    start_time = _number("start_time", start_time)
+    _check_budget(model, start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
     if rep.dof > 0:
@@ -75,7 +78,9 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
             if cond < SINGULAR_TOL:
                 state = solve_at(sys, state[1], t, sf, hint=None if anchor is None else _rates_hint(anchor, t))
                 records.append({"time": float(t), "conditioning": cond, "joints": joints, "sample": len(out)})
-        except AssemblyError as exc:
+        except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
+            from .common import analysis_error
+            exc = analysis_error(exc, t)
             success, error = False, exc
             message = f"{exc}; last good state at t = {out[-1][0] if out else start_time:.9g} s"
             break

@@ -16,6 +16,7 @@ import warnings
 
 import numpy as np
 
+from .guard import guarded_time_function
 from ..errors import ModelError
 from ..math.rotation import cross3, matrix_to_quat, perpendicular_frame
 from .constraints.base import JointGeom, RowSpec
@@ -194,7 +195,8 @@ def _row_specs(model, fid):
         g = geoms[m.joint.name]
         if m.dof == "rotation" and g.particle_j:
             raise ModelError(f"motion '{m.name}'", "joint", "cannot drive a rotation of a particle")
-        specs += _placed(driver_rows(g, m.dof, m.function, m.name), g)
+        fn = guarded_time_function(m.function, f"motion '{m.name}'", m.kind)   # failures named (system.guard)
+        specs += _placed(driver_rows(g, m.dof, fn, m.name), g)
     return specs, geoms
 
 

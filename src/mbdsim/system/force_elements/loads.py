@@ -6,6 +6,7 @@ import numpy as np
 from ...errors import ModelError
 from ...model.forces import Force, SpringDamper, Torque
 from ..frames import point_state
+from ..guard import call_vector
 from . import register
 
 
@@ -28,10 +29,10 @@ def add_torque(sys, fr, Q, fid, T):
 
 
 def _vector(elem, value, t, state, fr, sys, what):
-    v = value(t, state) if callable(value) else value
-    v = np.asarray(v, dtype=float).reshape(-1)
-    if v.shape != (3,) or not np.all(np.isfinite(v)):
-        raise ModelError(f"{what} '{elem.name}'", what, f"callable returned {v!r} at t={t}; expected 3 finite numbers")
+    if callable(value):
+        v = call_vector(value, t, state, f"{what} '{elem.name}'", what)
+    else:
+        v = np.asarray(value, dtype=float).reshape(-1)
     if elem.frame is not None:
         from ..measures import locate
         fid, _, R_BM = locate(sys, elem.frame)

@@ -1,0 +1,223 @@
+"""Run monitors (issue 10): constraint violation, energy balance and contact penetration of a run's samples.
+
+Checked by `simulate` from the stored output samples: after the run for results in memory, after every
+chunk for runs streamed to disk (`simulate(out=...)`), i.e. not inside the compiled step loop. The first
+time a quantity exceeds its tolerance a `MonitorWarning` names the time [s], the quantity, the element and
+the value; `Result.diagnostics` keeps the history.
+
+- constraint_violation: max |phi(q, t)| over the position constraint rows [m or rad] (the owning joint or
+  motion named), at most MAX_SAMPLES evenly spaced samples per run or chunk (plus the last); tolerance
+  CONSTRAINT_TOL.
+- energy_error: (T + V + D - W) - (T + V + D - W)(t0) [J]: kinetic T, potential V (gravity and elastic
+  elements), dissipated D (damping, friction, contact: trapezoidal rule on the samples) and the work W of
+  applied forces and torques (trapezoidal rule of their power); tolerance ENERGY_TOL times the energy scale
+  (the largest of T, |V - V(t0)|, D, |W| over the run, 1e-6 |V| and 1e-12 J) plus a trapezoid allowance when
+  D or W are present (ENERGY_TOL_QUADRATURE). Not checked for driven models (motions do work through
+  their multipliers) or unknown element types: `energy_error` is then None with the reason in `notes`.
+- penetration: max(0, -gap) per contact [m]; tolerance PENETRATION_FRACTION of the (smaller) sphere radius,
+  beyond which a point contact no longer describes the geometry.
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass, field
+
+import numpy as np
+
+CONSTRAINT_TOL = 1e-6
+ENERGY_TOL = 1e-4
+ENERGY_TOL_QUADRATURE = 2e-2
+PENETRATION_FRACTION = 0.1
+MAX_SAMPLES = 2000
+
+
+class MonitorWarning(UserWarning):
+    """A monitored quantity (constraint violation, energy balance, contact penetration) exceeded its
+    tolerance during a run."""
+
+
+@dataclass
+class Diagnostics:
+    """History of the run monitors; arrays are per stored sample (per checked sample for
+    constraint_violation: `constraint_time`). `exceedances`: first exceedance of each quantity and element,
+    dicts with time [s], quantity, element, value, tolerance."""
+
+    time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    constraint_time: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    constraint_violation: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    energy_error: np.ndarray | None = None
+    energy_scale: float = 0.0
+    penetration: dict = field(default_factory=dict)
+    tolerances: dict = field(default_factory=dict)
+    exceedances: list = field(default_factory=list)
+    notes: list = field(default_factory=list)
+    _carry: dict = field(default_factory=dict, repr=False)
+
+    def summary(self) -> dict:
+        """Largest value of each monitored quantity [m or rad, J, m]."""
+        out = {"constraint_violation": float(np.max(self.constraint_violation, initial=0.0))}
+        if self.energy_error is not None and len(self.energy_error):
+            out["energy_error"] = float(np.max(np.abs(self.energy_error)))
+        for k, v in self.penetration.items():
+            out[f"penetration {k}"] = float(np.max(v, initial=0.0))
+        return out
+
+
+def _constraint(res, diag, stride_limit=MAX_SAMPLES):
+    from ..system.equations import constraint_terms
+    sys = res.system
+    if not sys.nc or not len(res.time):
+        return np.zeros(0), np.zeros(0), []
+    n = len(res.time)
+    idx = np.unique(np.concatenate([np.linspace(0, n - 1, min(n, stride_limit)).astype(int), [n - 1]]))
+    zero = np.zeros(sys.nv)
+    rows = np.asarray(sys.__dict__.get("_monitor_rows", np.arange(sys.nc)))
+    val, owner = np.zeros(len(idx)), []
+    for k, i in enumerate(idx):
+        phi = constraint_terms(sys, res.q[i], zero, res.time[i], jacobian=False)[0][rows]
+        j = int(np.argmax(np.abs(phi))) if len(phi) else 0
+        val[k] = abs(phi[j]) if len(phi) else 0.0
+        owner.append(sys.row_owner[rows[j]] if len(phi) else "")
+    return res.time[idx], val, owner
+
+
+def _energy_terms(res):
+    """(T + V, D, P_applied) at the samples, or (None, reason)."""
+    from ..model.forces import Force, Torque
+    from ..system.force_elements import evaluator
+    from .energy import dissipation_power
+    sys = res.system
+    if "HHT" in str(res.stats.get("method", "")):
+        return None, "energy balance not checked: HHT dissipates high frequencies numerically by design"
+    if sys.model.motions:
+        return None, "energy balance not checked: driven model (motions do work through their multipliers)"
+    applied = [e for e in sys.model.forces.values() if isinstance(e, (Force, Torque))]
+    for e in sys.model.forces.values():
+        ev = evaluator(e)
+        if e not in applied and not (hasattr(ev, "potential") or hasattr(ev, "dissipation")):
+            return None, f"energy balance not checked: element '{e.name}' has no energy bookkeeping"
+        if getattr(ev, "needs_lambda", False):
+            return None, f"energy balance not checked: friction '{e.name}' needs the multipliers"
+    fr = res.frames
+    T, V = res.kinetic_energy(), res.potential_energy()
+    P_d = dissipation_power(sys, fr, res.time) if any(
+        hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None
+    P_w = None
+    if applied:
+        from ..solvers.state import state_factory
+        sf = state_factory(sys)
+        P_w = np.zeros(len(res.time))
+        from ..system.frames import body_frames
+        try:
+            for i, t in enumerate(res.time):
+                f1 = body_frames(sys, res.q[i], res.v[i])
+                st = sf(t, res.q[i], res.v[i]) if sf else None
+                for e in applied:
+                    P_w[i] += float(evaluator(e).generalized(sys, f1, e, t, st) @ res.v[i])
+        except Exception as exc:  # noqa: BLE001 - a user load failing here: monitor skipped, run unaffected
+            return None, f"energy balance not checked: applied load failed ({type(exc).__name__})"
+    return (T, V, P_d, P_w), None
+
+
+def _trapz_cum(P, t, start=0.0):
+    if P is None:
+        return None
+    return start + np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(t))])
+
+
+def update(diag: Diagnostics, res, first: bool = True) -> Diagnostics:
+    """Check the samples of `res` (a whole run, or the next chunk of a streamed run whose first sample
+    repeats the previous chunk's last) and append to `diag`; warns at first exceedances."""
+    sys = res.system
+    t = res.time
+    skip = 0 if first else 1
+    ct, cv, owners = _constraint(res, diag)
+    keep = ct > (diag.constraint_time[-1] if len(diag.constraint_time) else -np.inf)
+    diag.constraint_time = np.concatenate([diag.constraint_time, ct[keep]])
+    diag.constraint_violation = np.concatenate([diag.constraint_violation, cv[keep]])
+    diag.tolerances.setdefault("constraint_violation", CONSTRAINT_TOL)
+    for k in np.flatnonzero(cv > CONSTRAINT_TOL):
+        _exceed(diag, float(ct[k]), "constraint_violation", f"joint '{owners[k]}'", float(cv[k]), CONSTRAINT_TOL)
+    terms, note = _energy_terms(res) if "energy_off" not in diag._carry else (None, None)
+    if terms is None:
+        if note and note not in diag.notes:
+            diag.notes.append(note)
+        diag._carry["energy_off"] = True
+        diag.energy_error = None
+    else:
+        T, V, P_d, P_w = terms
+        c = diag._carry
+        D = _trapz_cum(P_d, t, c.get("D", 0.0))
+        W = _trapz_cum(P_w, t, c.get("W", 0.0))
+        bal = T + V + (0.0 if D is None else D) - (0.0 if W is None else W)
+        c.setdefault("E0", float(bal[0]))
+        c.setdefault("V0", float(V[0]))
+        err = bal - c["E0"]
+        c["D"], c["W"] = (float(D[-1]) if D is not None else 0.0), (float(W[-1]) if W is not None else 0.0)
+        scale = max(diag.energy_scale, float(np.max(T)), float(np.max(np.abs(V - c["V0"]))), abs(c["D"]),
+                    abs(c["W"]), 1e-6 * float(np.max(np.abs(V))), 1e-12)   # round-off floor: 1e-10 |V|
+        diag.energy_scale = scale
+        tol = (ENERGY_TOL_QUADRATURE if (P_d is not None or P_w is not None) else ENERGY_TOL) * scale
+        diag.tolerances["energy_error"] = tol
+        prev = diag.energy_error if diag.energy_error is not None else np.zeros(0)
+        diag.energy_error = np.concatenate([prev, err[skip:]])
+        bad = np.flatnonzero(np.abs(err) > tol)
+        if len(bad):
+            _exceed(diag, float(t[bad[0]]), "energy_error", f"model '{sys.model.name}'", float(err[bad[0]]), tol)
+    from ..model.element_specs import Contact
+    for e in sys.model.forces.values():
+        if isinstance(e, Contact):
+            gap = res.spring_length(e)
+            pen = np.maximum(-gap, 0.0)
+            prev = diag.penetration.get(e.name, np.zeros(0))
+            diag.penetration[e.name] = np.concatenate([prev, pen[skip:]])
+            tol = PENETRATION_FRACTION * min(sh.radius for sh in (e.shape_i, e.shape_j) if sh.kind == "sphere")
+            diag.tolerances[f"penetration {e.name}"] = tol
+            bad = np.flatnonzero(pen > tol)
+            if len(bad):
+                _exceed(diag, float(t[bad[0]]), "penetration", f"contact '{e.name}'", float(pen[bad[0]]), tol)
+    diag.time = np.concatenate([diag.time, t[skip:]])
+    return diag
+
+
+def compact_tail(diag: Diagnostics, n_time: int, n_constraint: int) -> None:
+    """Replace the history entries appended after the first n_time samples (n_constraint checked samples)
+    by one entry at the chunk's last time holding the chunk's extreme values: bounded history for streamed
+    runs (one entry per chunk)."""
+    if len(diag.time) <= n_time + 1:
+        return
+    t_last = diag.time[-1:]
+
+    def extreme(a, n):
+        tail = a[n:]
+        return np.concatenate([a[:n], tail[[int(np.argmax(np.abs(tail)))]]]) if len(tail) else a
+    if diag.energy_error is not None and len(diag.energy_error) == len(diag.time):
+        diag.energy_error = extreme(diag.energy_error, n_time)
+    for k, v in diag.penetration.items():
+        if len(v) == len(diag.time):
+            diag.penetration[k] = extreme(v, n_time)
+    if len(diag.constraint_violation) > n_constraint + 1:
+        diag.constraint_violation = extreme(diag.constraint_violation, n_constraint)
+        diag.constraint_time = np.concatenate([diag.constraint_time[:n_constraint], t_last])
+    diag.time = np.concatenate([diag.time[:n_time], t_last])
+
+
+def _exceed(diag, t, quantity, element, value, tol):
+    if any(x["quantity"] == quantity and x["element"] == element for x in diag.exceedances):
+        return
+    diag.exceedances.append({"time": t, "quantity": quantity, "element": element, "value": value, "tolerance": tol})
+    warnings.warn(f"{element}: {quantity.replace('_', ' ')} {value:.3g} exceeds the tolerance {tol:.3g} first at "
+                  f"t = {t:.9g} s", MonitorWarning, stacklevel=4)
+
+
+def monitor(res, diag: Diagnostics | None = None, first: bool = True) -> Diagnostics:
+    """Run the monitors over `res` (see module doc); never fails the run: an error inside a monitor is
+    recorded in `notes`."""
+    diag = Diagnostics() if diag is None else diag
+    if not len(res.time):
+        return diag
+    try:
+        return update(diag, res, first)
+    except (ValueError, np.linalg.LinAlgError, FloatingPointError) as exc:
+        diag.notes.append(f"monitors stopped: {type(exc).__name__}: {exc}")
+        return diag

@@ -1,0 +1,279 @@
+"""Long runs on disk: `simulate(..., out="run.parquet")` streams the results in chunks as they are computed.
+
+Layout: `out` is a Parquet dataset directory (what `pandas.read_parquet(out)` reads as one table):
+``part-000000.parquet``, ``part-000001.parquet``, ... one file per chunk of CHUNK_ROWS output times, with
+the columns of `Result.to_dataframe()` (joint angles and Euler parameters continuous across chunks), and
+``_checkpoint.npz`` (ignored by Parquet readers) with everything the compiled integrator carries from one
+chunk to the next: time and step size [t, h], the integrator state y and its derivative f, the step
+statistics and stiffness counters, the last output row and the last written table row. Each file is
+written to a hidden temporary name and renamed (atomic on POSIX), part first, checkpoint second: a run
+killed at any moment (SIGKILL included) leaves every completed part readable and a checkpoint that is
+never ahead of the parts.
+
+Memory is bounded by one chunk whatever the run's length. `resume=True` reloads the checkpoint (the
+run's settings and assembled initial state must match, checked by a fingerprint) and continues with
+exactly the carried state: the compiled step loop returns to Python at every chunk boundary in an
+uninterrupted run too, so a resumed run is bit-identical to an uninterrupted one.
+
+Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
+switch while streaming). Other methods and models run in memory and then write the same layout (no
+resume).
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import time
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import AnalysisInterrupted, ModelError, SolverError
+from ..results import stream as results_stream
+from ..results.result import Result
+
+CHUNK_ROWS = 5_000           # output times per part file (a chunk ends at the first step end past them)
+STREAM_KEEP = 32 * 2**20   # bytes of output states the returned Result may hold (else: the last part only)
+MARGIN = 1024                # extra rows for the outputs of a chunk's last step (grown when a step has more)
+CHECKPOINT = "_checkpoint.npz"
+META = "_run.json"
+
+
+# ----------------------------------------------------------------------------- files
+def prepare(out, resume: bool) -> Path:
+    """The dataset directory for `out` (created; emptied of a previous run unless resuming)."""
+    try:
+        path = Path(out)
+    except TypeError:
+        raise ModelError("simulate", "out", f"expected a path, got {out!r}") from None
+    if path.exists() and not path.is_dir():
+        if resume:
+            raise ModelError("simulate", "out", f"{str(path)!r} is a file, not a run directory to resume")
+        path.unlink()
+    if path.is_dir():
+        foreign = [p.name for p in path.iterdir() if not _ours(p.name)]
+        if foreign:
+            raise ModelError("simulate", "out", f"{str(path)!r} holds files not written by mbdsim ({foreign[:3]}); "
+                             "choose a new path")
+        if not resume:
+            for p in path.iterdir():
+                p.unlink()
+    try:
+        path.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise ModelError("simulate", "out", f"cannot create {str(path)!r}: {exc}") from None
+    return path
+
+
+def _ours(name: str) -> bool:
+    return name in (CHECKPOINT, META) or name.startswith(("part-", ".part-", ".ckpt-", "._run"))
+
+
+def _atomic(path: Path, write) -> None:
+    tmp = path.parent / f".{path.name.lstrip('_')}.tmp"
+    write(tmp)
+    with open(tmp, "rb") as fh:
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+
+
+def write_part(path: Path, index: int, df) -> None:
+    """Chunk `index` of the run as part-<index>.parquet (atomic)."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    table = pa.Table.from_pandas(df, preserve_index=False)
+    _atomic(path / f"part-{index:06d}.parquet", lambda p: pq.write_table(table, p))
+
+
+def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
+    """Hash of what makes two runs the same computation (settings, grid, model size, initial state)."""
+    h = hashlib.sha1()
+    for a in (np.asarray([times[0], times[-1], len(times), rtol, atol, max_step or 0.0, sys.nq, sys.nv, sys.nc]),
+              np.asarray(times[:2]), np.asarray(rep.q, float), np.asarray(rep.v, float), np.asarray(rep.rows)):
+        h.update(np.ascontiguousarray(a, dtype=float).tobytes())
+    h.update(",".join(sorted(sys.model.bodies)).encode())
+    h.update(",".join(sorted(sys.model.joints)).encode())
+    return h.hexdigest()
+
+
+# ----------------------------------------------------------------------------- tables
+def chunk_frame(res, prev_row):
+    """The `to_dataframe()` table of a chunk's Result; with prev_row (the previous chunk's last table row, a
+    pandas Series, also the chunk's first sample), angle columns continue it (multiples of 2 pi) and Euler
+    parameters keep its sign, and that first row is dropped."""
+    df = res.to_dataframe()
+    if prev_row is None:
+        return df
+    for col in df.columns:
+        if col.endswith("[rad]"):
+            shift = np.round((prev_row[col] - df[col].iloc[0]) / (2 * np.pi)) * 2 * np.pi
+            if shift:
+                df[col] = df[col] + shift
+    for qw in [c for c in df.columns if c.endswith(".qw [-]")]:
+        stem = qw[:-len("qw [-]")]
+        cols = [f"{stem}q{c} [-]" for c in "wxyz"]
+        if all(c in df.columns for c in cols):
+            dot = float(np.dot(prev_row[cols].to_numpy(float), df[cols].iloc[0].to_numpy(float)))
+            if dot < 0:
+                df[cols] = -df[cols]
+    return df.iloc[1:].reset_index(drop=True)
+
+
+# ----------------------------------------------------------------------------- compiled streaming
+def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
+    """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
+    raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
+    (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
+    from . import fastdop
+    from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers
+    from .fastdyn import INTERRUPTED
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v))
+    path = prepare(out, resume)
+    a, w = run.cm.arrays(), run.work.arrays()
+    y0 = np.concatenate([rep.q, rep.v])
+    fp = fingerprint(sys, rep, times, rtol, atol, max_step)
+    state = _load_checkpoint(path, fp) if resume else None
+    if state is None:
+        for p in path.iterdir():
+            p.unlink()
+        y = run.state_of(y0)
+        f = np.zeros(len(y))
+        status = fastdop.rhs(a, w, times[0], y, f)
+        if status != 0:
+            raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
+        st = np.array([times[0], fastdop.initial_step(a, w, times[0], y, f, rtol, atol, run.max_step,
+                                                      np.zeros(len(y)), np.zeros(len(y)), np.zeros(len(y)))])
+        chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
+        _write_meta(path, fp, times, rtol, atol)
+    else:
+        chunk, i0, st, y, f, stats, ylast, prev_row = state
+        run.stats[:] = stats
+    n, ns = len(y0), len(y)
+    K, F, sc = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns))
+    SY, ST, nsv = np.zeros((0, ns)), np.zeros((0, 2)), np.zeros(1, np.int64)
+    t_end, nout = float(times[-1]), len(times)
+    from ..results.diagnostics import compact_tail, monitor as run_monitors
+    diag, kept = None, []
+    status, error, last = 0, None, (np.asarray(times[i0 - 1:i0], float), ylast[None, :], None)
+    while i0 < nout:
+        g0 = i0 - 1                                # global index of row 0 (the previous chunk's last output)
+        L = min(CHUNK_ROWS + MARGIN + 1, nout - g0)
+        Y = np.zeros((L, n))
+        Y[0] = ylast
+        iout = 1
+        t_part = time.monotonic()
+        # the kernels' work arrays at the carried state exactly as the step loop leaves them (the output
+        # projection reuses the factorisation there): same whether the previous chunk ran in this process
+        fastdop.rhs(a, w, st[0], y, np.zeros(ns))
+        try:
+            while status == 0 and iout < min(CHUNK_ROWS + 1, L):
+                saved = (st.copy(), y.copy(), f.copy(), run.stats.copy())
+                tout = np.asarray(times[g0:g0 + L], float)
+                status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
+                                          run.max_step, run.max_steps, max(1, CHUNK_ROWS + 1 - iout), 1e-12,
+                                          run.stats, K, F, sc, False, SY, ST, nsv)
+                if status == 0 and got == L and g0 + L < nout and \
+                        times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
+                    # the last step covered outputs beyond the window: redo it from the saved state into a
+                    # larger window, so that every step writes all of its outputs (chunks end at step ends)
+                    st[:], y[:], f[:], run.stats[:] = saved
+                    L = min(2 * L, nout - g0)
+                    Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
+                    continue
+                iout = got
+                if progress is not None:
+                    progress(float(st[0]))
+                if time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
+                    break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part)
+        except KeyboardInterrupt:
+            status = INTERRUPTED
+        tout = np.asarray(times[g0:g0 + iout], float)
+        i1 = g0 + iout
+        rows = Y[:iout]
+
+        def accelerations(ts=tout, Yc=rows):
+            VD, LAM = run.outputs(ts, Yc)
+            return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
+        cres = Result(sys, tout, rows[:, :sys.nq], rows[:, sys.nq:], None, None, accelerations=accelerations)
+        df = chunk_frame(cres, prev_row)
+        if monitor:   # history kept as one entry per chunk (its extremes): bounded memory
+            n_t, n_c = (0, 0) if diag is None else (len(diag.time), len(diag.constraint_time))
+            diag = run_monitors(cres, diag, first=prev_row is None)
+            compact_tail(diag, n_t, n_c)
+        if len(df):
+            write_part(path, chunk, df)
+        cres._fr = None   # break the Result <-> lazy frames cycle: the chunk's arrays go now, not at a GC
+        last = (tout, rows, accelerations)
+        if status != 0:
+            if kept is not None:
+                kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
+            cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
+            error = cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
+            break
+        if kept is not None:
+            kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
+            if sum(r.nbytes for _, r in kept) > STREAM_KEEP:
+                kept = None   # long run: the Result holds the last part only
+        prev_row, ylast = df.iloc[-1], rows[-1].copy()
+        chunk, i0 = chunk + 1, i1
+        _save_checkpoint(path, fp, chunk, i0, st, y, f, run.stats, ylast, prev_row)
+    ts, rows, acc = last
+    if kept is not None and state is None and len(kept) > 1:   # every output fits: the Result holds them all
+        ts, rows = np.concatenate([k[0] for k in kept]), np.concatenate([k[1] for k in kept])
+
+        def acc(ts=ts, Yc=rows):
+            VD, LAM = run.outputs(ts, Yc)
+            return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
+    written = (i0 - 1 + len(ts)) if error is not None else nout
+    success = error is None
+    message = "ok" if success else f"{error}; last good output at t = {ts[-1]:.9g} s (written to {path})"
+    res = Result(sys, ts, rows[:, :sys.nq], rows[:, sys.nq:], None, None, success=success,
+                 status=0 if success else -1, message=message, accelerations=acc,
+                 stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
+                        "projections": int(run.stats[3]), "method": "DOP853 (compiled, streamed)", "out": str(path),
+                        "samples": int(written), "chunks": chunk + (0 if success else 1), "assembly": rep})
+    res.error = error
+    res.diagnostics = diag
+    return res
+
+
+def _write_meta(path, fp, times, rtol, atol):
+    meta = {"fingerprint": fp, "start_time": float(times[0]), "end_time": float(times[-1]), "outputs": len(times),
+            "rtol": rtol, "atol": atol, "chunk_rows": CHUNK_ROWS}
+    _atomic(path / META, lambda p: p.write_text(json.dumps(meta, indent=1)))
+
+
+def _save_checkpoint(path, fp, chunk, i0, st, y, f, stats, ylast, prev_row):
+    def write(p):
+        with open(p, "wb") as fh:
+            np.savez(fh, fingerprint=np.array(fp), chunk=chunk, i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
+                     row=prev_row.to_numpy(float), columns=np.array(list(prev_row.index)))
+    _atomic(path / CHECKPOINT, write)
+
+
+def _load_checkpoint(path, fp):
+    """The carried state of the last completed chunk, None when there is none; ModelError when it belongs
+    to another run (other settings or model)."""
+    import pandas as pd
+    file = path / CHECKPOINT
+    if not file.exists():
+        return None
+    with np.load(file) as z:
+        if str(z["fingerprint"]) != fp:
+            raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (model, "
+                             "times or tolerances differ); run without resume to start afresh")
+        prev = pd.Series(z["row"], index=[str(c) for c in z["columns"]])
+        return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
+                z["ylast"].copy(), prev)
+
+
+# ----------------------------------------------------------------------------- in-memory fallback
+def write_result(res: Result, out) -> Result:
+    """Write a Result computed in memory in the same layout (parts of CHUNK_ROWS rows, no checkpoint)."""
+    path = prepare(out, resume=False)
+    df = res.to_dataframe()
+    for k, start in enumerate(range(0, max(len(df), 1), CHUNK_ROWS)):
+        write_part(path, k, df.iloc[start:start + CHUNK_ROWS])
+    res.stats["out"], res.stats["samples"] = str(path), len(df)
+    return res

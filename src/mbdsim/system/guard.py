@@ -1,0 +1,112 @@
+"""Run-time guards around user functions: a failure names the element, the field and the time.
+
+Drivers (TimeFunction value/d1/d2), applied forces and torques given as callables are called through
+`guarded_time_function` / `call_vector`: an exception raised by the user's code, a value that is not a
+number (None, a string) or a non-finite one becomes an `EvaluationError(entity, field, message, time)`;
+the analysis loops turn that into `Result.success = False` keeping every step before it.
+"""
+from __future__ import annotations
+
+import inspect
+
+import numpy as np
+
+from ..errors import EvaluationError, MbdsimError, ModelError
+
+
+def _time(t):
+    try:
+        return float(np.ravel(np.asarray(t, dtype=float))[0])
+    except (TypeError, ValueError, IndexError):
+        return None
+
+
+class GuardedTimeFunction:
+    """A TimeFunction whose evaluations are checked (finite numbers) and whose failures are named.
+    Other attributes (expr, f, f_d1, f_d2, description) are the wrapped function's."""
+
+    def __init__(self, tf, entity: str, field: str):
+        self._tf, self._entity, self._field = tf, entity, field
+
+    def __getattr__(self, name):
+        return getattr(self._tf, name)
+
+    def _call(self, fn, what, t):
+        try:
+            y = fn(t)
+        except MbdsimError:
+            raise
+        except Exception as exc:  # noqa: BLE001 - user code: named, with the time
+            raise EvaluationError(self._entity, self._field, f"{what} raised {type(exc).__name__}: {exc}",
+                                  time=_time(t)) from exc
+        try:
+            finite = bool(np.all(np.isfinite(np.asarray(y, dtype=float))))
+        except (TypeError, ValueError):
+            raise EvaluationError(self._entity, self._field, f"{what} returned {y!r}, not a number",
+                                  time=_time(t)) from None
+        if not finite:
+            raise EvaluationError(self._entity, self._field, f"{what} is not finite ({y!r})", time=_time(t))
+        return y
+
+    def value(self, t):
+        return self._call(self._tf.value, "the function", t)
+
+    def d1(self, t):
+        return self._call(self._tf.d1, "its first derivative", t)
+
+    def d2(self, t):
+        return self._call(self._tf.d2, "its second derivative", t)
+
+    __call__ = value
+
+    def __repr__(self):
+        return repr(self._tf)
+
+
+def guarded_time_function(tf, entity: str, field: str):
+    """tf wrapped by GuardedTimeFunction (once)."""
+    return tf if isinstance(tf, GuardedTimeFunction) else GuardedTimeFunction(tf, entity, field)
+
+
+def call_vector(fn, t, state, entity: str, field: str) -> np.ndarray:
+    """fn(t, state) as a finite 3-vector, else EvaluationError naming entity, field and t [s]."""
+    try:
+        v = fn(t, state)
+    except MbdsimError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - user code
+        raise EvaluationError(entity, field, f"callable raised {type(exc).__name__}: {exc}", time=_time(t)) from exc
+    try:
+        a = np.asarray(v, dtype=float).reshape(-1)
+    except (TypeError, ValueError):
+        raise EvaluationError(entity, field, f"callable returned {v!r}; expected 3 finite numbers",
+                              time=_time(t)) from None
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise EvaluationError(entity, field, f"callable returned {v!r}; expected 3 finite numbers", time=_time(t))
+    return a
+
+
+def check_load_callable(entity: str, field: str, fn) -> None:
+    """ModelError unless fn can be called as fn(t, state) (checked at add time, without calling it)."""
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return   # builtins without a signature: checked at run time
+    try:
+        sig.bind(0.0, None)
+    except TypeError:
+        raise ModelError(entity, field, f"a callable load is called as f(t, state) -> 3 numbers; "
+                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t, state)") from None
+
+
+def check_time_callable(entity: str, field: str, fn) -> None:
+    """ModelError unless fn can be called as fn(t)."""
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return
+    try:
+        sig.bind(0.0)
+    except TypeError:
+        raise ModelError(entity, field, f"a driver callable is called as f(t) -> number; "
+                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t)") from None

@@ -1,0 +1,90 @@
+"""Issue 10, monitors: constraint violation, energy balance and contact penetration checked on every run;
+the first exceedance warns with time, quantity and element; Result.diagnostics keeps the history."""
+import warnings
+
+import numpy as np
+import pytest
+
+import mbdsim as mb
+from mbdsim.results.diagnostics import MonitorWarning, monitor
+from mbdsim.results.result import Result
+
+
+def pendulum():
+    m = mb.Model("p", gravity=(0.0, -9.81, 0.0))
+    b = m.add_body("b", 1.0, inertia=(0.01, 0.01, 0.01), position=(1.0, 0.0, 0.0))
+    m.add_revolute("j", m.ground, b, (0, 0, 0), (0, 0, 1))
+    return m, b
+
+
+def test_conservative_run_is_quiet_and_keeps_the_history():
+    m, _ = pendulum()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MonitorWarning)
+        res = mb.simulate(m, 2.0, 0.01)
+    d = res.diagnostics
+    assert len(d.time) == len(res.time) and len(d.energy_error) == len(res.time)
+    assert d.energy_scale > 9.0   # the pendulum falls from rest through 1 m: T reaches m g L = 9.81 J
+    assert np.max(np.abs(d.energy_error)) < 1e-6 * d.energy_scale
+    assert np.max(d.constraint_violation) < 1e-10 and not d.exceedances
+
+
+def test_energy_drift_of_a_loose_run_warns_with_time_and_element():
+    m, _ = pendulum()
+    with pytest.warns(MonitorWarning, match=r"model 'p': energy error .* first at t = ") as rec:
+        res = mb.simulate(m, 2.0, 0.01, rtol=1e-3, method="rk45")
+    first = res.diagnostics.exceedances[0]
+    assert first["quantity"] == "energy_error" and first["element"] == "model 'p'"
+    assert abs(first["value"]) > first["tolerance"] and 0 < first["time"] <= 2.0
+    i = int(np.searchsorted(res.time, first["time"]))   # the first sample past the tolerance
+    assert np.all(np.abs(res.diagnostics.energy_error[:i]) <= first["tolerance"])
+    assert len([w for w in rec if issubclass(w.category, MonitorWarning)]) == 1   # once per quantity and element
+
+
+def test_energy_balance_counts_the_work_of_applied_loads():
+    m, b = pendulum()
+    m.add_torque("tq", b, lambda t, state: (0.0, 0.0, 2.0 * np.sin(3.0 * t)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MonitorWarning)
+        res = mb.simulate(m, 2.0, 0.002, method="rk45", rtol=1e-10)
+    d = res.diagnostics
+    W = d._carry["W"]
+    assert abs(W) > 0.05 * d.energy_scale   # the torque did work: without W the balance would fail
+    assert np.max(np.abs(d.energy_error)) < 1e-4 * d.energy_scale
+
+
+def test_constraint_violation_names_the_joint_and_time():
+    m, _ = pendulum()
+    res = mb.simulate(m, 0.5, 0.01, monitor=False)
+    assert res.diagnostics is None
+    q = res.q.copy()
+    q[20:, 1] += 1e-3   # the body's CM moved off the pin circle from sample 20 on
+    bad = Result(res.system, res.time, q, res.v, None, None)
+    with pytest.warns(MonitorWarning, match=r"joint 'j': constraint violation 0.001 .* t = 0.2 s"):
+        d = monitor(bad)
+    assert d.exceedances[0]["element"] == "joint 'j'" and d.exceedances[0]["time"] == pytest.approx(0.2)
+
+
+def test_contact_penetration_warns_naming_the_contact():
+    m = mb.Model("c", gravity=(0, 0, -9.81))
+    ball = m.add_body("ball", 1.0, inertia=(0.1, 0.1, 0.1), position=(0, 0, 0.6))
+    m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), mb.Sphere(ball, 0.5), stiffness=1e3, exponent=1.5,
+                  damping=1.0, penetration=1e-3)   # far too soft: the 1 kg ball sinks ~10 cm into the plane
+    with pytest.warns(MonitorWarning, match=r"contact 'c': penetration"):
+        res = mb.simulate(m, 1.0, 0.001)
+    d = res.diagnostics
+    assert d.exceedances[0]["element"] == "contact 'c'" and np.max(d.penetration["c"]) > 0.05
+    # free fall from 0.1 m: first contact at t = sqrt(2 h / g); the exceedance comes after it
+    assert d.exceedances[0]["time"] > np.sqrt(2 * 0.1 / 9.81)
+
+
+def test_streamed_run_monitors_every_chunk(tmp_path, monkeypatch):
+    from mbdsim.solvers import stream
+    monkeypatch.setattr(stream, "CHUNK_ROWS", 300)
+    m, _ = pendulum()
+    res = mb.simulate(m, 2.0, 0.002, out=tmp_path / "r.parquet")
+    ref = mb.simulate(m, 2.0, 0.002)
+    d = res.diagnostics   # one entry per chunk (its extreme values): bounded history
+    assert len(d.time) == res.stats["chunks"] and d.time[-1] == 2.0
+    assert np.max(np.abs(d.energy_error)) == pytest.approx(np.max(np.abs(ref.diagnostics.energy_error)), abs=1e-12)
+    assert np.max(d.constraint_violation) == pytest.approx(np.max(ref.diagnostics.constraint_violation), abs=1e-15)

@@ -1,0 +1,123 @@
+"""Issue 10, long runs on disk: simulate(out=...) streams Parquet parts as computed, equal to the in-memory run;
+a SIGKILL at a random moment leaves every completed part readable; resume=True then ends bit-identical to an
+uninterrupted run (a chaotic double pendulum: any difference in the carried state would grow visibly)."""
+import os
+import random
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+import mbdsim as mb
+from mbdsim.cli.app import app
+from mbdsim.solvers import stream
+
+ROWS, MARGIN = 1000, 7
+
+
+def double_pendulum():
+    m = mb.Model("dp", gravity=(0.0, -9.81, 0.0))
+    a = m.add_body("a", 1.0, inertia=(0.01, 0.01, 0.01), position=(0.5, 0.0, 0.0))
+    b = m.add_body("b", 1.0, inertia=(0.01, 0.01, 0.01), position=(1.5, 0.0, 0.0))
+    m.add_revolute("j1", m.ground, a, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("j2", a, b, (1.0, 0, 0), (0, 0, 1))
+    return m
+
+
+@pytest.fixture
+def small_chunks(monkeypatch):
+    monkeypatch.setattr(stream, "CHUNK_ROWS", ROWS)
+    monkeypatch.setattr(stream, "MARGIN", MARGIN)   # small: the window-growing path is exercised too
+
+
+def test_streamed_run_equals_the_in_memory_run(tmp_path, small_chunks):
+    m = double_pendulum()
+    ref = mb.simulate(m, 5.0, 0.001)
+    res = mb.simulate(m, 5.0, 0.001, out=tmp_path / "run.parquet")
+    assert res.success and res.stats["samples"] == 5001 and res.stats["chunks"] >= 5
+    parts = sorted(p.name for p in (tmp_path / "run.parquet").glob("part-*.parquet"))
+    assert len(parts) == res.stats["chunks"]
+    df, d0 = pd.read_parquet(tmp_path / "run.parquet"), ref.to_dataframe()
+    assert list(df.columns) == list(d0.columns) and len(df) == len(d0)
+    assert np.array_equal(df["time [s]"].to_numpy(), ref.time)
+    # every chunk ends at a step end: the states are the in-memory run's exactly; derived columns to round-off
+    assert np.array_equal(res.q[-1], ref.q[-1]) and np.array_equal(res.v[-1], ref.v[-1])
+    assert np.max(np.abs(df.to_numpy() - d0.to_numpy())) < 1e-10
+    # angles are continuous across the part boundaries (no 2 pi jumps), Euler parameters keep their sign
+    assert np.max(np.abs(np.diff(df["j2.angle [rad]"].to_numpy()))) < 0.1
+    assert np.max(np.abs(np.diff(df["b.qw [-]"].to_numpy()))) < 0.1
+
+
+def test_bad_stream_arguments(tmp_path):
+    m = double_pendulum()
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, 1.0, resume=True)
+    assert err.value.field == "resume"
+    (tmp_path / "mine").mkdir()
+    (tmp_path / "mine" / "thesis.tex").write_text("precious")
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, 1.0, out=tmp_path / "mine")
+    assert err.value.field == "out" and (tmp_path / "mine" / "thesis.tex").exists()
+    mb.simulate(m, 0.5, 0.01, out=tmp_path / "r.parquet")
+    with pytest.raises(mb.ModelError, match="another run") as err:   # other settings than the checkpoint's
+        mb.simulate(m, 0.5, 0.01, rtol=1e-6, out=tmp_path / "r.parquet", resume=True)
+
+
+CHILD = """
+import sys
+sys.path[:0] = {path!r}
+import mbdsim as mb
+from mbdsim.solvers import stream
+stream.CHUNK_ROWS, stream.MARGIN = {rows}, {margin}
+sys.path.insert(0, {here!r})
+from test_stream_resume import double_pendulum
+mb.simulate(double_pendulum(), {end}, 0.001, out={out!r})
+"""
+
+
+def test_sigkill_at_a_random_moment_then_resume_is_bit_identical(tmp_path, small_chunks):
+    end = 30.0
+    out = tmp_path / "killed.parquet"
+    code = CHILD.format(path=sys.path, rows=ROWS, margin=MARGIN, here=str(Path(__file__).parent), end=end,
+                        out=str(out))
+    proc = subprocess.Popen([sys.executable, "-c", code], stderr=subprocess.PIPE)
+    deadline = time.time() + 240
+    while not (out / stream.CHECKPOINT).exists() and proc.poll() is None and time.time() < deadline:
+        time.sleep(0.05)
+    assert proc.poll() is None, proc.stderr.read().decode()[-3000:]
+    time.sleep(random.uniform(0.0, 1.0))   # a random moment: between or inside part / checkpoint writes
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait()
+    killed_rows = len(pd.read_parquet(out))   # every completed part is readable by pandas
+    assert 0 < killed_rows < int(end / 0.001) + 1
+    assert not any(p.name.startswith("part-") and p.suffix != ".parquet" for p in out.iterdir())
+
+    m = double_pendulum()
+    resumed = mb.simulate(m, end, 0.001, out=out, resume=True)
+    full = mb.simulate(m, end, 0.001, out=tmp_path / "full.parquet")
+    assert resumed.success and full.success
+    assert np.array_equal(resumed.q[-1], full.q[-1]) and np.array_equal(resumed.v[-1], full.v[-1])
+    a, b = pd.read_parquet(out), pd.read_parquet(tmp_path / "full.parquet")
+    assert len(a) == len(b) == int(end / 0.001) + 1
+    assert a.equals(b)   # every row, bit for bit
+
+
+def test_cli_streams_and_resumes(tmp_path, small_chunks):
+    model = tmp_path / "p.yaml"
+    mb.save_model(double_pendulum(), model)
+    out = tmp_path / "cli.parquet"
+    r = CliRunner().invoke(app, ["run", str(model), "--end", "2", "--step", "0.001", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    df = pd.read_parquet(out)
+    assert len(df) == 2001 and len(list(out.glob("part-*.parquet"))) >= 2
+    r = CliRunner().invoke(app, ["run", str(model), "--end", "2", "--step", "0.001", "--out", str(out), "--resume"])
+    assert r.exit_code == 0, r.output   # a finished run resumes to its end at once
+    assert pd.read_parquet(out).equals(df)
+    r = CliRunner().invoke(app, ["run", str(model), "--end", "2", "--resume"])
+    assert r.exit_code == 2
