@@ -32,6 +32,8 @@ def double_pendulum():
 
 @pytest.fixture
 def small_chunks(monkeypatch):
+    from mbdsim.results import stream as results_stream
+    monkeypatch.setattr(results_stream, "WRITE_INTERVAL", 1e9)   # parts by output count only: same boundaries
     monkeypatch.setattr(stream, "CHUNK_ROWS", ROWS)
     monkeypatch.setattr(stream, "MARGIN", MARGIN)   # small: the window-growing path is exercised too
 
@@ -75,6 +77,8 @@ sys.path[:0] = {path!r}
 import mbdsim as mb
 from mbdsim.solvers import stream
 stream.CHUNK_ROWS, stream.MARGIN = {rows}, {margin}
+from mbdsim.results import stream as results_stream
+results_stream.WRITE_INTERVAL = 1e9
 sys.path.insert(0, {here!r})
 from test_stream_resume import double_pendulum
 mb.simulate(double_pendulum(), {end}, 0.001, out={out!r})

@@ -15,7 +15,7 @@ import numpy as np
 from scipy import integrate
 
 from ._threads import blas_single_thread
-from ..errors import MbdsimError, ModelError, SolverError
+from ..errors import ModelError, SolverError
 from ..results.result import Result
 from ..results.stream import notify
 from ..system.assemble import assemble_system

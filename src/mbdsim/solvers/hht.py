@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.linalg as sla
 
-from ..errors import MbdsimError, SolverError
+from ..errors import SolverError
 from ..results.result import Result
 from ..results.stream import notify
 from ..system.dynamics import applied_forces
@@ -100,9 +100,6 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
     except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
         exc = analysis_error(exc, cur.t)
         success, message, error = False, f"{exc}; last good step at t = {cur.t:.9g} s", exc
-    except KeyboardInterrupt:
-        error = SolverError("interrupted (KeyboardInterrupt)", time=float(cur.t))
-        success, message = False, f"{error}; last good step at t = {cur.t:.9g} s"
     n = len(out)
 
     def evaluate(ts):

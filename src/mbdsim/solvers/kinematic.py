@@ -10,7 +10,7 @@ import warnings
 import numpy as np
 
 from ._threads import blas_single_thread
-from ..errors import AssemblyError, ModelError, SolverError
+from ..errors import AssemblyError, ModelError
 from ..results.result import Result
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
@@ -83,11 +83,6 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
             exc = analysis_error(exc, t)
             success, error = False, exc
             message = f"{exc}; last good state at t = {out[-1][0] if out else start_time:.9g} s"
-            break
-        except KeyboardInterrupt:
-            success, error = False, SolverError("interrupted (KeyboardInterrupt)", time=float(t))
-            last = out[-1][0] if out else start_time
-            message = f"interrupted (KeyboardInterrupt); last good state at t = {last:.9g} s"
             break
         out.append(state)
         flags.append(cond < SINGULAR_TOL)

@@ -171,7 +171,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                 saved = (st.copy(), y.copy(), f.copy(), run.stats.copy())
                 tout = np.asarray(times[g0:g0 + L], float)
                 status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
-                                          run.max_step, run.max_steps, max(1, CHUNK_ROWS + 1 - iout), 1e-12,
+                                          run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
                                           run.stats, K, F, sc, False, SY, ST, nsv)
                 if status == 0 and got == L and g0 + L < nout and \
                         times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
