@@ -40,31 +40,32 @@ def make_study(n: int) -> mb.Study:
     return mb.Study(slider_crank, PARAMETERS, OUTPUTS, analysis=ANALYSIS, sampling="lhs", samples=n, seed=7)
 
 
-def python_loop(design) -> tuple[float, list]:
-    """The baseline a user writes: one model after the other in this process."""
-    rows = []
-    t0 = time.perf_counter()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        for params in design.to_dict("records"):
-            res = mb.simulate(slider_crank(**params), 2.0, 0.01, rtol=1e-6)
-            _, force = res.maximum(lambda r: np.linalg.norm(r.reaction_force("crank_rod"), axis=1))
-            acc = np.max(np.abs(res.acceleration("slider")[:, 0]))
-            rows.append((force, acc))
-    return time.perf_counter() - t0, rows
+def python_loop(design) -> tuple[float, float, list]:
+    """The baseline a user writes: one model after the other in this process, Result.maximum for the peak."""
+    def loop():
+        rows = []
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for params in design.to_dict("records"):
+                res = mb.simulate(slider_crank(**params), 2.0, 0.01, rtol=1e-6)
+                _, force = res.maximum(lambda r: np.linalg.norm(r.reaction_force("crank_rod"), axis=1))
+                acc = np.max(np.abs(res.acceleration("slider")[:, 0]))
+                rows.append((force, acc))
+        return rows
+    return timed(loop)
 
 
 def timed(fn):
-    t0 = time.perf_counter()
+    """(wall seconds, CPU seconds of this process, result)."""
+    t0, c0 = time.perf_counter(), time.process_time()
     out = fn()
-    return time.perf_counter() - t0, out
+    return time.perf_counter() - t0, time.process_time() - c0, out
 
 
 def exudyn_loop(design):
     from exudyn_slider_crank import run_variant   # bench/exudyn_slider_crank.py
-    t0 = time.perf_counter()
-    rows = [run_variant(**p) for p in design.to_dict("records")]
-    return time.perf_counter() - t0, rows
+    run_variant(**design.iloc[0].to_dict())       # warm-up
+    return timed(lambda: [run_variant(**p) for p in design.to_dict("records")])
 
 
 def main(argv=None):
@@ -77,56 +78,72 @@ def main(argv=None):
     study = make_study(args.n)
     design = study.variants()
     python_loop(design.iloc[:1])                                  # warm-up: kernels loaded, as in a session
+    load0 = os.getloadavg()[0]
     results = []
-    secs, loop_rows = python_loop(design)
-    results.append(("python loop (mbdsim)", secs, 1))
-    secs, serial = timed(lambda: study.run(workers=0, progress=False))
-    results.append(("study, serial (workers=0)", secs, 1))
+    secs, cpu, loop_rows = python_loop(design)
+    results.append(("python loop (mbdsim, Result.maximum)", secs, cpu, 1))
+    secs, cpu, serial = timed(lambda: study.run(workers=0, progress=False))
+    results.append(("study, serial (workers=0)", secs, cpu, 1))
     assert (serial.status == "ok").all(), serial[serial.status != "ok"].message.tolist()
     assert np.allclose(serial.peak_rod_force, [r[0] for r in loop_rows], rtol=1e-12)
-    secs, cold = timed(lambda: study.run(workers=args.workers, progress=False))
-    results.append((f"study, dask {args.workers} workers (cluster start included)", secs, args.workers))
+    secs, _, cold = timed(lambda: study.run(workers=args.workers, progress=False))
+    results.append((f"study, dask {args.workers} workers (cluster start included)", secs, math.nan, args.workers))
+    import dask
     from distributed import Client, LocalCluster
-    with LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None) as cluster, \
+
+    from mbdsim.studies.runner import start_method
+    with dask.config.set({"distributed.worker.multiprocessing-method": start_method()}), \
+            LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None) as cluster, \
             Client(cluster) as client:
         make_study(2 * args.workers).run(client=client, chunk_size=1, progress=False)   # warm the workers
-        secs, warm = timed(lambda: study.run(client=client, progress=False))
-    results.append((f"study, dask {args.workers} workers (warm cluster)", secs, args.workers))
+        secs, _, warm = timed(lambda: study.run(client=client, progress=False))
+    results.append((f"study, dask {args.workers} workers (warm cluster)", secs, math.nan, args.workers))
     cols = ["peak_rod_force", "slider_peak_acceleration"]
     same = all(np.array_equal(serial[cols].to_numpy(), df[cols].to_numpy()) for df in (cold, warm))
     if args.exudyn:
-        secs, ex_rows = exudyn_loop(design)
-        results.append(("python loop (Exudyn 2D, 2 ms steps)", secs, 1))
+        secs, cpu, ex_rows = exudyn_loop(design)
+        results.append(("python loop (Exudyn 2D, 2 ms steps)", secs, cpu, 1))
         ex = np.array(ex_rows)
         dev = np.max(np.abs(ex[:, 0] / serial.peak_rod_force.to_numpy() - 1))
-        results.append((f"  (Exudyn peak rod force vs mbdsim: max deviation {100 * dev:.2f} %)", math.nan, 0))
-    report(results, args, same)
+        results.append((f"  (Exudyn peak rod force vs mbdsim: max deviation {100 * dev:.2f} %)", math.nan, math.nan, 0))
+    loads = (load0, os.getloadavg()[0])
+    report(results, args, same, loads)
 
 
-def report(results, args, same):
-    lines = [f"| method | seconds | variants/min | per worker |", "|---|---:|---:|---:|"]
-    for name, secs, nw in results:
+def report(results, args, same, loads):
+    lines = ["| method | seconds | variants/min | per worker | CPU ms/variant |", "|---|---:|---:|---:|---:|"]
+    rate = {}
+    for name, secs, cpu, nw in results:
         if math.isnan(secs):
-            lines.append(f"| {name} | | | |")
+            lines.append(f"| {name} | | | | |")
             continue
-        rate = 60 * args.n / secs
-        lines.append(f"| {name} | {secs:.2f} | {rate:.0f} | {rate / nw:.0f} |")
+        rate[name] = 60 * args.n / secs
+        cpu_txt = "" if math.isnan(cpu) else f"{1000 * cpu / args.n:.1f}"
+        lines.append(f"| {name} | {secs:.2f} | {rate[name]:.0f} | {rate[name] / nw:.0f} | {cpu_txt} |")
+    ex = next((v for k, v in rate.items() if "Exudyn" in k), None)
+    warm = next(v for k, v in rate.items() if "warm" in k)
+    serial = next(v for k, v in rate.items() if "serial" in k)
+    ratio = (f"\nRatio to the Exudyn loop: dask warm {warm / ex:.2f}x, serial study {serial / ex:.2f}x "
+             f"(target 10x); variants per minute, dask warm: {warm:.0f} (target 1000).\n") if ex else ""
     table = "\n".join(lines)
-    print(table)
+    print(table + ratio)
     head = (f"# Study throughput: slider-crank variants per minute\n\n"
             f"`python bench/study_throughput.py --n {args.n} --workers {args.workers}"
             f"{' --exudyn' if args.exudyn else ''}` on {platform.node()} ({os.cpu_count()} cores, "
-            f"{platform.python_version()}), {time.strftime('%Y-%m-%d')}.\n\n"
+            f"{platform.python_version()}), {time.strftime('%Y-%m-%d %H:%M')}; load average "
+            f"{loads[0]:.1f} at the start, {loads[1]:.1f} at the end (the cores are shared: wall-clock rates "
+            "are pessimistic by about that factor over the core count; the CPU column is this process's "
+            "CPU time).\n\n"
             "Each variant: slider-crank (crank, rod, three masses, drive speed from a Latin hypercube), dynamics "
             "over 2 s, output every 10 ms, rtol 1e-6; outputs: peak rod force at the crank pin (refined on the "
             "dense output) and the slider's peak acceleration.  The loop and the serial study run the same "
-            "work in one process; the Dask rows use worker processes (the first including the cluster start "
-            "and each worker's imports and kernel loading).\n\n"
+            "work in one process; the Dask rows use worker processes (the first including the cluster start: "
+            "one run in this process, then workers forked from it).\n\n"
             f"Dask results bit-identical to the serial run: {'yes' if same else 'NO'}.\n\n"
             + ("Exudyn: the same slider-crank as 2D rigid bodies (bench/exudyn_slider_crank.py), generalized-alpha "
                "with 1000 fixed steps of 2 ms, the drive a coordinate constraint with a Python offset function, "
                "peak values from its sensors at every step (no refinement); one process.\n\n" if args.exudyn else ""))
-    Path(args.out).write_text(head + table + "\n", encoding="utf-8")
+    Path(args.out).write_text(head + table + "\n" + ratio, encoding="utf-8")
     print(f"written: {args.out}")
 
 
