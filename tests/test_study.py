@@ -299,3 +299,17 @@ def test_row_store_journal_keeps_every_finished_row(tmp_path):
     assert list(load_rows(out, "abc").run) == [0, 1, 2, 3, 4]
     store2.close()
     assert not journal_path(out).exists() and list(load_rows(out, "abc").run) == [0, 1, 2, 3, 4]
+
+
+def test_callable_outputs():
+    """An output may be a callable of the Result: the same number as the expression; one that raises or
+    returns an array makes that run an 'error' row naming the output."""
+    outs = {"x_end": lambda res: float(res.position("slider")[-1, 0]), "x_end_expr": "final(x(position('slider')))",
+            "bad": lambda res: res.position("slider")[:, 0]}
+    df = mb.Study(slider_crank, {"crank": [0.1, 0.15]}, {k: outs[k] for k in ("x_end", "x_end_expr")},
+                  analysis={**FAST, "end_time": 0.25}).run(workers=0)
+    assert (df.status == "ok").all() and df.x_end.tolist() == df.x_end_expr.tolist()
+    r, l = df.crank, 0.4       # theta = pi/2 at t = 0.25 s: x = sqrt(l^2 - r^2)
+    assert np.allclose(df.x_end, np.sqrt(l**2 - r**2), atol=1e-9)
+    bad = mb.Study(slider_crank, {"crank": [0.1]}, {"bad": outs["bad"]}, analysis={**FAST, "end_time": 0.1}).run(workers=0)
+    assert bad.status[0] == "error" and "study output 'bad'" in bad.message[0] and "one number" in bad.message[0]
