@@ -188,3 +188,23 @@ def test_cold_kernel_cache_is_announced(tmp_path, monkeypatch):
     (tmp_path / "solvers_abc").mkdir()
     (tmp_path / "solvers_abc" / "fastdop.run-145.py311.nbi").write_bytes(b"")
     assert not _kernels_cold()
+
+
+def test_the_issue_sequence_run_plot_animate(tmp_path):
+    """issue 9, Must show: run a model file to Parquet, plot a column of it, animate the model and the
+    results (a streamed run's .parquet is a dataset directory: plot and animate read it too)."""
+    from mbdsim.cli.app import app as cli
+    out, png, page, page2 = (tmp_path / n for n in ("r.parquet", "x.png", "a.html", "b.html"))
+    r = runner.invoke(cli, ["run", str(EXAMPLES / "slider_crank.yaml"), "--end", "0.5", "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    r = runner.invoke(cli, ["plot", str(out), "slider.x", "-o", str(png)])
+    assert r.exit_code == 0, r.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    x = pd.read_parquet(out)["slider.x [m]"].to_numpy()
+    t = pd.read_parquet(out)["time [s]"].to_numpy()
+    th = 2 * np.pi * t                                   # x = r cos(th) + sqrt(l^2 - r^2 sin^2(th)), r 0.2, l 0.4
+    assert np.allclose(x, 0.2 * np.cos(th) + np.sqrt(0.16 - 0.04 * np.sin(th) ** 2), atol=1e-6)
+    for src, dst in ((EXAMPLES / "slider_crank.yaml", page), (out, page2)):
+        r = runner.invoke(cli, ["animate", str(src), "-o", str(dst), "--end", "0.5"])
+        assert r.exit_code == 0, r.output
+        assert "<html" in dst.read_text()[:500].lower()

@@ -28,12 +28,14 @@ def _fail(message: str, code: int = 2) -> None:
 
 
 def read_results(path: Path):
-    """The DataFrame of a results file (.csv or .parquet written from `res.to_dataframe()`)."""
+    """The DataFrame of a results file (.csv or .parquet written from `res.to_dataframe()`, or the Parquet
+    dataset directory a long run streams its parts into)."""
     import pandas as pd
 
-    if not path.is_file():
-        _fail(f"results file {str(path)!r} does not exist")
     suffix = path.suffix.lower()
+    dataset = path.is_dir() and suffix in (".parquet", ".pq")   # a run streamed in parts (`run --out x.parquet`)
+    if not (path.is_file() or dataset):
+        _fail(f"results file {str(path)!r} does not exist")
     if suffix not in RESULT_SUFFIXES:
         _fail(f"results file {str(path)!r}: expected .csv or .parquet, got {suffix or 'no suffix'!r}")
     try:
@@ -107,7 +109,7 @@ def animate_cmd(
     Exit status: 0 ok, 1 the run or the file failed, 2 bad input."""
     if out.suffix.lower() not in (".html", ".htm"):
         _fail(f"--out {str(out)!r}: expected an .html file")
-    if not source.is_file():
+    if not (source.is_file() or (source.is_dir() and source.suffix.lower() in (".parquet", ".pq"))):
         _fail(f"{str(source)!r} does not exist")
     from mbdsim.errors import MbdsimError
     from mbdsim.viewer import animate
