@@ -203,6 +203,13 @@ def test_cubic_spline_table():
 
 
 def test_library_registry():
-    assert set(F.LIBRARY) == {"STEP", "STEP5", "HAVSIN", "POLY", "SHF"}
+    assert set(F.LIBRARY) == {"STEP", "STEP5", "HAVSIN", "POLY", "SHF", "IMPACT", "BISTOP"}
     for name, entry in F.LIBRARY.items():
+        if name in ("IMPACT", "BISTOP"):   # order 0: the force, order 1: its partial d/dx at fixed xdot
+            args = (0.99, -0.3, 1.0, 1e4, 1.5, 10.0, 0.02) if name == "IMPACT" else (0.99, -0.3, 1.0, 2.0, 1e4, 1.5, 10.0, 0.02)
+            assert entry.fn(*args) == getattr(F, name)(*args)
+            assert entry.fn(*args, order=1) == getattr(F, f"{name}_d")(*args)
+            with pytest.raises(ValueError):
+                entry.fn(*args, order=2)
+            continue
         assert entry.fn is getattr(F, name)

@@ -127,11 +127,15 @@ _KINDS = {ast.Attribute: "attribute access", ast.Subscript: "subscript", ast.Lam
 _ARITY = {"atan2": (2, 2)}
 
 
-def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any] | None = None) -> Expr:
+def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any] | None = None,
+          measures: Any = None) -> Expr:
     """Parse ``text`` into an :class:`Expr` of ``variables`` (see the module docstring for the grammar).
 
     ``tables``: optional {name: table}, each callable as ``table(x, order=n)`` (e.g.
     :class:`mbdsim.functions.Akima`), usable in the text as ``name(x)``.
+    ``measures``: optional hook for state measures (load expressions, :mod:`mbdsim.model.loadexpr`): an
+    object with ``names`` (the measure function names) and ``call(name, args, fail) -> Var`` receiving
+    the argument texts (``"rod"``, ``"rod.tip"``); the returned variable is added to the Expr's variables.
     """
     if not isinstance(text, str):
         raise TypeError(f"expression must be a str, got {type(text).__name__}")
@@ -155,6 +159,9 @@ def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any
         raise ExpressionError(f"expression cannot be parsed ({type(exc).__name__})", text) from None
 
     src = body.lstrip()
+    measure_names = tuple(getattr(measures, "names", ()))
+    reserved |= set(measure_names)
+    extra_vars: list[str] = []
 
     def fail(what, node, token=None):
         pos = lead + len(src.encode()[:node.col_offset].decode(errors="ignore"))
@@ -205,10 +212,12 @@ def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any
         if not isinstance(n.func, ast.Name):
             fail("only whitelisted functions may be called, by name; not allowed: call of", n.func)
         name = n.func.id
+        if name in measure_names:
+            return walk_measure(n, name)
         lib = name.upper() if name in LIBRARY_FUNCTIONS else None
         if name not in _NP and lib is None and name not in tables:
-            fail(f"function not allowed (allowed: {', '.join(FUNCTIONS + LIBRARY_FUNCTIONS + tuple(tables))}):",
-                 n.func)
+            fail(f"function not allowed (allowed: "
+                 f"{', '.join(FUNCTIONS + LIBRARY_FUNCTIONS + tuple(tables) + measure_names)}):", n.func)
         for a in n.args:
             if isinstance(a, ast.Starred):
                 fail("starred argument not allowed:", a)
@@ -236,7 +245,24 @@ def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any
                 fail(f"invalid arguments ({exc}):", n)
         return finite(n, call(lib or name, tuple(args), order, tables.get(name)), args)
 
-    return Expr(walk(tree.body, 0), variables, text)
+    def walk_measure(n, name):
+        if n.keywords:
+            fail(f"{name} takes no keyword arguments:", n.keywords[0].value)
+        args = []
+        for a in n.args:
+            if isinstance(a, ast.Name):
+                args.append(a.id)
+            elif isinstance(a, ast.Attribute) and isinstance(a.value, ast.Name):
+                args.append(f"{a.value.id}.{a.attr}")
+            else:
+                fail(f"arguments of {name} name a body (its centre of mass) or a marker as body.marker, not", a)
+        var = measures.call(name, args, lambda what, node=n: fail(what, node))
+        if var.name not in extra_vars and var.name not in variables:
+            extra_vars.append(var.name)
+        return var
+
+    node = walk(tree.body, 0)
+    return Expr(node, variables + tuple(extra_vars), text)
 
 
 from .timefunctions import TimeFunction, double_integrated, integrated, time_function  # noqa: E402

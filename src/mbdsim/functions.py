@@ -287,8 +287,21 @@ class LibraryFunction:
     max_args: int | None     # None: unbounded
 
 
+def _contact_fn(fn, fn_d, name):
+    def f(x, *params, order=0):
+        if order == 0:
+            return fn(x, *params)
+        if order == 1:
+            return fn_d(x, *params)
+        raise ValueError(f"{name} has derivatives of order 0 and 1 (with respect to x) only")
+    f.__name__ = name.lower()
+    return f
+
+
 # the functions mbdsim.expressions accepts (upper case; lower-case aliases are added there)
 LIBRARY = {
+    "IMPACT": LibraryFunction("IMPACT", _contact_fn(impact, impact_d, "IMPACT"), 7, 7),
+    "BISTOP": LibraryFunction("BISTOP", _contact_fn(bistop, bistop_d, "BISTOP"), 8, 8),
     "STEP": LibraryFunction("STEP", step, 5, 5),
     "STEP5": LibraryFunction("STEP5", step5, 5, 5),
     "HAVSIN": LibraryFunction("HAVSIN", havsin, 5, 5),

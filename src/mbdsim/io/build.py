@@ -248,12 +248,33 @@ class Builder:
         entity = f"{element_word(e.type)} '{e.name}'"
         getattr(self, "add_" + e.type)(entity, e)
 
+    def load_value(self, value, unit):
+        """A load component: a number, a constant with units ("3 kN") or else an expression string (parsed,
+        never run, by the model's add_* method, which names the entity and field when it does not parse)."""
+        if not isinstance(value, str):
+            return float(value)
+        try:
+            return to_si(value, unit)
+        except UnitError:
+            return value
+
     def add_force(self, entity, e):
-        self.model.add_force(e.name, self.location(entity, "at", e.at), e.force, self.frame(entity, "frame", e.frame))
+        self.model.add_force(e.name, self.location(entity, "at", e.at), [self.load_value(c, "N") for c in e.force],
+                             self.frame(entity, "frame", e.frame))
 
     def add_torque(self, entity, e):
-        self.model.add_torque(e.name, self.body(entity, "body", e.body), e.torque,
+        self.model.add_torque(e.name, self.body(entity, "body", e.body), [self.load_value(c, "N*m") for c in e.torque],
                               self.frame(entity, "frame", e.frame))
+
+    def add_line_force(self, entity, e):
+        self.model.add_line_force(e.name, self.location(entity, "at_i", e.at_i), self.location(entity, "at_j", e.at_j),
+                                  self.load_value(e.magnitude, "N"))
+
+    def add_joint_force(self, entity, e):
+        jt = self.joint(entity, "joint", e.joint)
+        unit = "N*m" if self.coordinate_unit(entity, jt, e.dof or ("rotation" if jt.kind != "translational"
+                                                                     else "translation")) == "rad" else "N"
+        self.model.add_joint_force(e.name, jt, self.load_value(e.value, unit), e.dof)
 
     def add_spring_damper(self, entity, e):
         self.model.add_spring_damper(e.name, self.location(entity, "at_i", e.at_i), self.location(entity, "at_j", e.at_j),

@@ -160,10 +160,14 @@ def _motion(m) -> dict:
 
 
 def _constant(entity, field, value):
+    """A load as stored: numbers, or the expression texts of components written as expressions."""
+    from ..model.loadexpr import ExprVector, LoadExpr, load_text
+    if isinstance(value, (ExprVector, LoadExpr)):
+        return load_text(value)
     if callable(value):
         raise ModelError(entity, field, "a Python callable cannot be stored in a model file; "
-                         "use a constant vector")
-    return _vec(value)
+                         "use a constant or an expression string of time and state")
+    return _vec(value) if np.ndim(value) else float(value)
 
 
 def _force(f) -> dict:
@@ -194,13 +198,20 @@ def _shape(s) -> dict:
 
 def _element(e) -> dict:
     from ..model.element_specs import Bushing, Contact, Stop, TorsionSpring
-    from ..model.forces import Force, SpringDamper, Torque
+    from ..model.forces import Force, JointForce, LineForce, SpringDamper, Torque
     from ..model.friction_path import JointFriction
     if isinstance(e, Force):
         return _force(e)
     if isinstance(e, Torque):
         return _torque(e)
     head = {"name": e.name}
+    if isinstance(e, LineForce):
+        return {**head, "type": "line_force", "at_i": _marker_ref(e.marker_i), "at_j": _marker_ref(e.marker_j),
+                "magnitude": _constant(f"line force '{e.name}'", "magnitude", e.magnitude)}
+    if isinstance(e, JointForce):
+        d = {**head, "type": "joint_force", "joint": e.joint.name,
+             "value": _constant(f"joint force '{e.name}'", "value", e.value)}
+        return _put(d, "dof", e.dof if e.joint.kind == "cylindrical" else None)
     if isinstance(e, SpringDamper):
         return {**head, "type": "spring_damper", "at_i": _marker_ref(e.marker_i), "at_j": _marker_ref(e.marker_j),
                 "stiffness": e.stiffness, "damping": e.damping, "free_length": e.free_length, "preload": e.preload}

@@ -203,7 +203,7 @@ class PointOnCurveSpec(Spec):
     curve: CurveSpec
 
 
-from .schema_extra import EXTRA_JOINTS, ConstraintSpec, SensorSpec  # noqa: E402  (issue 11 specs)
+from .schema_extra import EXTRA_JOINTS, ConstraintSpec, JointForceSpec, LineForceSpec, SensorSpec  # noqa: E402
 
 JointSpec = Annotated[Union[(AxisJointSpec, SphericalSpec, UniversalSpec, PlanarSpec, FixedSpec, PointOnCurveSpec,
                              *EXTRA_JOINTS)], Field(discriminator="type")]
@@ -225,21 +225,29 @@ class MotionSpec(Spec):
 
 
 # ----------------------------------------------------------------------------- loads and elements
+# a load component: a number [SI], a constant with units ("3 kN") or an expression string of time and state
+# ("-k*DZ(ball)", mbdsim.model.loadexpr), told apart by mbdsim.io.build
+LoadVector = Annotated[list[Raw], Field(min_length=3, max_length=3)]
+
+
 class ForceSpec(Spec):
-    """Constant force [N] at a point; in ground axes, or in the axes of `frame` ("body" or "body.marker")."""
+    """Force [N] at a point, each component a number, a constant with units or an expression of time and
+    state; in ground axes, or in the axes of `frame` ("body" or "body.marker")."""
 
     type: Literal["force"]
     name: Name
     at: Location
-    force: V("N")
+    force: LoadVector
     frame: Optional[str] = None
 
 
 class TorqueSpec(Spec):
+    """Torque [N m] on a body, components as ForceSpec."""
+
     type: Literal["torque"]
     name: Name
     body: Name
-    torque: V("N*m")
+    torque: LoadVector
     frame: Optional[str] = None
 
 
@@ -340,7 +348,7 @@ class FrictionSpec(Spec):
 
 
 ElementSpec = Annotated[Union[ForceSpec, TorqueSpec, SpringDamperSpec, TorsionSpringSpec, BushingSpec, ContactSpec,
-                              StopSpec, FrictionSpec], Field(discriminator="type")]
+                              StopSpec, FrictionSpec, LineForceSpec, JointForceSpec], Field(discriminator="type")]
 
 
 class ModelSpec(Spec):

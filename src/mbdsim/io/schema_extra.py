@@ -1,12 +1,12 @@
 """Model-file specs of issue 11: joint primitives, screw and constant-velocity joints, coordinate
-constraints (couplers, gears, user constraints) and sensors.  Units as in mbdsim.io.schema."""
+constraints (couplers, gears, user constraints) and sensors; of issue 14: line and joint forces.  Units as in mbdsim.io.schema."""
 from __future__ import annotations
 
 from typing import Annotated, Literal, Optional, Union
 
 from pydantic import Field
 
-from .schema import Name, Number, Q, Spec, V   # imported by schema.py once these exist
+from .schema import Location, Name, Number, Q, Raw, Spec, V   # imported by schema.py once these exist
 
 
 class _Pair(Spec):
@@ -86,3 +86,24 @@ class SensorSpec(Spec):
     value: Number = 0.0
     direction: Literal[-1, 0, 1] = 0
     action: Literal["stop", "record"] = "stop"
+
+
+class LineForceSpec(Spec):
+    """Force [N] along the line between two points, positive pulling them together: a number, a constant
+    with units or an expression of time and state ("k*(DM(a.p, b.q) - L0) + c*VR(a.p, b.q)")."""
+
+    type: Literal["line_force"]
+    name: Name
+    at_i: Location
+    at_j: Location
+    magnitude: Raw
+
+
+class JointForceSpec(Spec):
+    """Generalized force [N] or torque [N m] along / about a joint's axis (unit by the joint's dof)."""
+
+    type: Literal["joint_force"]
+    name: Name
+    joint: Name
+    value: Raw
+    dof: Optional[Literal["rotation", "translation"]] = None

@@ -58,3 +58,47 @@ class SpringDamper:
     def point_j(self) -> np.ndarray:
         """Attachment point on body j in ground at t=0 [m]."""
         return self.marker_j.point
+
+
+@dataclass(eq=False)
+class ExprForce(Force):
+    """A Force whose components are numbers or load expressions (`force` is a loadexpr.ExprVector)."""
+
+
+@dataclass(eq=False)
+class ExprTorque(Torque):
+    """A Torque whose components are numbers or load expressions (`torque` is a loadexpr.ExprVector)."""
+
+
+@dataclass(eq=False)
+class LineForce:
+    """Action-reaction force along the line between two points (Adams SFORCE, translational).
+
+    `magnitude` [N] (a number, a loadexpr.LoadExpr or a callable (t, state)); positive pulls the points
+    together (the sign of a spring's tension): +magnitude u on marker_i's body, -magnitude u on
+    marker_j's, u the unit vector from point i to point j."""
+
+    name: str
+    marker_i: Marker
+    marker_j: Marker
+    magnitude: Any
+
+    @property
+    def needs_state(self) -> bool:
+        return callable(self.magnitude) and not isinstance(self.magnitude, str)
+
+
+@dataclass(eq=False)
+class JointForce:
+    """Generalized force along (dof "translation" [N]) or torque about (dof "rotation" [N m]) a joint's
+    axis, acting on body_j and, reacting, on body_i: positive drives the joint coordinate up (a motor's
+    torque, an actuator's force). `value`: a number, a loadexpr.LoadExpr or a callable (t, state)."""
+
+    name: str
+    joint: Any
+    dof: str
+    value: Any
+
+    @property
+    def needs_state(self) -> bool:
+        return callable(self.value)

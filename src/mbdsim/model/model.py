@@ -8,7 +8,8 @@ import numpy as np
 from ..errors import ModelError
 from ._check import scalar, vec3
 from .body import Body, Marker, make_body, shape_mass_properties
-from .forces import Force, SpringDamper, Torque
+from .forces import ExprForce, ExprTorque, Force, SpringDamper, Torque
+from .loadexpr import ExprLoadsMixin, ExprVector, load_vector
 from .elements import ForceElementsMixin
 from .friction_path import FrictionPathMixin
 from .joints import Joint, Motion, joint_initial
@@ -22,7 +23,7 @@ if TYPE_CHECKING:
                           TimeFunction, Vector)
 
 
-class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
+class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0), planar=False):
@@ -231,35 +232,37 @@ class Model(ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMix
     def add_force(self, name: str, at: Location, force: Load, frame: FrameRef = None) -> Force:
         """Force [N] at a point: `at` is a Marker or (body, point in ground at t=0 [m]).
 
-        `force` is a constant 3-vector or a callable (t, state) -> 3-vector, in ground axes when
-        frame is None else in the axes of the given Body/Marker."""
+        `force` is a constant 3-vector, three components each a number or an expression string of time
+        and state (mbdsim.model.loadexpr: "-k*DZ(ball)", "STEP(TIME, 0, 0, 1, 10)"), or a callable
+        (t, state) -> 3-vector, in ground axes when frame is None else in the axes of the given Body/Marker."""
         entity = f"force '{name}'"
         self._claim(name, "force")
         try:
             mk = self._location(entity, "at", at)
-            val = _load_callable(entity, "force", force) if callable(force) else vec3(entity, "force", force)
+            val = _load_callable(entity, "force", force) if callable(force) else load_vector(self, entity, "force", force)
             self._check_frame(entity, frame)
         except ModelError:
             self._names.discard(name)
             raise
-        f = Force(name, mk.body, mk.s_B, val, frame)
+        f = (ExprForce if isinstance(val, ExprVector) else Force)(name, mk.body, mk.s_B, val, frame)
         self.forces[name] = f
         return f
 
     def add_torque(self, name: str, body: BodyRef, torque: Load, frame: FrameRef = None) -> Torque:
-        """Pure torque [N m] on a body; constant 3-vector or callable (t, state); axes as add_force."""
+        """Pure torque [N m] on a body; constant 3-vector, components that are numbers or expression strings,
+        or a callable (t, state); axes as add_force."""
         entity = f"torque '{name}'"
         self._claim(name, "torque")
         try:
             b = self._lookup(body, self.bodies, entity, "body")
             if b.is_particle:
                 raise ModelError(entity, "body", f"{b.name!r} is a particle: it has no rotation for a torque to act on")
-            val = _load_callable(entity, "torque", torque) if callable(torque) else vec3(entity, "torque", torque)
+            val = _load_callable(entity, "torque", torque) if callable(torque) else load_vector(self, entity, "torque", torque)
             self._check_frame(entity, frame)
         except ModelError:
             self._names.discard(name)
             raise
-        t = Torque(name, b, val, frame)
+        t = (ExprTorque if isinstance(val, ExprVector) else Torque)(name, b, val, frame)
         self.forces[name] = t
         return t
 

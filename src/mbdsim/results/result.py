@@ -295,6 +295,23 @@ class Result:
             raise ValueError("driver efforts are not available: this result holds no multipliers")
         return jm.driver_effort(self, motion)
 
+    def expression(self, text: str) -> np.ndarray:
+        """Values (N,) of an expression of time and state written as for loads (mbdsim.model.loadexpr:
+        DM(rod.tip, ground.anchor), VR, WZ(rod), AX, joint coordinates by name and <joint>_dot ...);
+        here the accelerations ACCX/ACCY/ACCZ(i[, j][, k]) [m/s^2] are available too. Units: those of
+        the quantity written."""
+        from ..model.loadexpr import parse_load
+        from ..system.exprmeasures import evaluate
+        le = parse_load(self.system.model, text, f"expression {text!r}", "text", allow_acc=True)
+        if any(m.needs_acceleration for m in le.measures.values()):
+            self._need_acc("ACCX/ACCY/ACCZ")
+
+        def joint_value(joint, dof, rate):
+            x = (self.joint_velocity if rate else self.joint_coordinate)(joint)
+            jt = self._joint(joint)
+            return x[:, 1] if jt.kind == "cylindrical" and dof == "translation" else x
+        return evaluate(self.system, self.frames, le, self.time, joint_value)
+
     # ------------------------------------------------------------ springs and energy
     def _element(self, spring):
         forces = self.system.model.forces

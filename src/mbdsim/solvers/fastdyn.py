@@ -21,6 +21,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
     @njit(cache=True, _nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
+from ..system.exprloads_kernel import expr_loads
 from ..system.kernels import frames_into, quat_step, rows_kernel
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 from . import fasttree
@@ -61,13 +62,17 @@ def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
 
 
 @njit(cache=True, _nrt=False)
-def loads_into(cm, wk, r, A, rd, w, F):
-    """Gravity, gyroscopic torques, constant point forces/torques and linear spring-dampers into F."""
+def loads_into(cm, wk, t, y, r, A, rd, w, F):
+    """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings and the
+    loads written as expressions (system.exprloads_kernel; at time t [s], y: the joint-coordinate state on
+    the tree path) into F."""
     loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
                  cm[29], r, A, rd, w, F)
     if cm[36].shape[0]:
         bushings_kernel(cm[36], cm[37], cm[38], cm[39], cm[40], cm[41], r, A, rd, w, cm[6], F, wk[42][0],
                         wk[42][1])
+    if cm[43][7].shape[0]:
+        expr_loads(cm[43], wk[44], t, y, r, A, rd, w, cm[6], F)
 
 
 @njit(cache=True, _nrt=False)
@@ -286,7 +291,7 @@ def accelerations(cm, wk, t, q, v, vd, lam, refactor=True):
     _constraints(cm, wk, t, q, v)
     F = wk[8]
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
-    loads_into(cm, wk, r, A, rd, w, F)
+    loads_into(cm, wk, t, q, r, A, rd, w, F)
     if refactor and not _factor(cm, wk):
         return SINGULAR
     x6 = wk[25]
@@ -367,7 +372,7 @@ def tree_rhs(cm, wk, t, y, ydot):
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     fasttree.kinematics(cm[42], y, nj, r, A, rd, w, tw[10], tw[11])
     F = wk[8]
-    loads_into(cm, wk, r, A, rd, w, F)
+    loads_into(cm, wk, t, y, r, A, rd, w, F)
     if not fasttree.aba(cm[42], y, nj, r, A, rd, w, tw[10], F, cm[9], cm[10], tw, ydot):
         return SINGULAR
     for i in range(ydot.shape[0]):

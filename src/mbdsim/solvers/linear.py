@@ -365,7 +365,7 @@ def _inputs(model, sys, inputs, rows):
             raise ModelError("linearize", "inputs", f"{spec!r}: the component must be x, y or z")
         unit = "N" if isinstance(elem, Force) else "N m"
         val = elem.force if isinstance(elem, Force) else elem.torque
-        step = 1e-4 * max(1.0, float(np.max(np.abs(val))) if not callable(val) else 1.0)
+        step = 1e-4 * max(1.0, float(np.max(np.abs(val))) if isinstance(val, np.ndarray) else 1.0)
         for c in ("xyz".index(comp),) if comp else range(3):
             out.append(_Input(f"{name}.{'xyz'[c]} [{unit}]", elem, c, -1, step))
     return out
@@ -375,7 +375,9 @@ def _unit_load(sys, fr, t, inp, size=1.0):
     """Generalized force Q (nv) of `size` along component inp.comp of element inp.elem (its axes)."""
     e = np.zeros(3)
     e[inp.comp] = size
-    tmp = dataclasses.replace(inp.elem, **{"force" if isinstance(inp.elem, Force) else "torque": e})
+    base = Force if isinstance(inp.elem, Force) else Torque   # (an expression load's input: a plain load)
+    tmp = base(**{f.name: getattr(inp.elem, f.name) for f in dataclasses.fields(base)})
+    tmp = dataclasses.replace(tmp, **{"force" if base is Force else "torque": e})
     return evaluator(tmp).generalized(sys, fr, tmp, t, None)
 
 

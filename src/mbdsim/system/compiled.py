@@ -14,7 +14,7 @@ import numpy as np
 
 from ..model.element_specs import Bushing
 from ..model.forces import Force, SpringDamper, Torque
-from . import jointtree, kernels
+from . import exprloads_pack, jointtree, kernels
 from .measures import locate
 from .topology import Topology, system_topology
 
@@ -68,6 +68,8 @@ class CompiledModel:
     bushings: tuple = ()      # (frames (n, 2), marker points s_B (n, 2, 3), marker axes R_BM (n, 2, 3, 3),
     #                           stiffness, damping, preload (n, 6) each), see model.element_specs.Bushing
     tree: tuple = ()          # joint-coordinate tree (system.jointtree) when dims[5] == 1, else empty arrays
+    exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
+    ex_stack: int = 4         # stack size of their programs
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -78,7 +80,7 @@ class CompiledModel:
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
                 self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy(),
-                *self.bushings, self.tree)
+                *self.bushings, self.tree, self.exprloads)
 
 
 @dataclass
@@ -102,7 +104,8 @@ class Work:
              z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
              # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
              (z((nf, 6, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z(nf), z(nf), z((6, 6)),
-              z(6), z((nf, 3)), z((2, 3, 3))))
+              z(6), z((nf, 3)), z((2, 3, 3))),
+             exprloads_pack.work(cm.exprloads, cm.ex_stack))   # 44: expression loads' x and stack
         return cls(a)
 
     def arrays(self) -> tuple:
@@ -132,6 +135,8 @@ def _loads(sys):
     else."""
     pf, sp, bu = [], [], []
     for e in sys.model.forces.values():
+        if isinstance(e, exprloads_pack.EXPR_TYPES):
+            continue   # packed by exprloads_pack
         if isinstance(e, (Force, Torque)):
             vec = e.force if isinstance(e, Force) else e.torque
             if callable(vec):
@@ -185,6 +190,8 @@ def compile_system(sys, rows, state=None) -> CompiledModel:
     dense = any(np.linalg.eigvalsh(M6[f]).min() <= 1e-12 * max(np.abs(M6[f]).max(), 1e-300) for f in range(1, nf))
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
         jointtree.tree_arrays(sys, rows, *state)
+    exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES)]
+    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state) if exl else (exprloads_pack.empty(), 4)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
                          sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
@@ -192,4 +199,4 @@ def compile_system(sys, rows, state=None) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          np.stack([v1, v2, v3]), drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
-                         np.sort(rows), stack, bushings, tree)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack)

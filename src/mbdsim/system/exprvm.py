@@ -4,7 +4,7 @@
 spline tables); `pack(programs)` concatenates a model's programs into single arrays; `eval_program`
 (numba, compiled once and cached: its signature is fixed arrays) evaluates program k with the variable
 values x. Semantics are numpy's (nan for log of a negative number, inf for division by zero), the
-Adams library (STEP, STEP5, HAVSIN, POLY, SHF with derivative orders) as in `mbdsim.functions`, and
+Adams library (STEP, STEP5, HAVSIN, POLY, SHF with derivative orders; IMPACT, BISTOP and their d/dx) as in `mbdsim.functions`, and
 spline tables (Akima, cubic) as piecewise cubics with their derivatives. Variables are slots of x
 (e.g. x[0] = t [s]); a program never runs Python.
 """
@@ -22,7 +22,7 @@ from .._exprtree import Bin, Call, Const, ExpressionError, Fn, Neg, Var
 CONST, VAR, ADD, SUB, MUL, DIV, POW, NEG, ATAN2 = 0, 1, 2, 3, 4, 5, 6, 7, 8
 UNARY = {"sin": 10, "cos": 11, "tan": 12, "asin": 13, "acos": 14, "atan": 15, "sinh": 16, "cosh": 17,
          "tanh": 18, "exp": 19, "log": 20, "sqrt": 21, "abs": 22, "sign": 23}
-LIB = {"STEP": 30, "STEP5": 31, "HAVSIN": 32, "POLY": 33, "SHF": 34}
+LIB = {"STEP": 30, "STEP5": 31, "HAVSIN": 32, "POLY": 33, "SHF": 34, "IMPACT": 35, "BISTOP": 36}
 TABLE = 40
 _BIN = {"+": ADD, "-": SUB, "*": MUL, "/": DIV, "**": POW}
 
@@ -189,6 +189,21 @@ def _poly_step(deg, x, x0, h0, x1, h1, order):
 
 
 @njit(cache=True, _nrt=False, error_model="numpy")
+def _impact(x, xd, x1, k, e, cmax, d, order):
+    """Adams IMPACT (mbdsim.functions.impact) and, order 1, its partial d/dx at fixed xd."""
+    p = x1 - x
+    if p <= 0.0:
+        return 0.0
+    c = _poly_step(3, x, x1 - d, cmax, x1, 0.0, 0)
+    f = k * p ** e - c * xd
+    if f <= 0.0:
+        return 0.0
+    if order == 0:
+        return f
+    return -k * e * p ** (e - 1.0) - _poly_step(3, x, x1 - d, cmax, x1, 0.0, 1) * xd
+
+
+@njit(cache=True, _nrt=False, error_model="numpy")
 def _table(tables, off, order, x):
     """Piecewise cubic (scipy PPoly layout) and its derivatives at x; nan outside when not extrapolating."""
     m = int(tables[off])
@@ -301,6 +316,13 @@ def eval_program(code, consts, tables, start, end, x, stack):
                     r = 0.0
                 else:
                     r = -dh / 2.0 * (np.pi / dx) ** order * np.cos(uu + order * np.pi / 2.0)
+            elif op == 35:                         # IMPACT(x, xdot, x1, k, e, cmax, d)
+                r = _impact(xx, stack[base + 1], stack[base + 2], stack[base + 3], stack[base + 4],
+                            stack[base + 5], stack[base + 6], order)
+            elif op == 36:                         # BISTOP(x, xdot, x1, x2, k, e, cmax, d): IMPACT minus its mirror
+                k, e, cm, d = stack[base + 4], stack[base + 5], stack[base + 6], stack[base + 7]
+                r = (_impact(xx, stack[base + 1], stack[base + 2], k, e, cm, d, order)
+                     - (-1.0) ** order * _impact(-xx, -stack[base + 1], -stack[base + 3], k, e, cm, d, order))
             elif op == 33:                         # POLY(x, x0, a0, ..., an): Horner on the derivative
                 uu = xx - stack[base + 1]
                 r = 0.0

@@ -1,0 +1,195 @@
+"""Compiled (numba) loads written as expressions (issue 14): measures, programs, forces into F.
+
+`expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F)` fills the variable vector x (x[0] = t [s], x[1 + m] the
+value of measure m) from the frames of one state, runs each load component's postfix program with the
+expression interpreter of `system.exprvm` and adds the loads into F (six slots per frame: CM force in
+ground axes, torque in body axes), as `solvers.fastdyn.loads_into` does for the built-in elements.
+No Python runs per evaluation. `ex` is `system.exprloads_pack.pack(...)`'s tuple, `ew` its work tuple.
+
+Measure kinds (mbdsim.model.loadexpr): 0-2 DX DY DZ, 3 DM, 4-6 VX VY VZ, 7 VM, 8 VR, 9-11 WX WY WZ,
+12 WM, 13-15 AX AY AZ, 20 joint angle (joint-coordinate path only: offset + sign theta), 21 its rate,
+22 joint slide, 23 its rate. Load kinds: 0 point force, 1 torque (components in the axes of frame
+ld_f[e, 2] rotated by ld_R), 2 line force (magnitude along the line, positive pulling together),
+3 joint torque (about the joint axis; the angle's Jacobian rows), 4 joint force (along the axis).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .exprvm import eval_program
+from .kernels import _dot1
+
+
+@njit(cache=True, _nrt=False)
+def _rot(A, f, s0, s1, s2):
+    return (A[f, 0, 0] * s0 + A[f, 0, 1] * s1 + A[f, 0, 2] * s2,
+            A[f, 1, 0] * s0 + A[f, 1, 1] * s1 + A[f, 1, 2] * s2,
+            A[f, 2, 0] * s0 + A[f, 2, 1] * s1 + A[f, 2, 2] * s2)
+
+
+@njit(cache=True, _nrt=False)
+def _axis(A, f, R, c):
+    """Column c of A[f] R (a marker's axis c in ground)."""
+    return _rot(A, f, R[0, c], R[1, c], R[2, c])
+
+
+@njit(cache=True, _nrt=False)
+def _cross(a0, a1, a2, b0, b1, b2):
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@njit(cache=True, _nrt=False)
+def _point(r, A, rd, w, f, s):
+    """Ground position and velocity of the point s (body axes, from the CM) of frame f."""
+    s0, s1, s2 = _rot(A, f, s[0], s[1], s[2])
+    v0, v1, v2 = _cross(w[f, 0], w[f, 1], w[f, 2], s0, s1, s2)
+    return (r[f, 0] + s0, r[f, 1] + s1, r[f, 2] + s2), (rd[f, 0] + v0, rd[f, 1] + v1, rd[f, 2] + v2)
+
+
+@njit(cache=True, _nrt=False)
+def _in_axes(A, f, R, v0, v1, v2, c):
+    """Component c of the ground vector v in the axes A[f] R."""
+    a = _axis(A, f, R, c)
+    return a[0] * v0 + a[1] * v1 + a[2] * v2
+
+
+@njit(cache=True, _nrt=False)
+def measure(k, fi, fj, fk, si, sj, Ri, Rj, Rk, v, r, A, rd, w):
+    """Value of a measure of kind k at one state (frames r, A, rd, w; ground = frame 0)."""
+    if k <= 8:
+        pi, vi = _point(r, A, rd, w, fi, si)
+        pj, vj = _point(r, A, rd, w, fj, sj)
+        d0, d1, d2 = pi[0] - pj[0], pi[1] - pj[1], pi[2] - pj[2]
+        e0, e1, e2 = vi[0] - vj[0], vi[1] - vj[1], vi[2] - vj[2]
+        if k <= 2:
+            return _in_axes(A, fk, Rk, d0, d1, d2, k)
+        if k == 3:
+            return np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if k <= 6:
+            return _in_axes(A, fk, Rk, e0, e1, e2, k - 4)
+        if k == 7:
+            return np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        return (d0 * e0 + d1 * e1 + d2 * e2) / L if L > 0.0 else 0.0
+    if k <= 12:
+        o0, o1, o2 = w[fi, 0] - w[fj, 0], w[fi, 1] - w[fj, 1], w[fi, 2] - w[fj, 2]
+        if k == 12:
+            return np.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+        return _in_axes(A, fk, Rk, o0, o1, o2, k - 9)
+    if k <= 15:
+        if k == 13:     # AX = atan2(-zi.yj, zi.zj)
+            a, b, c = _axis(A, fi, Ri, 2), _axis(A, fj, Rj, 1), _axis(A, fj, Rj, 2)
+            return np.arctan2(-(a[0] * b[0] + a[1] * b[1] + a[2] * b[2]), a[0] * c[0] + a[1] * c[1] + a[2] * c[2])
+        if k == 14:     # AY = atan2(zi.xj, zi.zj)
+            a, b, c = _axis(A, fi, Ri, 2), _axis(A, fj, Rj, 0), _axis(A, fj, Rj, 2)
+        else:           # AZ = atan2(xi.yj, xi.xj)
+            a, b, c = _axis(A, fi, Ri, 0), _axis(A, fj, Rj, 1), _axis(A, fj, Rj, 0)
+        return np.arctan2(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], a[0] * c[0] + a[1] * c[1] + a[2] * c[2])
+    if k == 21:         # joint angle rate (absolute coordinates): N / rho^2 of the angle primitive
+        S, cS, qS, Sd = _dot1(A, w, fi, fj, v[1], v[2])
+        C, cC, qC, Cd = _dot1(A, w, fi, fj, v[0], v[2])
+        return (C * Sd - S * Cd) / (S * S + C * C)
+    # joint slide (22) and its rate (23): h_i . d, d = P_j - P_i (v: h_i, s_i, s_j in body axes)
+    h = _rot(A, fi, v[0, 0], v[0, 1], v[0, 2])
+    pi, vi = _point(r, A, rd, w, fi, v[1])
+    pj, vj = _point(r, A, rd, w, fj, v[2])
+    d0, d1, d2 = pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]
+    if k == 22:
+        return h[0] * d0 + h[1] * d1 + h[2] * d2
+    c0, c1, c2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], h[0], h[1], h[2])
+    return (h[0] * (vj[0] - vi[0]) + h[1] * (vj[1] - vi[1]) + h[2] * (vj[2] - vi[2])
+            + c0 * d0 + c1 * d1 + c2 * d2)
+
+
+@njit(cache=True, _nrt=False)
+def _force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
+    """Ground-axes force at ground offset s from the CM of frame f, into F (nf, 6)."""
+    if f == 0:
+        return
+    F[f, 0] += F0
+    F[f, 1] += F1
+    F[f, 2] += F2
+    if rigid[f]:
+        m0, m1, m2 = _cross(s0, s1, s2, F0, F1, F2)
+        for k in range(3):
+            F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
+
+
+@njit(cache=True, _nrt=False)
+def _torque(F, A, f, T0, T1, T2, rigid):
+    """Ground-axes torque on frame f, into F (body axes)."""
+    if f == 0 or not rigid[f]:
+        return
+    for k in range(3):
+        F[f, 3 + k] += A[f, 0, k] * T0 + A[f, 1, k] * T1 + A[f, 2, k] * T2
+
+
+@njit(cache=True, _nrt=False)
+def _value(code, consts, tables, start, end, p, x, stack):
+    return 0.0 if p < 0 else eval_program(code, consts, tables, start[p], end[p], x, stack)
+
+
+@njit(cache=True, _nrt=False)
+def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
+    """Measures, expression programs and their loads at one state into F (see the module docstring).
+    y: the joint-coordinate state [theta, theta_dot] on the tree path (read by joint measures that have
+    a tree coordinate), else unused."""
+    ms_kind, ms_f, ms_s, ms_R, ms_v, ms_jq, ms_jc = ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6]
+    ld_kind, ld_f, ld_s, ld_R, ld_v, ld_prog = ex[7], ex[8], ex[9], ex[10], ex[11], ex[12]
+    code, consts, tables, start, end = ex[13], ex[14], ex[15], ex[16], ex[17]
+    x, stack = ew[0], ew[1]
+    x[0] = t
+    nj = y.shape[0] // 2
+    for m in range(ms_kind.shape[0]):
+        k = ms_kind[m]
+        q = ms_jq[m]
+        if k >= 20 and q >= 0:
+            if k == 20 or k == 22:
+                x[1 + m] = ms_jc[m, 0] + ms_jc[m, 1] * y[q]
+            else:
+                x[1 + m] = ms_jc[m, 1] * y[nj + q]
+            continue
+        x[1 + m] = measure(k, ms_f[m, 0], ms_f[m, 1], ms_f[m, 2], ms_s[m, 0], ms_s[m, 1], ms_R[m, 0],
+                           ms_R[m, 1], ms_R[m, 2], ms_v[m], r, A, rd, w)
+    for e in range(ld_kind.shape[0]):
+        k = ld_kind[e]
+        fi, fj = ld_f[e, 0], ld_f[e, 1]
+        v0 = _value(code, consts, tables, start, end, ld_prog[e, 0], x, stack)
+        if k <= 1:
+            v1 = _value(code, consts, tables, start, end, ld_prog[e, 1], x, stack)
+            v2 = _value(code, consts, tables, start, end, ld_prog[e, 2], x, stack)
+            R = ld_R[e]
+            l0 = R[0, 0] * v0 + R[0, 1] * v1 + R[0, 2] * v2
+            l1 = R[1, 0] * v0 + R[1, 1] * v1 + R[1, 2] * v2
+            l2 = R[2, 0] * v0 + R[2, 1] * v1 + R[2, 2] * v2
+            G0, G1, G2 = _rot(A, ld_f[e, 2], l0, l1, l2)
+            if k == 1:
+                _torque(F, A, fi, G0, G1, G2, rigid)
+            else:
+                s0, s1, s2 = _rot(A, fi, ld_s[e, 0, 0], ld_s[e, 0, 1], ld_s[e, 0, 2])
+                _force(F, A, fi, s0, s1, s2, G0, G1, G2, rigid)
+        elif k == 2:        # line force: +T u on i, -T u on j, u from point i to point j
+            si = _rot(A, fi, ld_s[e, 0, 0], ld_s[e, 0, 1], ld_s[e, 0, 2])
+            sj = _rot(A, fj, ld_s[e, 1, 0], ld_s[e, 1, 1], ld_s[e, 1, 2])
+            d0 = r[fj, 0] + sj[0] - r[fi, 0] - si[0]
+            d1 = r[fj, 1] + sj[1] - r[fi, 1] - si[1]
+            d2 = r[fj, 2] + sj[2] - r[fi, 2] - si[2]
+            L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            inv = v0 / L if L > 0.0 else 0.0
+            _force(F, A, fi, si[0], si[1], si[2], d0 * inv, d1 * inv, d2 * inv, rigid)
+            _force(F, A, fj, sj[0], sj[1], sj[2], -d0 * inv, -d1 * inv, -d2 * inv, rigid)
+        elif k == 3:        # joint torque: T times the angle's Jacobian rows (ground-axes rotations)
+            S, cS, qS, Sd = _dot1(A, w, fi, fj, ld_v[e, 1], ld_v[e, 2])
+            C, cC, qC, Cd = _dot1(A, w, fi, fj, ld_v[e, 0], ld_v[e, 2])
+            s = v0 / (S * S + C * C)
+            J0, J1, J2 = s * (C * cS[0] - S * cC[0]), s * (C * cS[1] - S * cC[1]), s * (C * cS[2] - S * cC[2])
+            _torque(F, A, fi, J0, J1, J2, rigid)
+            _torque(F, A, fj, -J0, -J1, -J2, rigid)
+        else:               # joint force: F h_i at P_j on body j, -F h_i at the same ground point on body i
+            h = _rot(A, fi, ld_v[e, 0, 0], ld_v[e, 0, 1], ld_v[e, 0, 2])
+            sj = _rot(A, fj, ld_v[e, 2, 0], ld_v[e, 2, 1], ld_v[e, 2, 2])
+            _force(F, A, fj, sj[0], sj[1], sj[2], v0 * h[0], v0 * h[1], v0 * h[2], rigid)
+            o0, o1, o2 = r[fj, 0] + sj[0] - r[fi, 0], r[fj, 1] + sj[1] - r[fi, 1], r[fj, 2] + sj[2] - r[fi, 2]
+            _force(F, A, fi, o0, o1, o2, -v0 * h[0], -v0 * h[1], -v0 * h[2], rigid)

@@ -1,0 +1,137 @@
+"""Arrays of the expression loads (issue 14) for the compiled kernel `system.exprloads_kernel`.
+
+`pack(sys, elems, mode, tree, state)` turns ExprForce/ExprTorque/LineForce/JointForce elements into the
+tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`); `work(ex)` gives its scratch.
+A Python callable, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
+event-driven reference path), raises NotCompiled with the reason. On the joint-coordinate path a joint
+measure reads the tree's own coordinate: angle = angle at assembly + sign theta (sign -1 when the
+joint's body_i is the child in the tree).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..model.forces import ExprForce, ExprTorque, JointForce, LineForce
+from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr
+from .measures import locate
+
+EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce)
+
+
+class _NotCompiled(Exception):
+    pass
+
+
+def empty() -> tuple:
+    """`ex` of a model without expression loads (same types as `pack`'s)."""
+    i, f = np.int64, float
+    return (np.zeros(0, i), np.zeros((0, 3), i), np.zeros((0, 2, 3)), np.zeros((0, 3, 3, 3)), np.zeros((0, 3, 3)),
+            np.zeros(0, i), np.zeros((0, 2)), np.zeros(0, i), np.zeros((0, 3), i), np.zeros((0, 2, 3)),
+            np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), np.zeros((0, 3), i), np.zeros((0, 2), i), np.zeros(0, f),
+            np.zeros(0, f), np.zeros(0, i), np.zeros(0, i))
+
+
+def work(ex, stack_size) -> tuple:
+    """Scratch of `expr_loads`: the variable vector x (1 + measures) and the interpreter's stack."""
+    return np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4))
+
+
+def _target(sys, name):
+    if name is None:
+        return 0, np.zeros(3), np.eye(3)
+    return locate(sys, name)
+
+
+def _joint_measure(sys, m, mode, tree, fr):
+    """(kind, frames, vectors, tree coordinate index, (offset, sign)) of a joint measure."""
+    from .measures import joint_coordinate
+    jt = sys.model.joints[m.joint]
+    g = sys.geoms[jt.name]
+    rot = m.dof == "rotation"
+    v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
+    kind = (JOINT_ANGLE if rot else JOINT_SLIDE) + int(m.rate)
+    jq, jc = -1, (0.0, 1.0)
+    if mode == 1:
+        parent, qadr = tree[0], tree[7]
+        child, sign = (g.bj, 1.0) if parent[g.bj] == g.bi else (g.bi, -1.0)
+        jq = int(qadr[child])
+        ang, _, sl, _ = joint_coordinate(sys, fr, jt)
+        jc = (float((ang if rot else sl)[0]), sign)
+    elif rot and not m.rate:
+        raise _NotCompiled(f"the angle of joint '{jt.name}' (continued beyond +-pi by events on the "
+                           "reference path, or the joint-coordinate state)")
+    return kind, (g.bi, g.bj, 0), v, jq, jc
+
+
+def pack(sys, elems, mode, tree, state):
+    """(ex, stack size) of the expression loads `elems`; NotCompiled (from system.compiled) when one cannot
+    be compiled."""
+    from . import exprvm
+    from .compiled import NotCompiled
+    from .frames import body_frames
+    fr = None
+    if mode == 1:
+        f1 = body_frames(sys, *state)
+        from .frames import Frames
+        fr = Frames(f1.r[None], f1.A[None], f1.rd[None], f1.w[None])
+    measures, ms, loads, progs = {}, [], [], []
+
+    def program(elem, v):
+        if isinstance(v, LoadExpr):
+            slots = {n: 0 for n in TIME_NAMES}
+            for var, m in v.measures.items():
+                if m not in measures:
+                    measures[m] = len(measures)
+                    try:
+                        ms.append(_measure_row(sys, m, mode, tree, fr))
+                    except _NotCompiled as exc:
+                        raise NotCompiled(f"load '{elem.name}' reads {exc}") from None
+                slots[var] = 1 + measures[m]
+            progs.append(exprvm.compile_expr(v.expr, slots))
+        elif callable(v):
+            raise NotCompiled(f"load '{elem.name}' is a Python callable")
+        else:
+            progs.append(exprvm.constant_program(float(v)))
+        return len(progs) - 1
+
+    for e in elems:
+        z3, eye = np.zeros(3), np.eye(3)
+        if isinstance(e, (ExprForce, ExprTorque)):
+            vec = e.force if isinstance(e, ExprForce) else e.torque
+            p = [program(e, c) for c in vec.components]
+            ff, _, R = (0, None, eye) if e.frame is None else locate(sys, e.frame)
+            s = e.s_B if isinstance(e, ExprForce) else z3
+            loads.append((0 if isinstance(e, ExprForce) else 1, (sys.fid[e.body], 0, ff), (s, z3), R,
+                          np.zeros((3, 3)), p))
+        elif isinstance(e, LineForce):
+            p = [program(e, e.magnitude), -1, -1]
+            loads.append((2, (sys.fid[e.marker_i.body], sys.fid[e.marker_j.body], 0),
+                          (e.marker_i.s_B, e.marker_j.s_B), eye, np.zeros((3, 3)), p))
+        else:
+            g = sys.geoms[e.joint.name]
+            rot = e.dof == "rotation"
+            v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
+            loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, e.value), -1, -1]))
+    if not loads:
+        return empty(), 4
+    pk = exprvm.pack(progs)
+    i = np.int64
+    nm = len(ms)
+    ex = (np.array([m[0] for m in ms], i).reshape(nm), np.array([m[1] for m in ms], i).reshape(nm, 3),
+          np.array([m[2] for m in ms], float).reshape(nm, 2, 3), np.array([m[3] for m in ms], float).reshape(nm, 3, 3, 3),
+          np.array([m[4] for m in ms], float).reshape(nm, 3, 3), np.array([m[5] for m in ms], i).reshape(nm),
+          np.array([m[6] for m in ms], float).reshape(nm, 2),
+          np.array([x[0] for x in loads], i), np.array([x[1] for x in loads], i).reshape(-1, 3),
+          np.array([x[2] for x in loads], float).reshape(-1, 2, 3), np.array([x[3] for x in loads], float).reshape(-1, 3, 3),
+          np.array([x[4] for x in loads], float).reshape(-1, 3, 3), np.array([x[5] for x in loads], i).reshape(-1, 3),
+          pk.code, pk.consts, pk.tables, pk.start, pk.end)
+    return ex, int(pk.stack_size)
+
+
+def _measure_row(sys, m, mode, tree, fr):
+    """(kind, (fi, fj, fk), (s_i, s_j), (R_i, R_j, R_k), joint vectors, tree index, (offset, sign))."""
+    if m.joint is not None:
+        kind, f, v, jq, jc = _joint_measure(sys, m, mode, tree, fr)
+        return kind, f, np.zeros((2, 3)), np.broadcast_to(np.eye(3), (3, 3, 3)), v, jq, jc
+    (fi, si, Ri), (fj, sj, Rj), (fk, _, Rk) = (_target(sys, x) for x in (m.i, m.j, m.k))
+    return m.kind, (fi, fj, fk), (si, sj), (Ri, Rj, Rk), np.zeros((3, 3)), -1, (0.0, 1.0)
