@@ -21,7 +21,7 @@ import numpy as np
 
 import mbdsim as mb
 
-REPEAT, END, STEP, RTOL = 5, 5.0, 0.01, 1e-8
+REPEAT, END, STEP, RTOL = 15, 5.0, 0.01, 1e-8
 K, C, L0, N_SPRING, N_LINK, C_JOINT = 200.0, 0.8, 0.25, 6, 5, 0.05
 
 
