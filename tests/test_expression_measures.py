@@ -216,3 +216,14 @@ def test_callables_still_run_and_refuse_model_files(tmp_path):
     assert res.joint_velocity("pin")[-1] == pytest.approx(2.0 / I, rel=1e-8)
     with pytest.raises(ModelError, match="callable"):
         mb.save_model(m, tmp_path / "x.yaml")
+
+
+def test_sensor_on_a_measure_meets_the_drop_time():
+    """A sensor on DZ(ball, ground) - R (the gap) stops a free fall from h at t = sqrt(2 (h - R) / g)."""
+    m = mb.Model(gravity=(0, 0, -9.81))
+    m.add_body("ball", mass=1.0, inertia=(1, 1, 1), position=(0.3, 0, 1.0))
+    m.add_sensor("floor", "DZ(ball, ground) - 0.1", 0.0, direction=-1)
+    res = mb.simulate(m, 1.0, output_step=0.01)
+    assert res.sensor_events[0].time == pytest.approx(np.sqrt(2 * 0.9 / 9.81), abs=1e-10)
+    with pytest.raises(ModelError, match="sensor 'x'.signal.*no body or body.marker named 'bal'"):
+        m.add_sensor("x", "DZ(bal)")

@@ -3,7 +3,7 @@ the time it is met, located on the integrator's dense output to solver precision
 
 The signal is an expression string in t [s], the coordinates of one-coordinate joints by name
 (revolute/screw angle [rad], continuous; translational slide [m]) and their rates `<joint>_dot`
-[rad/s, m/s]; or a callable signal(t, state) -> float receiving the same `state` as load callables
+[rad/s, m/s], and the measures of load expressions (DX ... AZ, TIME; mbdsim.model.loadexpr); or a callable signal(t, state) -> float receiving the same `state` as load callables
 (Result measures at one instant: state.position("ball")[2], state.joint_coordinate("pin"), ...).
 """
 from __future__ import annotations
@@ -73,21 +73,18 @@ class SensorsMixin:
         return s
 
     def _sensor_expression(self, entity, text):
-        from ..expressions import FUNCTIONS, LIBRARY_FUNCTIONS, ExpressionError, parse
-        reserved = set(FUNCTIONS) | set(LIBRARY_FUNCTIONS) | {"pi", "t"}
-        one = [n for n, j in self.joints.items() if j.ncoord == 1 and n.isidentifier() and n not in reserved]
-        names = one + [f"{n}_dot" for n in one if f"{n}_dot" not in reserved]
-        try:
-            e = parse(text, ("t", *names))
-        except (ExpressionError, ValueError) as exc:
-            raise ModelError(entity, "signal", f"{exc} (variables: t, the one-coordinate joints "
-                             f"{', '.join(one) or '(none)'} and their rates <joint>_dot)") from None
-        coords = [n for n in one if e.depends_on(n)]
-        rates = [(f"{n}_dot", n) for n in one if f"{n}_dot" in names and e.depends_on(f"{n}_dot")]
+        """signal(t, state) of an expression in the language of load expressions (mbdsim.model.loadexpr:
+        t, TIME, joint coordinates by name and <joint>_dot, measures DX ... AZ of bodies and markers)."""
+        import numpy as np
+
+        from .loadexpr import parse_load
+        le = parse_load(self, text, entity, "signal")
 
         def signal(t, state):
-            env = {"t": t} if e.depends_on("t") else {}
-            env.update({n: float(state.joint_coordinate(n)) for n in coords})
-            env.update({r: float(state.joint_velocity(n)) for r, n in rates})
-            return float(e.evaluate(**env))
+            from ..system.exprmeasures import evaluate
+            res = state._res
+
+            def joint_value(joint, dof, rate):
+                return np.atleast_1d(state.joint_velocity(joint) if rate else state.joint_coordinate(joint))
+            return float(evaluate(res.system, res.frames, le, t, joint_value)[0])
         return signal
