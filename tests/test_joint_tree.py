@@ -68,7 +68,7 @@ def test_articulated_body_accelerations_equal_the_augmented_solve():
     r, A, rd, ww, P, Rt = _frames_scratch(nf)
     fasttree.kinematics(tree, y, nj, r, A, rd, ww, P, Rt)
     F = np.zeros((nf, 6))
-    fastdyn.loads_into(a, w, r, A, rd, ww, F)
+    fastdyn.loads_into(a, w, 0.0, y, r, A, rd, ww, F)
     tw = tuple(np.zeros(s) for s in ((nf, 6, 6), (nf, 6), (nf, 6), (nf, 6), (nf, 6), (nf, 6), nf, nf, (6, 6), 6))
     ydot = np.zeros(2 * nj)
     assert fasttree.aba(tree, y, nj, r, A, rd, ww, P, F, cm.mass, cm.inertia, tw, ydot)
