@@ -27,7 +27,7 @@ def random_tree(seed=3, kinds=("revolute", "translational", "revolute", "fixed",
     for k, kind in enumerate(kinds):
         c = pts + rng.normal(size=3) * 0.3
         J = Rotation.random(random_state=seed + k).as_matrix()
-        I = J @ np.diag(rng.uniform(0.05, 0.2, 3)) @ J.T
+        I = J @ np.diag(rng.uniform(0.12, 0.2, 3)) @ J.T   # principal moments meet the triangle inequality
         b = m.add_body(f"b{k}", rng.uniform(0.5, 2), inertia=I, position=c,
                        orientation=Rotation.random(random_state=k).as_matrix(),
                        velocity=rng.normal(size=3), angular_velocity=rng.normal(size=3))

@@ -236,7 +236,7 @@ class Result:
         `frame` axes; indeterminate components flagged as in reaction_force."""
         return self._flagged(joint, on, frame, 1)
 
-    def reaction_determinacy(self, joint, on=None, frame=None):
+    def reaction_determinacy(self, joint: JointRef, on: BodyRef | None = None, frame: FrameRef = None) -> Array:
         """(N, 6) booleans, True where (Fx, Fy, Fz, Tx, Ty, Tz) of the joint's reaction (axes as
         reaction_force) is *indeterminate* at each sample; all False without redundant constraints."""
         from ..system.determinacy import indeterminate_components
