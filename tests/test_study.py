@@ -313,3 +313,21 @@ def test_callable_outputs():
     assert np.allclose(df.x_end, np.sqrt(l**2 - r**2), atol=1e-9)
     bad = mb.Study(slider_crank, {"crank": [0.1]}, {"bad": outs["bad"]}, analysis={**FAST, "end_time": 0.1}).run(workers=0)
     assert bad.status[0] == "error" and "study output 'bad'" in bad.message[0] and "one number" in bad.message[0]
+
+
+def test_reaction_measures_equal_result_values():
+    """Study reaction measures skip Result's determinacy analysis (an SVD per sample at every call) but give
+    its values: same numbers with on= and frame=; wrong arguments name the output."""
+    from mbdsim.studies.measures import compile_output
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.simulate(slider_crank(), 0.5, 0.01, rtol=1e-6)
+        ref_f = res.reaction_force("crank_rod", on="crank", frame="rod")
+        ref_t = res.reaction_torque("crank_rod")
+    f = compile_output("f", "final(y(reaction_force('crank_rod', on='crank', frame='rod')))")
+    t = compile_output("t", "max(z(reaction_torque('crank_rod')))")
+    assert f(res) == ref_f[-1, 1]
+    assert abs(t(res)) <= np.max(np.abs(ref_t)) + 1e-12 and np.max(np.abs(ref_t)) < 1e-9   # revolute: no torque about z
+    df = mb.Study(slider_crank, {"crank": [0.1]}, {"bad": "max(norm(reaction_force('crank_rod', relative_to='rod')))"},
+                  analysis={**FAST, "end_time": 0.1}).run(workers=0)
+    assert df.status[0] == "error" and "study output 'bad'" in df.message[0]

@@ -97,8 +97,9 @@ class Result:
         if self._evaluate is None:
             return self._bracketed(ts)
         q, v, vd, lam = self._evaluate(np.clip(ts, lo, hi))
-        out = Result(self.system, ts, q, v, vd, lam, self._evaluate, self.success, self.status, self.message)
-        out._parent = self._parent or self
+        out = Result(self.system, ts, q, v, vd, lam, self._evaluate, self.success, self.status, self.message,
+                     stats={"assembly": self.stats["assembly"]} if "assembly" in self.stats else None)
+        out._parent = self._parent or self   # (the assembly's rows: no determinacy analysis without redundancy)
         return out
 
     def _bracketed(self, ts) -> "Result":

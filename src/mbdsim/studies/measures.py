@@ -5,7 +5,9 @@ numbers, strings, + - * / ** , indexing ([:, 0]), and calls of the whitelisted n
 
 Signals (arrays over the output times; SI units, ground axes unless a frame is given):
     t, position(x), velocity(x), acceleration(x), angular_velocity(b), angular_acceleration(b),
-    joint_coordinate(j), joint_velocity(j), joint_acceleration(j), reaction_force(j), reaction_torque(j),
+    joint_coordinate(j), joint_velocity(j), joint_acceleration(j), reaction_force(j), reaction_torque(j)
+    (the minimum-norm values where redundant constraints leave components indeterminate, without
+    Result's determinacy flags: check those once with Result.reaction_determinacy),
     driver_effort(m), spring_length(s), spring_velocity(s), spring_force(s), kinetic_energy(),
     potential_energy()      (keywords as in Result: frame=, on=, relative_to=, kind=)
 Element-wise: x(v), y(v), z(v) (components of an (N, 3) signal), norm(v), abs, sqrt, sin, cos, degrees.
@@ -53,6 +55,7 @@ SIMPLE_REDUCTIONS = {
     "initial": lambda s: s[0], "final": lambda s: s[-1],
 }
 REFINED = {"max": (+1, 1), "min": (-1, 1), "time_of_max": (+1, 0), "time_of_min": (-1, 0)}
+REACTIONS = {"reaction_force": 0, "reaction_torque": 1}
 KEYWORDS = {"frame", "on", "relative_to", "kind", "direction"}
 BINOPS = {ast.Add: operator.add, ast.Sub: operator.sub, ast.Mult: operator.mul, ast.Div: operator.truediv,
           ast.Pow: operator.pow}
@@ -155,7 +158,17 @@ class _Interpreter:
         fn = node.func.id
         kw = {k.arg: self.ev(k.value, res) for k in node.keywords}
         if fn in MEASURES:
-            return getattr(res, fn)(*(self.ev(a, res) for a in node.args), **kw)
+            args = [self.ev(a, res) for a in node.args]
+            if fn in REACTIONS and hasattr(res, "_reaction"):
+                # the values of Result.reaction_force/torque without their determinacy analysis (an SVD
+                # per sample at every call; with redundant constraints the indeterminate components are
+                # the minimum-norm split either way: check them once with Result.reaction_determinacy)
+                given = {**dict(zip(("joint", "on", "frame"), args)), **kw}
+                if len(args) > 3 or set(given) - {"joint", "on", "frame"} or "joint" not in given:
+                    raise TypeError(f"{fn}(joint, on=None, frame=None): got {len(args)} arguments and "
+                                    f"keywords {sorted(kw)}")
+                return res._reaction(given["joint"], given.get("on"), given.get("frame"))[REACTIONS[fn]]
+            return getattr(res, fn)(*args, **kw)
         args = node.args
         if fn in REFINED and len(args) == 1:
             sign, which = REFINED[fn]
