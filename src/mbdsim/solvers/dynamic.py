@@ -69,7 +69,7 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     killed run leaves what it computed. A ".parquet" path on the compiled DOP853 (method "auto" or
     "dop853" on a model the kernels carry) is a Parquet dataset directory streamed in parts as they are
     computed, with checkpoints: bounded memory whatever the length (the returned Result holds every
-    output while they fit STREAM_KEEP bytes, else the last part; res.stats["out"], ["samples"]) and
+    output while they fit 8 MB (stream.STREAM_KEEP), else the last part; res.stats["out"], ["samples"]) and
     resume=True continues it from its last checkpoint, bit-identical to an uninterrupted run
     (mbdsim.solvers.stream). Otherwise `res.to_dataframe()` of the outputs so far is rewritten every few
     seconds, atomically, and completely at the end (mbdsim.results.stream); `pandas.read_parquet(out)`

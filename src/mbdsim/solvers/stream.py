@@ -34,7 +34,7 @@ from ..results import stream as results_stream
 from ..results.result import Result
 
 CHUNK_ROWS = 5_000           # output times per part file (a chunk ends at the first step end past them)
-STREAM_KEEP = 32 * 2**20   # bytes of output states the returned Result may hold (else: the last part only)
+STREAM_KEEP = 8 * 2**20    # bytes of output states the returned Result may hold (else: the last part only)
 MARGIN = 1024                # extra rows for the outputs of a chunk's last step (grown when a step has more)
 CHECKPOINT = "_checkpoint.npz"
 META = "_run.json"
@@ -154,7 +154,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     SY, ST, nsv = np.zeros((0, ns)), np.zeros((0, 2)), np.zeros(1, np.int64)
     t_end, nout = float(times[-1]), len(times)
     from ..results.diagnostics import compact_tail, monitor as run_monitors
-    diag, kept = None, []
+    diag = None
+    kept = [] if nout * n * 8 <= STREAM_KEEP else None   # a long run keeps nothing but the current part
     status, error, last = 0, None, (np.asarray(times[i0 - 1:i0], float), ylast[None, :], None)
     while i0 < nout:
         g0 = i0 - 1                                # global index of row 0 (the previous chunk's last output)
@@ -213,8 +214,6 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
-            if sum(r.nbytes for _, r in kept) > STREAM_KEEP:
-                kept = None   # long run: the Result holds the last part only
         prev_row, ylast = df.iloc[-1], rows[-1].copy()
         chunk, i0 = chunk + 1, i1
         _save_checkpoint(path, fp, chunk, i0, st, y, f, run.stats, ylast, prev_row)
