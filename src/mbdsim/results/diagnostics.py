@@ -28,7 +28,7 @@ CONSTRAINT_TOL = 1e-6
 ENERGY_TOL = 1e-4
 ENERGY_TOL_QUADRATURE = 2e-2
 PENETRATION_FRACTION = 0.1
-MAX_SAMPLES = 2000
+MAX_SAMPLES = 32   # constraint residuals are evaluated one sample at a time: a coarse, cheap check
 
 
 class MonitorWarning(UserWarning):
