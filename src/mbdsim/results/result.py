@@ -246,8 +246,13 @@ class Result:
             return np.zeros((len(self.time), 6), dtype=bool)
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
         body = None if on is None else ms.resolve_body(self.system, on, "on")
-        return indeterminate_components(self.system, self.q, jt, body,
-                                        None if frame is None else (lambda x: self._express(x, frame)))
+        cache = self.__dict__.setdefault("_determinacy", {})   # an SVD per sample: once per joint, body, axes
+        key = (getattr(jt, "name", jt), id(body), id(frame) if frame is not None and not isinstance(frame, str)
+               else frame)
+        if key not in cache:
+            cache[key] = indeterminate_components(self.system, self.q, jt, body,
+                                                  None if frame is None else (lambda x: self._express(x, frame)))
+        return cache[key].copy()
 
     def _flagged(self, joint, on, frame, which):
         import warnings
