@@ -91,8 +91,8 @@ def main(argv=None):
     import dask
     from distributed import Client, LocalCluster
 
-    from mbdsim.studies.runner import start_method
-    with dask.config.set({"distributed.worker.multiprocessing-method": start_method()}), \
+    from mbdsim.studies.runner import local_cluster_config
+    with dask.config.set(local_cluster_config()), \
             LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None) as cluster, \
             Client(cluster) as client:
         make_study(2 * args.workers).run(client=client, chunk_size=1, progress=False)   # warm the workers
