@@ -13,8 +13,13 @@ Coordinates are zero in the configuration the model was built in; axes are those
   angle1 the rotation of the cross about axis_i relative to body_i, angle2 the rotation of body_j about
   axis_j relative to the cross, so that R_rel = Rot(axis_i, angle1) Rot(axis_j(t=0), angle2).
 
-Angles continue beyond +-pi: each wrapped sample is placed on the branch nearest the trapezoidal
-prediction from the rates, so a joint turning by more than pi per output step is followed.  A rotation
+Angles continue beyond +-pi, with whole turns counted on the solver's own steps: the analyses record
+the state at the start of each accepted step (`Result.steps`), the angle is continued step to step
+(each step's increment the one nearest the trapezoidal prediction from the rates; a step turns a
+joint by far less than pi), and each output sample is placed on the branch nearest the prediction from
+the start of its step.  Revolute, cylindrical, planar and the universal joint's yoke angles are
+therefore the same for any output_step, and at the same times from Result.at.  (Without a step record,
+e.g. a Result built by hand, samples are continued sample to sample the same way.)  A rotation
 vector theta = psi a keeps a continuous axis a (its sign follows the previous sample) and its angle psi
 is continued the same way, i.e. past pi it becomes the equivalent vector (|theta| - 2 pi) theta / |theta|
 instead of jumping.  (Through a full turn, |theta| = 2 pi, of a tumbling motion the axis itself is not
@@ -175,7 +180,7 @@ def rotation_coordinate(res, jt):
         sign = np.where(sign == 0, 1.0, sign)
     axis = axis * sign[:, None]
     psi0, rate = phi * sign, np.einsum("ni,ni->n", axis, th_dot)
-    psi = continued(res, psi0, rate, lambda p: (parent[0], parent[2]))
+    psi = continued(res, psi0, rate, lambda p: (parent[0], parent[2]), steps=False)
     return psi, axis, rate
 
 
@@ -206,12 +211,21 @@ def _fill_axes(th, phi, tiny=1e-12):
 
 
 # ----------------------------------------------------------------------------- continuity of angles
-def continued(res, raw, rate, parent_values, anchor=None):
+def continued(res, raw, rate, parent_values, anchor=None, steps=True):
     """Continue wrapped angles raw (N,) [rad] with rates (N,) [rad/s] past +-pi.
 
-    A Result without parent continues sample to sample (from `anchor` (N,), a reference recorded during
+    When the analysis recorded its own steps (`step_track`), the angle is continued along the solver's
+    steps and each sample is placed on the branch nearest the trapezoidal prediction from the start of
+    the step containing it: the same for any output_step, dense output and Result.at.  Otherwise a
+    Result without parent continues sample to sample (from `anchor` (N,), a reference recorded during
     the run, when given); a Result from `at()` continues `parent_values(parent) -> (angles, rates)` from
     the parent's nearest sample."""
+    track = step_track(res) if steps else None
+    if track is not None:
+        s_ang, s_rate = parent_values(track)
+        k = np.clip(np.searchsorted(track.time, res.time, side="right") - 1, 0, len(track.time) - 1)
+        ref = s_ang[k] + 0.5 * (s_rate[k] + rate) * (res.time - track.time[k])
+        return ref + _wrap(raw - ref)
     if res._parent is None:
         if anchor is not None:   # a torsion spring / stop on the joint continued the angle in the run
             raw = anchor + _wrap(raw - anchor)
@@ -221,6 +235,25 @@ def continued(res, raw, rate, parent_values, anchor=None):
     k = _nearest(p.time, res.time)
     ref = p_ang[k] + 0.5 * (p_rate[k] + rate) * (res.time - p.time[k])
     return ref + _wrap(raw - ref)
+
+
+def step_track(res):
+    """A Result (no output sampling) holding the states at the start of every accepted solver step and at
+    the end of the run, from the analysis' `steps` record ((t, q, v) or a callable giving it); None when
+    the analysis kept none, or for that Result itself."""
+    root = res._parent or res
+    st = getattr(root, "steps", None)
+    if st is None:
+        return None
+    track = root.__dict__.get("_step_track")
+    if track is None:
+        st = st() if callable(st) else st
+        if st is None or len(st[0]) < 2:
+            root.steps = None
+            return None
+        track = type(root)(root.system, *st, None, None)
+        root._step_track = track
+    return None if track is res else track
 
 
 def _wrap(x):

@@ -43,6 +43,7 @@ class Result:
         self.stats = stats or {}
         self._fr = None
         self._parent = None
+        self.steps = None   # (t, q, v) at the solver's step starts and the end, or a callable giving them
         self.error = None   # the MbdsimError that stopped a failed run (time, joints, last good state)
         self.diagnostics = None   # run monitors (mbdsim.results.diagnostics.Diagnostics), set by simulate
 

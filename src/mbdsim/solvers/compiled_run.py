@@ -150,6 +150,26 @@ class CompiledRun:
         return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
 
 
+    def step_states(self, t_last, y_last):
+        """(t, q, v) at the start of every accepted step (the checkpoints, absolute coordinates) and at
+        (t_last, y_last), or None when the run kept no checkpoints."""
+        cp = getattr(self, "checkpoints", None)
+        if cp is None or not len(cp[1]):
+            return None
+        SY, ST = cp
+        inside = ST[:, 0] < t_last
+        SY, ST = SY[inside], ST[inside]
+        n = self.sys.nq + self.sys.nv
+        Y = np.zeros((len(SY) + 1, n))
+        if self.joint_space:
+            a, w = self.cm.arrays(), self.work.arrays()
+            for j in range(len(SY)):
+                fastdyn.write_state(a, w, SY[j].copy(), Y[j], Y[j][:0])
+        else:
+            Y[:-1] = SY
+        Y[-1] = y_last
+        return np.append(ST[:, 0], t_last), Y[:, :self.sys.nq], Y[:, self.sys.nq:]
+
     def _from_checkpoints(self, cp, ts, full=True):
         SY, ST = cp
         sys = self.sys
@@ -226,9 +246,12 @@ def _result(sys, rep, run, t_out, Y, success=True, message="ok", stats=None) -> 
         VD, LAM = run.outputs(t_out, Y)
         return VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)
 
-    return Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None, evaluate=lambda ts: run.states_at(t_out, Y, ts),
-                  success=success, status=0 if success else -1, message=message, stats=stats,
-                  accelerations=accelerations)
+    res = Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None, evaluate=lambda ts: run.states_at(t_out, Y, ts),
+                 success=success, status=0 if success else -1, message=message, stats=stats,
+                 accelerations=accelerations)
+    if len(t_out):   # the run's own steps (checkpoints), for joint angles independent of the sampling
+        res.steps = lambda: run.step_states(float(t_out[-1]), Y[-1])
+    return res
 
 
 def _full_multipliers(sys, rows, times, Y, VD, LAM):

@@ -274,6 +274,14 @@ class _Trajectory:
         y = self.dense[k][1](t)
         return consistent_state(self.sys, y, t, self.rows, self.sf)
 
+    def step_states(self):
+        """(t, q, v) at the start of every accepted step and at the end (Euler parameters normalised)."""
+        ts = [d[0] for d in self.dense] + [self.t_end[-1]]
+        ys = [d(t0) for t0, d in self.dense] + [self.dense[-1][1](self.t_end[-1])]
+        Y = np.array(ys)
+        q = np.array([normalize(self.sys, y[:self.sys.nq]) for y in Y])
+        return np.array(ts), q, Y[:, self.sys.nq:]
+
     def evaluate(self, ts):
         states = [self.state(t) for t in ts]
         return tuple(np.array([s[i] for s in states]) for i in range(4))
@@ -359,6 +367,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
                  stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
     res.error = error
     res.sensor_events = list(events.sensor_events)
+    res.steps = traj.step_states if traj.dense else None
     return res
 
 

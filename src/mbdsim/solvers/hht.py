@@ -116,6 +116,8 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
                         "factorizations": tan.nlu, "order": 2, "method": "HHT", "alpha": alpha,
                         "assembly": rep})
     res.error = error
+    res.steps = lambda: (np.array([s.t for s in steps]), np.array([s.q for s in steps]),
+                         np.array([s.v for s in steps]))
     return res
 
 

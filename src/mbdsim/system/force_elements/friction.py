@@ -45,6 +45,7 @@ from ...model.friction_path import JointFriction
 from ..constraints.base import RowSpec
 from . import register
 from .friction_kkt import load_maps, normal_load
+from .friction_lcp import decide_all, stuck_margin
 
 V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
 STICK_TOL = 1e-10   # relative tolerance on the static friction limit
@@ -63,8 +64,12 @@ class StickSlip:
         return self.modes[k] if k >= 0 else (self.modes[0] if self.modes else None)
 
     def record(self, t, mode, direction=0.0, target=0.0):
-        if self.times and self.times[-1] >= t:
+        """Mode from time t on (replacing a decision at the same time); a repeat of the mode in force
+        (same mode and direction) is not recorded again, so each transition appears once."""
+        while self.times and self.times[-1] >= t:
             del self.times[-1], self.modes[-1]
+        if self.modes and self.modes[-1][:2] == (mode, float(direction)):
+            return
         self.times.append(float(t))
         self.modes.append((mode, float(direction), float(target)))
 
@@ -166,36 +171,6 @@ def _base_rows(sys, q, v, t):
     return rows
 
 
-def _decide(sys, elem, t, q, v):
-    """Mode decision at an event or at the start (see module docstring)."""
-    from ...solvers.common import accelerations
-    from ...solvers.state import state_factory
-    from ..equations import constraint_terms
-    from ..frames import body_frames
-    for other in sys.switched.values():   # elements not decided yet act as frictionless meanwhile
-        if not other.times:
-            other.record(t, "free")
-    st = sys.switched[elem.name]
-    m = st.at(t)
-    if m is not None and m[0] == "free":
-        m = None
-    fr = body_frames(sys, q, v)
-    xd = float(_rate(sys, _timed(fr), elem)[0])
-    if m is not None and m[0] == "slip" and m[1] * xd > V_TOL:
-        return
-    if m is None and abs(xd) > V_TOL:
-        st.record(t, "slip", np.sign(xd))
-        return
-    J = constraint_terms(sys, q, v, t)[1]
-    base = _base_rows(sys, q, v, t)
-    if m is None or m[0] == "slip":
-        st.record(t, "stick", 0.0, float(_coordinate(sys, _timed(fr), elem)[0]))
-    lam = accelerations(sys, q, v, t, base, state_factory(sys))[1]
-    margin, lf, eps = _stick_margin(sys, fr, J, lam, elem)
-    if margin <= eps / 2:
-        st.record(t, "slip", 1.0 if lf >= 0 else -1.0)
-
-
 @register(JointFriction)
 class FrictionEval:
     """Evaluator of JointFriction (its load enters through `friction_kkt`, not `generalized`)."""
@@ -218,19 +193,21 @@ class FrictionEval:
         m = sys.switched[elem.name].at(t)
         if m is None:
             return np.ones(1)
-        if m[0] == "slip":
-            return np.array([m[1] * float(_rate(sys, _timed(fr), elem)[0])])
+        if m[0] == "slip":   # offset V_TOL/2: the event is met with the joint at rest, never just before
+            return np.array([m[1] * float(_rate(sys, _timed(fr), elem)[0]) + 0.5 * V_TOL])
+        if m[0] == "free":
+            return np.ones(1)
         from ..equations import constraint_terms
         J = constraint_terms(sys, fr.q, fr.v, t)[1]
-        return np.array([_stick_margin(sys, fr, J, fr.lambda_, elem)[0]])
+        return np.array([stuck_margin(sys, fr, J, fr.lambda_, elem, t)[0]])
 
     @staticmethod
     def on_start(sys, elem, t, q, v):
-        _decide(sys, elem, t, q, v)
+        decide_all(sys, t, q, v)
 
     @staticmethod
     def on_event(sys, elem, t, q, v):
-        _decide(sys, elem, t, q, v)
+        decide_all(sys, t, q, v)
 
     @staticmethod
     def dissipation(sys, fr, elem, t=None):
@@ -255,7 +232,12 @@ def friction_events(res, name):
     """[(time [s], mode, direction)] of the element's stick/slip history within the result's span."""
     st = res.system.switched[_element(res, name).name]
     t1 = res.time[-1] if len(res.time) else -np.inf
-    return [(t, m, d) for t, (m, d, _) in zip(st.times, st.modes) if t <= t1 and m != "free"]
+    out = []
+    for t, (m, d, _) in zip(st.times, st.modes):
+        m = "stick" if m == "held" else m
+        if t <= t1 and m != "free" and (not out or out[-1][1:] != (m, d)):
+            out.append((t, m, d))
+    return out
 
 
 def friction_force(res, name):

@@ -9,7 +9,10 @@ stationary (1-3 solves; exact in one when the reaction direction does not depend
 """
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
+import scipy.linalg as sla
 
 from ...math.rotation import skew
 
@@ -79,20 +82,31 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
         maps = [(w, L[:, keep]) for w, L in maps]
         slips.append((elem, elem.mu_dynamic * m[1], J[sys.owner_rows[name][0]], maps, pos[jr][keep],
                       sys.owner_rows[name][0]))
-    x = _solve(K, b)
-    for _ in range(MAXIT if slips else 0):
-        K2, b2 = K.copy(), b.copy()
-        lam = x[nv:]
-        for elem, c, Jl, maps, idx, _ in slips:
-            g = np.zeros(nr)
-            g[idx] = _gradient(maps, lam[idx])
-            K2[:nv, nv:] += c * np.outer(Jl, g)
+    if not slips:
+        x = _solve(K, b)
+    else:   # K + U V(x)^T: one factorisation, then k x k solves per iteration (Woodbury)
+        with warnings.catch_warnings():   # an exactly singular K: inf / nan, reported by _checked
+            warnings.simplefilter("ignore", sla.LinAlgWarning)
+            lu = sla.lu_factor(K, check_finite=False)
+        U = np.zeros((nv + nr, len(slips)))
+        b2 = b.copy()
+        for k, (elem, c, Jl, _, _, _) in enumerate(slips):
+            U[:nv, k] = c * Jl
             b2[:nv] -= c * elem.preload * Jl
-        x_new = _solve(K2, b2)
-        done = np.linalg.norm(x_new - x) <= 1e-14 * (1.0 + np.linalg.norm(x))
-        x = x_new
-        if done:
-            break
+        x0 = _checked(sla.lu_solve(lu, b2, check_finite=False), b2)
+        Z = sla.lu_solve(lu, U, check_finite=False)
+        x = _checked(sla.lu_solve(lu, b, check_finite=False), b)
+        for _ in range(MAXIT):
+            lam = x[nv:]
+            V = np.zeros((nv + nr, len(slips)))
+            for k, (_, _, _, maps, idx, _) in enumerate(slips):
+                V[nv + idx, k] = _gradient(maps, lam[idx])
+            S = np.eye(len(slips)) + V.T @ Z
+            x_new = _checked(x0 - Z @ np.linalg.solve(S, V.T @ x0), b2)
+            done = np.linalg.norm(x_new - x) <= 1e-14 * (1.0 + np.linalg.norm(x))
+            x = x_new
+            if done:
+                break
     vd, lam = x[:nv], np.zeros(sys.nc)
     lam[rows] = x[nv:]
     Qf = np.zeros(nv)
@@ -106,7 +120,10 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
 
 
 def _solve(K, b):
-    x = np.linalg.solve(K, b)   # LinAlgError when exactly singular (reported by solvers.common)
+    return _checked(np.linalg.solve(K, b), b)   # LinAlgError when exactly singular (solvers.common)
+
+
+def _checked(x, b):
     if not np.all(np.isfinite(x)) or np.max(np.abs(x), initial=0.0) > 1e13 * (1.0 + np.max(np.abs(b), initial=0.0)):
         raise np.linalg.LinAlgError("augmented matrix with friction is numerically singular")
     return x
