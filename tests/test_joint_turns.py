@@ -49,3 +49,20 @@ def test_joint_coordinates_are_the_same_for_any_output_step(method):
     for a, b, f in zip(coordinates(coarse, ts), coordinates(fine, ts), coordinates(fine)):
         assert np.max(np.abs(a - b)) < 1e-9
         assert np.max(np.abs(a - np.interp(ts, fine.time, f))) < 0.3     # on the fine samples' branch
+
+
+def test_crossings_convention_at_the_start_of_a_signal():
+    """A ball thrown up at v0 from height h0: the height's crossings of h0 are the return alone
+    (2 v0 / g), never t = 0; a ball released at rest (vertical speed 0 at t = 0, the level) has no
+    crossing at t = 0 either (scipy's solve_ivp events would report t0 in both cases)."""
+    v0, h0 = 3.0, 1.0
+    m = mb.Model("throw", gravity=(0, -G, 0))
+    ball = m.add_particle("ball", 1.0, position=(0, h0, 0), velocity=(0.5, v0, 0))
+    rest = m.add_particle("rest", 1.0, position=(2, h0, 0))
+    res = mb.simulate(m, 1.0, output_step=0.1)
+    up = res.crossings(lambda r: r.position(ball)[:, 1], h0)
+    assert up == pytest.approx([2 * v0 / G], abs=1e-9)
+    assert len(res.crossings(lambda r: r.position(ball)[:, 1], h0, direction=+1)) == 0
+    assert res.crossings(lambda r: r.velocity(ball)[:, 1], 0.0) == pytest.approx([v0 / G], abs=1e-9)
+    assert len(res.crossings(lambda r: r.velocity(rest)[:, 1], 0.0)) == 0       # starts at the level
+    assert len(res.crossings(lambda r: r.position(rest)[:, 1], h0)) == 0

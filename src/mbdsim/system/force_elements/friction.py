@@ -19,16 +19,19 @@ Modes (history of (t, mode, direction s, x_stick) per element, kept on the Syste
 any time - dense output, Result.at - uses the mode in force then):
 - slip, direction s = +-1: lambda_f = mu_dynamic N(lambda_) s, the lock row is inactive.  N depends on
   lambda_, which depends on the friction load: `friction_kkt.friction_kkt` (called by
-  solvers.common.accelerations) solves the coupled KKT system by iterating on the direction of the
-  reaction (N is homogeneous of degree one in lambda_, so each iterate is an exact linear solve).
-  Switching function s xd: its zero (the joint stops) is located as an event.
+  solvers.common.accelerations) solves the coupled KKT system (N is homogeneous of degree one in
+  lambda_: a rank-k update of one factorisation, iterated on the reaction directions).
+  Switching function s xd + V_TOL/2: its zero (the joint comes to rest) is located as an event.
 - stick: the lock row is active (position level, so the joint cannot creep: coordinate projection
   holds x = x_stick to the Newton tolerance); the friction force is its multiplier.  Switching
   function mu_static N - |lambda_f| + eps, eps = STICK_TOL (1 + mu_static N): its zero releases the
-  joint in the direction sign(lambda_f) of the impending motion (dynamic friction from then on).
-- at every event (and at the start) a joint at rest (|xd| <= V_TOL) is tried in stick: it sticks if
-  |lambda_f| <= mu_static N + eps / 2, else it slips towards sign(lambda_f).  Several elements are
-  decided one after the other (not a complementarity solve).
+  joint.  held: stuck, but the lock row depends on the other active locks (a loop stopped with friction
+  in several joints): inactive, the group's capacity is shared (friction_lcp.stuck_margin).
+- at every event (and at the start) all joints at rest (|xd| <= V_TOL) are decided together
+  (`friction_lcp.decide_all`): a joint whose lock row is dependent on the joint and driver rows is
+  carried by the loop through zero velocity (slips on in the direction of its kinematic acceleration);
+  the others by the complementarity conditions of Coulomb friction, solved over all their
+  stick/slip assignments with the coupled normal loads.
 Only the "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic (through the
 EventTracker hooks on_start / on_event / switch); other analyses raise a ModelError naming the
 element.  One friction element per joint; a joint driven by a motion cannot have friction.  The
