@@ -225,7 +225,7 @@ def continued(res, raw, rate, parent_values, anchor=None, steps=True):
         s_ang, s_rate = parent_values(track)
         k = np.clip(np.searchsorted(track.time, res.time, side="right") - 1, 0, len(track.time) - 1)
         ref = s_ang[k] + 0.5 * (s_rate[k] + rate) * (res.time - track.time[k])
-        return ref + _wrap(raw - ref)
+        return raw + _TWO_PI * np.round((ref - raw) / _TWO_PI)   # the raw values, shifted by whole turns
     if res._parent is None:
         if anchor is not None:   # a torsion spring / stop on the joint continued the angle in the run
             raw = anchor + _wrap(raw - anchor)
