@@ -343,7 +343,7 @@ def test_body_fixed_torque_on_a_spinning_symmetric_body_full_inertia_matrix():
     axis (given in a marker's axes): Euler's equations give w1 = T/(I Om) sin Om t,
     w2 = T/(I Om)(1 - cos Om t), w3 constant, Om = (I3 - I)/I w3.  The principal axes are rotated relative
     to the body axes (full 3x3 inertia), the body orientation is a scipy Rotation."""
-    I, I3, w3, Tq = 0.2, 0.5, 10.0, 0.3
+    I, I3, w3, Tq = 0.2, 0.35, 10.0, 0.3   # I3 < 2 I: a physical body (triangle inequality)
     Rp = Rotation.from_rotvec([0.3, 0.5, -0.2]).as_matrix()          # principal axes in body axes
     J = Rp @ np.diag([I, I, I3]) @ Rp.T
     A = Rotation.from_rotvec([-0.6, 0.2, 0.9])
