@@ -28,7 +28,7 @@ def test_spatial_double_pendulum_conserves_energy():
     model = mb.Model("double_pendulum", gravity=(0.0, -G, 0.0))
     la, lb, ma, mb_ = 0.8, 0.6, 1.0, 0.7
     a = model.add_body("a", ma, inertia=(0.002, ma * la**2 / 12, ma * la**2 / 12), position=(la / 2, 0, 0))
-    b = model.add_body("b", mb_, inertia=(mb_ * lb**2 / 12, 0.03, 0.004), position=(la, 0, lb / 2),
+    b = model.add_body("b", mb_, inertia=(mb_ * lb**2 / 12, 0.024, 0.004), position=(la, 0, lb / 2),
                        orientation=Rotation.from_rotvec([0.0, -np.pi / 2, 0.0]),
                        angular_velocity=(1.0, 0.0, 0.0))
     j1 = model.add_revolute("j1", model.ground, a, (0, 0, 0), (0, 0, 1))

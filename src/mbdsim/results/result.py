@@ -305,7 +305,7 @@ class Result:
     def expression(self, text: str) -> np.ndarray:
         """Values (N,) of an expression of time and state written as for loads (mbdsim.model.loadexpr:
         DM(rod.tip, ground.anchor), VR, WZ(rod), AX, joint coordinates by name and <joint>_dot ...);
-        here the accelerations ACCX/ACCY/ACCZ(i[, j][, k]) [m/s^2] are available too. Units: those of
+        here the accelerations `ACCX/ACCY/ACCZ(i[, j][, k])` [m/s^2] are available too. Units: those of
         the quantity written."""
         from ..model.loadexpr import parse_load
         from ..system.exprmeasures import evaluate

@@ -40,7 +40,7 @@ COMPILED_METHODS = ("dop853", "high-accuracy")   # run by the compiled step loop
 USE_COMPILED = True   # False: always the reference scipy path (tests compare the two)
 DEFAULT_TOL = {"auto": (1e-7, 1e-9), "dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
                "radau": (1e-8, 1e-10), "bdf": (1e-8, 1e-10), "hht": (1e-5, 1e-7)}
-AUTO_LOCAL = 0.1    # "auto": rtol targets the global error of the outputs; the step control uses 0.1 rtol
+AUTO_LOCAL = 0.05   # "auto": rtol targets the global error of the outputs; the step control uses rtol / 20
 TIGHT = 1e-6        # "auto" on a model the compiled core does not carry: below this rtol DOP853, not HHT
 
 
@@ -54,7 +54,7 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
     element of the model is compiled, switching to HHT when it detects stiffness; otherwise "hht"
     ("dop853" for joint friction, sensors, or rtol below 1e-6). With "auto", rtol (default 1e-7) is
-    the target relative error of the outputs: the step control uses 0.1 rtol (local error) so that the
+    the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
@@ -168,7 +168,7 @@ def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resu
     if method not in ("auto",) + COMPILED_METHODS:
         raise NotStreamable(method)
     rt, at = _tolerances(method, rtol, atol)
-    if method == "auto":   # as in memory: rtol targets the outputs' global error (local 0.1 rtol)
+    if method == "auto":   # as in memory: rtol targets the outputs' global error (local rtol / 20)
         rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
     try:
         return stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume, monitor)

@@ -16,14 +16,12 @@ task), runner (Dask, Parquet, resume), store, spec (study files), sensitivity, p
 """
 from .spec import load_study
 from .study import Study
+from .sensitivity import sensitivity   # eager: a lazy one is shadowed by the submodule once imported
 
 __all__ = ["Study", "load_study", "sensitivity", "plot_study"]
 
 
 def __getattr__(name):
-    if name == "sensitivity":
-        from .sensitivity import sensitivity
-        return sensitivity
     if name == "plot_study":
         from .plots import plot_study
         return plot_study
