@@ -21,7 +21,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
     @njit(cache=True, _nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
-from ..system.exprloads_kernel import expr_loads
+from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, expr_loads
 from ..system.kernels import frames_into, quat_step, rows_kernel
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 from . import fasttree
@@ -40,25 +40,6 @@ def drivers_at(cm, wk, t):
         for k in range(3):
             p = 3 * d + k
             fv[k][d] = eval_program(code, consts, tables, start[p], end[p], x, stack)
-
-
-@njit(cache=True, _nrt=False)
-def _cross_into(a0, a1, a2, b0, b1, b2):
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@njit(cache=True, _nrt=False)
-def _point_force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
-    """Add a ground-axes force at ground offset s from the CM of frame f into F (nf, 6)."""
-    if f == 0:
-        return
-    F[f, 0] += F0
-    F[f, 1] += F1
-    F[f, 2] += F2
-    if rigid[f]:
-        m0, m1, m2 = _cross_into(s0, s1, s2, F0, F1, F2)
-        for k in range(3):
-            F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
 
 
 @njit(cache=True, _nrt=False)
