@@ -70,10 +70,15 @@ def scatter_jacobian(sys, fr: Frames, idx, rows, out):
 
 
 def constraint_terms(sys, q, v, t, jacobian=True):
-    """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False."""
-    if sys.nc and sys.kernel_rows:   # path constraints, numpy-only row kinds: numpy path
+    """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False.
+
+    The compiled kernel evaluates every row of the kinds it knows (point-on-curve rows too, with the
+    curve point evaluated here); couplers, screw and constant-velocity rows are added by numpy."""
+    if not sys.nc:
+        return constraint_terms_numpy(sys, q, v, t, jacobian)
+    if sys.kernel_rows:
         return _terms_compiled(sys, q, v, t, jacobian)
-    return constraint_terms_numpy(sys, q, v, t, jacobian)
+    return _terms_mixed(sys, q, v, t, jacobian)
 
 
 def _packed(sys):
@@ -96,6 +101,63 @@ def _terms_compiled(sys, q, v, t, jacobian):
     kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, v1, v2, v3, drv, f, fd, fdd,
                               sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
     return phi_, (J if jacobian else None), nu, gamma
+
+
+def _mixed_plan(sys):
+    """(curve groups with their rows and parameter-rate columns, groups left to numpy), cached."""
+    plan = sys.derived.get("mixed_plan")
+    if plan is None:
+        curves = [(g, _rows_of(g)) for g in sys.groups if g.kind == "curve"]
+        rest = [g for g in sys.groups if g.kind not in kernels.KIND and g.kind not in ("sph", "curve")]
+        plan = sys.derived["mixed_plan"] = (curves, rest)
+    return plan
+
+
+def _terms_mixed(sys, q, v, t, jacobian):
+    """constraint_terms of a system with rows the kernel does not evaluate (see there)."""
+    from .constraints.path import curve_extra_quad, curve_locals
+    kind, bi, bj, v1, v2, v3, drv, fns = _packed(sys)
+    curve_groups, rest = _mixed_plan(sys)
+    q, v = np.asarray(q), np.asarray(v)
+    fr = body_frames(sys, q, v)
+    fr.t = t
+    fr.aux_q, fr.aux_v = q[sys.aux_q_idx], v[sys.aux_v_idx]
+    curves = [(g, idx, curve_locals(fr, g)) for g, idx in curve_groups]
+    if curves:
+        v1 = v1.copy()
+        for g, idx, (_, _, c, _, _) in curves:
+            v1[idx] = np.repeat(c, 3, axis=0)
+    f = np.array([fn.value(t) for fn in fns], dtype=float)
+    fd = np.array([fn.d1(t) for fn in fns], dtype=float)
+    fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
+    phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
+    J = np.zeros((sys.nc, sys.nv))
+    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, v1, v2, v3, drv, f, fd, fdd,
+                              sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
+    for g, idx, (aux, sd, _, t1, t2) in curves:
+        gamma[idx] += curve_extra_quad(fr, g, sd, t1, t2)
+        J[idx, np.repeat(sys.aux_v_idx[aux], 3)] -= t1.reshape(-1)
+    for g in rest:
+        _numpy_group(sys, g, fr, q, v, t, phi_, J, nu, gamma)
+    return phi_, (J if jacobian else None), nu, gamma
+
+
+def _numpy_group(sys, g, fr, q, v, t, phi_, J, nu, gamma):
+    """Evaluate one group with the numpy primitives into the global arrays (J may be None)."""
+    if g.kind == "coord":   # couplers, gears, user constraints: rows over several joints
+        from .constraints.coupler import coord_terms
+        coord_terms(sys, g, fr, q, v, t, phi_, J, nu, gamma)
+        return
+    rows, nu_g, extra = group_rows(sys, fr, g)
+    idx = _rows_of(g)
+    phi_[idx] = rows.phi
+    gamma[idx] = -rows.quad
+    if nu_g is not None:
+        nu[idx] = nu_g
+        gamma[idx] += extra
+    if J is not None:
+        J[idx] = 0.0
+        scatter_jacobian(sys, fr, idx, rows, J)
 
 
 def jacobians(sys, q) -> np.ndarray:
@@ -121,19 +183,7 @@ def constraint_terms_numpy(sys, q, v, t, jacobian=True):
     gamma = np.zeros(sys.nc)
     J = np.zeros((sys.nc, sys.nv)) if jacobian else None
     for g in sys.groups:
-        if g.kind == "coord":   # couplers, gears, user constraints: rows over several joints
-            from .constraints.coupler import coord_terms
-            coord_terms(sys, g, fr, np.asarray(q), np.asarray(v), t, phi_, J, nu, gamma)
-            continue
-        rows, nu_g, extra = group_rows(sys, fr, g)
-        idx = _rows_of(g)
-        phi_[idx] = rows.phi
-        gamma[idx] = -rows.quad
-        if nu_g is not None:
-            nu[idx] = nu_g
-            gamma[idx] += extra
-        if jacobian:
-            scatter_jacobian(sys, fr, idx, rows, J)
+        _numpy_group(sys, g, fr, np.asarray(q), np.asarray(v), t, phi_, J, nu, gamma)
     return phi_, J, nu, gamma
 
 

@@ -17,7 +17,12 @@ KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6}
 
 
 def pack_rows(sys):
-    """Flat per-row arrays (kind, bi, bj, v1, v2, v3, driver index) from the system's groups."""
+    """Flat per-row arrays (kind, bi, bj, v1, v2, v3, driver index) from the system's groups.
+
+    A point-on-curve group packs as spherical rows with v2 = the marker point s_j (body-j axes) and
+    v1 = 0: the caller writes the curve point c(s) (body-i axes) into v1 at each evaluation.  Rows of
+    the groups the kernel does not evaluate (couplers, screw, constant-velocity) stay ground-ground
+    spherical rows (all zero) for the caller to overwrite."""
     nc = sys.nc
     kind = np.zeros(nc, np.int64)
     bi = np.zeros(nc, np.int64)
@@ -26,14 +31,18 @@ def pack_rows(sys):
     drv = -np.ones(nc, np.int64)
     fns = []
     for g in sys.groups:
+        if g.kind not in KIND and g.kind not in ("sph", "curve"):
+            continue
+        three = g.kind in ("sph", "curve")
+        first = 1 if g.kind == "curve" else 0      # curve: vecs[0] is the marker point s_j
         for k in range(len(g.bi)):
             r0 = g.row_adr[k]
-            rows = [r0, r0 + 1, r0 + 2] if g.kind == "sph" else [r0]
+            rows = [r0, r0 + 1, r0 + 2] if three else [r0]
             for c, r in enumerate(rows):
-                kind[r] = c if g.kind == "sph" else KIND[g.kind]
+                kind[r] = c if three else KIND[g.kind]
                 bi[r], bj[r] = g.bi[k], g.bj[k]
                 for m, vec in enumerate(g.vecs):
-                    v[m, r] = vec[k]
+                    v[first + m, r] = vec[k]
                 if g.kind in ("angle", "slide"):
                     drv[r] = len(fns)
                     fns.append(g.fns[k])

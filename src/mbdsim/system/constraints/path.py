@@ -66,19 +66,29 @@ def path_specs(model, fid, aux_start_q, aux_start_v):
     return specs, s0, sd0, np.arange(aux_start_q, aux_start_q + n), np.arange(aux_start_v, aux_start_v + n), geoms
 
 
-def curve_rows(sys, fr, group) -> pr.Rows:
-    """Rows (3 per constraint, x y z) with `aux` = (velocity column of s, Jacobian entries)."""
+def curve_locals(fr, group):
+    """(aux, s_dot, c, A_i c', A_i c'') of a point-on-curve group: parameter indices, rates [m/s per
+    unit s], curve points in body-i axes [m] and the first and second parameter derivatives in ground
+    axes, each (n, 3)."""
     n = len(group.bi)
     c, c1, c2 = np.zeros((n, 3)), np.zeros((n, 3)), np.zeros((n, 3))
     aux = np.array([cp.aux for cp in group.fns], dtype=int)
     s, sd = fr.aux_q[aux], fr.aux_v[aux]
     for k, cp in enumerate(group.fns):
         c[k], c1[k], c2[k] = cp.local(s[k])
-    rows = pr.spherical(fr, group.bi, group.bj, c, group.vecs[0])
     A_i = fr.A[group.bi]
-    t1 = np.einsum("nij,nj->ni", A_i, c1)
-    t2 = np.einsum("nij,nj->ni", A_i, c2)
-    w_i = fr.w[group.bi]
-    rows.quad = rows.quad - (2 * sd[:, None] * np.cross(w_i, t1) + sd[:, None] ** 2 * t2).reshape(-1)
+    return aux, sd, c, np.einsum("nij,nj->ni", A_i, c1), np.einsum("nij,nj->ni", A_i, c2)
+
+
+def curve_extra_quad(fr, group, sd, t1, t2):
+    """The parameter-rate part of quad (n*3,): 2 s_dot w_i x (A_i c') + s_dot^2 A_i c'' [m/s^2]."""
+    return (2 * sd[:, None] * pr.cross(fr.w[group.bi], t1) + sd[:, None] ** 2 * t2).reshape(-1)
+
+
+def curve_rows(sys, fr, group) -> pr.Rows:
+    """Rows (3 per constraint, x y z) with `aux` = (velocity column of s, Jacobian entries)."""
+    aux, sd, c, t1, t2 = curve_locals(fr, group)
+    rows = pr.spherical(fr, group.bi, group.bj, c, group.vecs[0])
+    rows.quad = rows.quad - curve_extra_quad(fr, group, sd, t1, t2)
     rows.aux = (np.repeat(sys.aux_v_idx[aux], 3), -t1.reshape(-1))
     return rows

@@ -81,12 +81,9 @@ def build_model():
     block = model.add_body("block", mass=MASS, inertia=I, position=(D_OG, 0.0, 0.0))
     rev = model.add_revolute("rev_O", model.ground, block, point=(0.0, 0.0, 0.0), axis=(0.0, 0.0, 1.0))
 
-    def torque(t, state):
-        """+T below 45 deg of joint rotation, -T from 45 deg on [N m, ground axes]."""
-        theta = float(np.ravel(state.joint_coordinate(rev))[0])
-        return (0.0, 0.0, TORQUE if theta < np.pi / 4 else -TORQUE)
-
-    model.add_torque("T", block, torque)
+    # +T below 45 deg of joint rotation, -T from 45 deg on [N m, ground axes]: an expression of the
+    # joint angle, compiled with the model (the switch is found by the step control)
+    model.add_torque("T", block, (0.0, 0.0, f"{TORQUE!r}*sign(pi/4 - {rev.name})"))
     return model
 
 
