@@ -1,6 +1,8 @@
 """Input checks that name the offending entity and field."""
 from __future__ import annotations
 
+import inspect
+
 import numpy as np
 
 from ..errors import ModelError
@@ -90,3 +92,29 @@ def inertia_matrix(entity: str, value, strict: bool = True) -> np.ndarray:
         import warnings
         warnings.warn(str(err), InertiaWarning, stacklevel=4)
     return J
+
+
+def check_load_callable(entity: str, field: str, fn) -> None:
+    """ModelError unless fn can be called as fn(t, state) (checked at add time, without calling it)."""
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return   # builtins without a signature: checked at run time
+    try:
+        sig.bind(0.0, None)
+    except TypeError:
+        raise ModelError(entity, field, f"a callable load is called as f(t, state) -> 3 numbers; "
+                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t, state)") from None
+
+
+def check_time_callable(entity: str, field: str, fn) -> None:
+    """ModelError unless fn can be called as fn(t)."""
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return
+    try:
+        sig.bind(0.0)
+    except TypeError:
+        raise ModelError(entity, field, f"a driver callable is called as f(t) -> number; "
+                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t)") from None

@@ -207,7 +207,7 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
                                      f"motion '{other.name}'; a coordinate takes one motion")
             try:
                 if callable(f) and not hasattr(f, "d1"):
-                    from ..system.guard import check_time_callable
+                    from ._check import check_time_callable
                     check_time_callable(entity, kind, f)
                 tf = time_function(f)
                 x0 = scalar(entity, "initial_displacement", initial_displacement)
@@ -418,6 +418,6 @@ def _default_u_axis(normal) -> np.ndarray:
 
 def _load_callable(entity, field, fn):
     """A load callable f(t, state) -> 3-vector, its signature checked now (values at run time)."""
-    from ..system.guard import check_load_callable
+    from ._check import check_load_callable
     check_load_callable(entity, field, fn)
     return fn

@@ -12,8 +12,8 @@ from ..system.assemble import System, assemble_system
 from ..system.equations import constraint_terms
 from .common import (DENSE_LIMIT, active_rows, dependent_owners, increment, independent_rows, min_norm_solve,
                      project_velocities)
-from .held import (changed_items, joint_position_items, kinetic_metric, length_scale, lexi_solve,
-                   position_metric, velocity_items)
+from ..system.metrics import kinetic_metric, length_scale, position_metric
+from .held import changed_items, joint_position_items, lexi_solve, velocity_items
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -146,7 +146,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
 
 # ------------------------------------------------------------------------------ positions
 def positions(sys, q0, t, rows, tol, held=True):
-    """Newton onto phi(q, t) = 0 with steps least in the position metric (held.position_metric); with
+    """Newton onto phi(q, t) = 0 with steps least in the position metric (system.metrics.position_metric); with
     `held`, the joints' initial displacements are reached by continuation from as drawn (so the branch
     is kept) and held exactly when consistent.  Returns (q, changed items)."""
     D = position_metric(sys)

@@ -41,67 +41,6 @@ class Held:
         return np.where(self.angle, (r + np.pi) % (2 * np.pi) - np.pi, r)
 
 
-# ------------------------------------------------------------------------------ metrics
-def _cached(name):
-    """Memoise a function of the System alone in sys.derived (arrays returned read-only)."""
-    def deco(fn):
-        def wrapper(sys):
-            out = sys.derived.get(name)
-            if out is None:
-                out = fn(sys)
-                if isinstance(out, np.ndarray):
-                    out.setflags(write=False)
-                sys.derived[name] = out
-            return out
-        wrapper.__name__, wrapper.__doc__ = fn.__name__, fn.__doc__
-        return wrapper
-    return deco
-
-
-@_cached("length_scale")
-def length_scale(sys) -> float:
-    """Characteristic length of the model [m]: the largest distance of a joint point or marker from
-    its body's CM, else the largest CM distance from the origin, else 1."""
-    pts = [g.s_i for g in sys.geoms.values() if hasattr(g, "s_i")]
-    pts += [g.s_j for g in sys.geoms.values() if hasattr(g, "s_j")]
-    pts += [b.position for b in sys.bodies]
-    if not pts:
-        return 1.0
-    d = np.sqrt(np.einsum("ij,ij->i", *(np.array(pts, dtype=float).reshape(-1, 3),) * 2))
-    d = d[np.isfinite(d) & (d > 0)]
-    return float(d.max()) if len(d) else 1.0
-
-
-@_cached("position_metric")
-def position_metric(sys) -> np.ndarray:
-    """Diagonal weights (nv,) of a position increment: each body's mass for its CM shift [kg] and its
-    principal-axis moments (floored at 1e-2 m L^2) for its rotation [kg m^2]; massless bodies weigh
-    as the mean body.  Lengths and angles are so weighed by size and inertia, not raw coordinates."""
-    L = length_scale(sys)
-    masses = [b.mass for b in sys.bodies if b.mass > 0]
-    mref = float(np.mean(masses)) if masses else 1.0
-    D = np.full(sys.nv, mref)
-    for k, b in enumerate(sys.bodies):
-        a = sys.frame_v_adr[k + 1]
-        m = b.mass if b.mass > 0 else mref
-        D[a:a + 3] = m
-        if not b.is_particle:
-            D[a + 3:a + 6] = np.maximum(np.diag(b.inertia), 1e-2 * m * L * L)
-    return D
-
-
-@_cached("kinetic_metric")
-def kinetic_metric(sys) -> np.ndarray:
-    """The mass matrix, with the position weights standing in where it has no mass (massless bodies,
-    zero moments of slender rods, curve parameters), so that it is positive definite."""
-    D = position_metric(sys)
-    M = sys.M.copy()
-    diag = np.diag(M)
-    empty = diag <= 1e-12 * max(float(diag.max(initial=0.0)), 1e-300)
-    M[empty, empty] += D[empty]
-    return M
-
-
 def item_weight(C, Minv) -> np.ndarray:
     """W = (C M^-1 C^T)^+ for one item's rows."""
     return np.linalg.pinv(C @ Minv @ C.T, rcond=1e-12)

@@ -105,7 +105,7 @@ class Monitor:
     weakest direction."""
 
     def __init__(self, sys, rows):
-        from .held import position_metric
+        from ..system.metrics import position_metric
         self.sys, self.rows = sys, rows
         self.scale = 1.0 / np.sqrt(position_metric(sys))
 
@@ -180,7 +180,7 @@ def solve_at(sys, q_guess, t, sf=None, hint=None):
     if hint is None:
         v0, vd0, S, rc = np.zeros(sys.nv), np.zeros(sys.nv), np.ones(sys.nv), None
     else:   # least change in the mass/inertia metric, the singular direction left to the hint
-        from .held import position_metric
+        from ..system.metrics import position_metric
         (v0, vd0), S, rc = hint, 1.0 / np.sqrt(position_metric(sys)), SINGULAR_TOL
     _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
     v = v0 + S * np.linalg.lstsq(J * S, nu - J @ v0, rcond=rc)[0]

@@ -53,7 +53,11 @@ def _continued(sys, name, t, raw):
 
 
 def state_factory(sys):
-    """Callable (t, q, v) -> State, or None when no load is a callable (saves the work)."""
+    """Callable (t, q, v) -> State, or None when no load is a callable (saves the work); also kept in
+    sys.run_state['state_factory'] for the system layer."""
     needs = any(callable(getattr(e, "force", None)) or callable(getattr(e, "torque", None))
                 or getattr(e, "needs_state", False) for e in sys.model.forces.values())
-    return (lambda t, q, v: State(sys, t, q, v)) if needs else None
+    factory = (lambda t, q, v: State(sys, t, q, v)) if needs else None
+    # the system layer (joint friction's mode decisions) evaluates loads too: it finds the factory here
+    sys.run_state["state_factory"] = factory
+    return factory

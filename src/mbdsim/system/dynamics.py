@@ -7,10 +7,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import SolverError
 from . import kernels
+from .equations import constraint_terms
 from .force_elements import evaluator
 from .force_elements import loads  # noqa: F401  (registers the built-in evaluators)
-from .frames import Frames
+from .frames import Frames, body_frames
+from .rows import active_rows
 
 
 def applied_forces(sys, fr: Frames, t, state=None) -> np.ndarray:
@@ -39,3 +42,40 @@ def solve_kkt(M, J, Q, gamma):
     if not np.all(np.isfinite(x)) or np.max(np.abs(x), initial=0.0) > 1e13 * (1.0 + np.max(np.abs(rhs), initial=0.0)):
         raise np.linalg.LinAlgError("augmented matrix is numerically singular")
     return x[:nv], x[nv:]
+
+
+def accelerations(sys, q, v, t, rows, state_factory=None):
+    """vd and lambda_ (full nc, minimum-norm where redundant) from the equations of motion at (q, v, t)."""
+    rows = active_rows(sys, rows, t)
+    fr = body_frames(sys, q, v)
+    state = state_factory(t, q, v) if state_factory else None
+    Q = applied_forces(sys, fr, t, state)
+    _, J, _, gamma = constraint_terms(sys, q, v, t)
+    try:
+        if len(sys.lock_rows):   # joint friction: slip loads depend on lambda_ (coupled KKT solve)
+            from .force_elements.friction_kkt import friction_kkt
+            return friction_kkt(sys, fr, J, gamma, Q, rows, t)
+        vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
+    except (np.linalg.LinAlgError, ValueError) as exc:
+        raise SolverError(f"singular equations of motion (lock-up or singular configuration): {exc}",
+                          time=t, joints=_worst_joints(sys, J, rows)) from None
+    lam = np.zeros(sys.nc)
+    if len(rows) == sys.nc:
+        lam = lam_i
+    else:
+        lam = np.linalg.lstsq(J.T, Q - sys.M @ vd, rcond=None)[0]
+    return vd, lam
+
+
+def _worst_joints(sys, J, rows):
+    """Joints whose rows are (nearly) dependent at this configuration."""
+    Jr = J[rows]
+    if Jr.shape[0] == 0:
+        return []
+    u, s, vt = np.linalg.svd(Jr.T, full_matrices=False)
+    weak = vt[-1]
+    names = []
+    for k in np.argsort(-np.abs(weak)):
+        if abs(weak[k]) > 1e-3 and sys.row_owner[rows[k]] not in names:
+            names.append(sys.row_owner[rows[k]])
+    return names

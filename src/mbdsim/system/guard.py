@@ -7,11 +7,10 @@ the analysis loops turn that into `Result.success = False` keeping every step be
 """
 from __future__ import annotations
 
-import inspect
 
 import numpy as np
 
-from ..errors import EvaluationError, MbdsimError, ModelError
+from ..errors import EvaluationError, MbdsimError
 
 
 def _time(t):
@@ -84,29 +83,3 @@ def call_vector(fn, t, state, entity: str, field: str) -> np.ndarray:
     if a.shape != (3,) or not np.all(np.isfinite(a)):
         raise EvaluationError(entity, field, f"callable returned {v!r}; expected 3 finite numbers", time=_time(t))
     return a
-
-
-def check_load_callable(entity: str, field: str, fn) -> None:
-    """ModelError unless fn can be called as fn(t, state) (checked at add time, without calling it)."""
-    try:
-        sig = inspect.signature(fn)
-    except (TypeError, ValueError):
-        return   # builtins without a signature: checked at run time
-    try:
-        sig.bind(0.0, None)
-    except TypeError:
-        raise ModelError(entity, field, f"a callable load is called as f(t, state) -> 3 numbers; "
-                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t, state)") from None
-
-
-def check_time_callable(entity: str, field: str, fn) -> None:
-    """ModelError unless fn can be called as fn(t)."""
-    try:
-        sig = inspect.signature(fn)
-    except (TypeError, ValueError):
-        return
-    try:
-        sig.bind(0.0)
-    except TypeError:
-        raise ModelError(entity, field, f"a driver callable is called as f(t) -> number; "
-                         f"{getattr(fn, '__name__', fn)!r}{sig} cannot take (t)") from None

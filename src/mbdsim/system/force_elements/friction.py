@@ -19,7 +19,7 @@ Modes (history of (t, mode, direction s, x_stick) per element, kept on the Syste
 any time - dense output, Result.at - uses the mode in force then):
 - slip, direction s = +-1: lambda_f = mu_dynamic N(lambda_) s, the lock row is inactive.  N depends on
   lambda_, which depends on the friction load: `friction_kkt.friction_kkt` (called by
-  solvers.common.accelerations) solves the coupled KKT system (N is homogeneous of degree one in
+  system.dynamics.accelerations) solves the coupled KKT system (N is homogeneous of degree one in
   lambda_: a rank-k update of one factorisation, iterated on the reaction directions).
   Switching function s xd + V_TOL/2: its zero (the joint comes to rest) is located as an event.
 - stick: the lock row is active (position level, so the joint cannot creep: coordinate projection
@@ -152,14 +152,13 @@ def _stick_margin(sys, fr, J, lam, elem):
 
 def _multipliers(sys, fr, elem, t):
     """lambda_ (N, nc) at the states fr.q, fr.v (N, ...) and times t, in the modes then in force."""
-    from ...solvers.common import accelerations
-    from ...solvers.state import state_factory
+    from ..dynamics import accelerations
     q, v = getattr(fr, "q", None), getattr(fr, "v", None)
     t = getattr(fr, "t", None) if t is None else t
     if q is None or v is None or t is None:
         raise ValueError(f"friction '{elem.name}': dissipation needs the multipliers or the states (q, v, t)")
     q, v, t = np.atleast_2d(q), np.atleast_2d(v), np.broadcast_to(np.asarray(t, dtype=float), (len(q),))
-    rows, sf = _base_rows(sys, q[0], v[0], t[0]), state_factory(sys)
+    rows, sf = _base_rows(sys, q[0], v[0], t[0]), sys.run_state.get("state_factory")
     return np.array([accelerations(sys, q[n], v[n], t[n], rows, sf)[1] for n in range(len(q))])
 
 
@@ -167,7 +166,7 @@ def _base_rows(sys, q, v, t):
     """Independent rows among the always-active ones (as assembly picks them), cached on the System."""
     rows = sys.derived.get("friction_base_rows")
     if rows is None:
-        from ...solvers.common import independent_rows
+        from ..rows import independent_rows
         from ..equations import constraint_terms
         J = constraint_terms(sys, q, v, t)[1]
         rows = sys.derived["friction_base_rows"] = sys.fixed_rows[independent_rows(J[sys.fixed_rows])]

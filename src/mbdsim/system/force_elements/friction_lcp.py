@@ -102,7 +102,7 @@ def _joint_acc(J, gamma, vd, r):
 
 def decide_all(sys, t, q, v):
     """Modes of every friction element at an event or at the start (see the module docstring)."""
-    from ...solvers.held import kinetic_metric
+    from ..metrics import kinetic_metric
     from ..equations import constraint_terms
     from ..frames import body_frames
     from .friction import V_TOL, _base_rows, _coordinate, _rate, _timed
@@ -181,9 +181,8 @@ def _apply(sys, t, J, base, group, combo, target):
 
 
 def _solve(sys, q, v, t, base):
-    from ...solvers.common import accelerations
-    from ...solvers.state import state_factory
-    return accelerations(sys, q, v, t, base, state_factory(sys))
+    from ..dynamics import accelerations
+    return accelerations(sys, q, v, t, base, sys.run_state.get("state_factory"))
 
 
 def _violation(sys, q, v, t, base, J, gamma, group, combo):
