@@ -12,20 +12,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import ModelError
+from ..model.joint_kinds import JOINT_KINDS
 from .schema import AxisAngleSpec, EulerSpec, ModelSpec
 from .units import UnitError, to_si
 
-JOINT_METHODS = {"revolute": "add_revolute", "translational": "add_translational", "cylindrical": "add_cylindrical",
-                 "spherical": "add_spherical", "universal": "add_universal", "planar": "add_planar",
-                 "fixed": "add_fixed", "inline": "add_inline", "inplane": "add_inplane", "orientation": "add_orientation",
-                 "parallel_axes": "add_parallel_axes", "perpendicular": "add_perpendicular", "atpoint": "add_atpoint",
-                 "screw": "add_screw", "constant_velocity": "add_constant_velocity"}
-JOINT_FIELDS = {"revolute": ("point", "axis"), "translational": ("point", "axis"), "cylindrical": ("point", "axis"),
-                "spherical": ("point",), "universal": ("point", "axis_i", "axis_j"),
-                "planar": ("point", "normal", "u_axis"), "fixed": ("point",), "inline": ("point", "axis"),
-                "inplane": ("point", "normal"), "orientation": (), "parallel_axes": ("axis",),
-                "perpendicular": ("axis_i", "axis_j"), "atpoint": ("point",), "screw": ("point", "axis", "lead"),
-                "constant_velocity": ("point", "axis_i", "axis_j")}
+JOINT_METHODS = {n: k.method for n, k in JOINT_KINDS.items()}     # the joint-kind registry
+JOINT_FIELDS = {n: k.fields for n, k in JOINT_KINDS.items()}
 PER = {"displacement": "", "velocity": "/s", "acceleration": "/s**2"}
 
 

@@ -3,13 +3,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-# constraints a joint removes between two rigid bodies, and its translational part (what a particle feels)
-TRANSLATION_CONSTRAINTS = {"revolute": 3, "translational": 2, "cylindrical": 2, "spherical": 3, "universal": 3,
-                           "planar": 1, "fixed": 3, "inline": 2, "inplane": 1, "orientation": 0, "parallel_axes": 0,
-                           "perpendicular": 0, "atpoint": 3, "screw": 2, "constant_velocity": 3}
+from ..model.joint_kinds import JOINT_KINDS
+
+# from the joint-kind registry: constraints on the relative translation (what a particle feels), and the
 # in-plane freedoms a joint leaves in a model flagged planar (3 per rigid body: two slides, one turn);
 # kinds whose in-plane freedom depends on how they are placed are left out (no planar count then)
-PLANAR_DOF = {"revolute": 1, "translational": 1, "fixed": 0, "spherical": 1, "atpoint": 1, "planar": 3}
+TRANSLATION_CONSTRAINTS = {n: k.translation_constraints for n, k in JOINT_KINDS.items()}
+PLANAR_DOF = {n: k.planar_dof for n, k in JOINT_KINDS.items() if k.planar_dof is not None}
 
 
 @dataclass

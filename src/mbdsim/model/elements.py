@@ -106,16 +106,17 @@ class ForceElementsMixin:
 
     @staticmethod
     def _rotational_joint(entity, jt, what):
-        if jt.kind not in ("revolute", "cylindrical"):
+        from .joint_kinds import ROT, axis_dofs
+        if ROT not in axis_dofs(jt.kind, loads=True):
             raise ModelError(entity, "joint", f"needs a revolute or cylindrical joint for a {what}, "
                              f"{jt.name!r} is {jt.kind}")
         if jt.body_j.is_particle:
             raise ModelError(entity, "joint", f"body_j of {jt.name!r} is a particle: it has no rotation")
 
     def _stop_dof(self, entity, jt, dof):
-        allowed = {"revolute": ("rotation",), "translational": ("translation",),
-                   "cylindrical": ("rotation", "translation")}   # the first is the default dof
-        if jt.kind not in allowed:
+        from .joint_kinds import axis_dofs
+        allowed = {jt.kind: axis_dofs(jt.kind, loads=True)}   # the first is the default dof
+        if not allowed[jt.kind]:
             raise ModelError(entity, "joint", f"needs a translational, revolute or cylindrical joint, "
                              f"{jt.name!r} is {jt.kind}")
         dof = allowed[jt.kind][0] if dof is None else dof

@@ -9,29 +9,13 @@ import numpy as np
 from ..errors import ModelError
 from ._check import scalar, vector
 from .body import Body, Marker
+from .joint_kinds import JOINT_KINDS
 
-# Joint kinds and their relative degrees of freedom (rotation, translation) between two rigid bodies.
-JOINT_DOF = {
-    "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
-    "universal": 2, "planar": 3, "fixed": 0,
-    # issue 11: joint primitives (Adams JPRIM), screw, constant-velocity joint
-    "inline": 4, "inplane": 5, "orientation": 3, "parallel_axes": 4, "perpendicular": 5, "atpoint": 3,
-    "screw": 1, "constant_velocity": 2,
-}
-# Number of joint coordinates (Result.joint_coordinate): a universal joint reports its relative rotation
-# vector (3 values, 2 of them independent), as a spherical joint does.
-JOINT_NCOORD = {
-    "revolute": 1, "translational": 1, "cylindrical": 2, "spherical": 3,
-    "universal": 3, "planar": 3, "fixed": 0,
-    # primitives have no joint coordinates; a screw reports its angle [rad] (slide = lead angle / 2 pi);
-    # a constant-velocity joint its relative rotation vector, as a universal joint does
-    "inline": 0, "inplane": 0, "orientation": 0, "parallel_axes": 0, "perpendicular": 0, "atpoint": 0,
-    "screw": 1, "constant_velocity": 3,
-}
-COORD_NAMES = {"cylindrical": "(angle [rad], slide [m])", "planar": "(u [m], v [m], angle [rad])",
-               "spherical": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes",
-               "universal": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes",
-               "constant_velocity": "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes"}
+# Derived from the joint-kind registry (model/joint_kinds.py): relative degrees of freedom between two
+# rigid bodies, values of Result.joint_coordinate, and how the multi-valued coordinates read.
+JOINT_DOF = {n: k.dof for n, k in JOINT_KINDS.items()}
+JOINT_NCOORD = {n: k.ncoord for n, k in JOINT_KINDS.items()}
+COORD_NAMES = {n: k.coord_names for n, k in JOINT_KINDS.items() if k.ncoord > 1}
 
 
 @dataclass(eq=False)

@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any, Callable, Union
 import numpy as np
 
 from ..errors import ModelError
+from .joint_kinds import JOINT_KINDS
 
 if TYPE_CHECKING:
     from .._types import JointRef, Location
@@ -40,7 +41,8 @@ ACCEL = {"ACCX": 16, "ACCY": 17, "ACCZ": 18}
 MEASURE_KIND = {**POSITION, **VELOCITY, **ANGULAR, **ANGLES, **ACCEL}
 JOINT_ANGLE, JOINT_ANGLE_RATE, JOINT_SLIDE, JOINT_SLIDE_RATE = 20, 21, 22, 23
 WITH_K = {"DX", "DY", "DZ", "VX", "VY", "VZ", "WX", "WY", "WZ", "ACCX", "ACCY", "ACCZ"}
-JOINT_DOF = {"revolute": "rotation", "screw": "rotation", "translational": "translation"}
+# the coordinate a one-coordinate joint's name reads in an expression (joint-kind registry)
+JOINT_DOF = {n: k.axis_dofs[0] for n, k in JOINT_KINDS.items() if k.ncoord == 1 and k.axis_dofs}
 TIME_NAMES = ("t", "TIME")
 
 
@@ -240,11 +242,11 @@ class ExprLoadsMixin:
         self._claim(name, "joint force")
         try:
             jt = self._lookup(joint, self.joints, entity, "joint")
-            allowed = {"revolute": ("rotation",), "translational": ("translation",),
-                       "cylindrical": ("rotation", "translation")}
-            if jt.kind not in allowed:
-                raise ModelError(entity, "joint", f"a {jt.kind} joint has no single axis; use a revolute, "
-                                 "translational or cylindrical joint")
+            from .joint_kinds import axis_dofs, kinds_with_axis
+            allowed = {jt.kind: axis_dofs(jt.kind, loads=True)}
+            if not allowed[jt.kind]:
+                raise ModelError(entity, "joint", f"a {jt.kind} joint has no single axis; use a "
+                                 f"{', '.join(kinds_with_axis(loads=True))} joint")
             if dof is None:
                 dof = allowed[jt.kind][0]
             if dof not in allowed[jt.kind]:

@@ -370,11 +370,11 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
 
     @staticmethod
     def _motion_dof(entity, joint, dof):
-        allowed = {"revolute": ("rotation",), "translational": ("translation",),
-                   "cylindrical": ("rotation", "translation"), "screw": ("rotation", "translation")}
-        if joint.kind not in allowed:
-            raise ModelError(entity, "joint", f"cannot drive a {joint.kind} joint; use revolute, "
-                             "translational, cylindrical or screw")
+        from .joint_kinds import axis_dofs, kinds_with_axis
+        allowed = {joint.kind: axis_dofs(joint.kind)}
+        if not allowed[joint.kind]:
+            raise ModelError(entity, "joint", f"cannot drive a {joint.kind} joint; use "
+                             f"{', '.join(kinds_with_axis())}")
         if dof is None:
             return allowed[joint.kind][0]
         if dof not in allowed[joint.kind]:

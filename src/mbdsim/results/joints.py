@@ -33,6 +33,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.joints import Joint
 from ..system import measures as ms
+from ..model.joint_kinds import is_angle
 
 ROTATION_JOINTS = ("spherical", "universal", "fixed", "constant_velocity")
 _TWO_PI = 2.0 * np.pi
@@ -101,7 +102,7 @@ def acceleration(res, joint, kind=None):
         ang = np.zeros(len(res.time)) if g.particle_j else _spin_acc(g, fr, axes[2])
         return np.stack([_slide_acc(g, fr, axes[0]), _slide_acc(g, fr, axes[1]), ang], -1)
     ang = sl = None
-    if jt.kind in ("revolute", "cylindrical", "screw") and not g.particle_j:
+    if is_angle(jt.kind) and not g.particle_j:
         ang = _spin_acc(g, fr, axes[2])
     if jt.kind in ("translational", "cylindrical"):
         sl = _slide_acc(g, fr, axes[2])

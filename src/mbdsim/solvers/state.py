@@ -4,6 +4,7 @@ from __future__ import annotations
 import bisect
 
 import numpy as np
+from ..model.joint_kinds import is_angle
 
 
 class State:
@@ -23,7 +24,7 @@ class State:
         res = self._res
         x = np.array(res.joint_coordinate(joint)[0], dtype=float)
         jt = res._joint(joint)
-        if jt.kind in ("revolute", "cylindrical", "screw") and not jt.body_j.is_particle:
+        if is_angle(jt.kind) and not jt.body_j.is_particle:
             ang = x.reshape(-1)
             ang[0] = _continued(res.system, jt.name, self.t, float(ang[0]))
         return x[()] if x.ndim == 0 else x

@@ -12,6 +12,7 @@ from ..errors import ModelError
 from ..model.body import Body, Marker
 from .constraints import primitives as pr
 from .frames import Frames
+from ..model.joint_kinds import is_angle
 
 
 def resolve(sys, target, field="target"):
@@ -106,7 +107,7 @@ def joint_coordinate(sys, fr, joint, dof=None):
     ff, bi, bj = flat(fr, g.bi, g.bj)
     rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
     ang = angd = sl = sld = None
-    if joint.kind in ("revolute", "cylindrical", "screw") and not g.particle_j:
+    if is_angle(joint.kind) and not g.particle_j:
         ang, _, angd = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
     if joint.kind in ("translational", "cylindrical"):
         sl = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)).phi
