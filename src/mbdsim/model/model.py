@@ -26,6 +26,12 @@ if TYPE_CHECKING:
 class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
+    def __getstate__(self):
+        """Pickled and copied without the assembled System kept by mbdsim.system.assemble_system."""
+        state = self.__dict__.copy()
+        state.pop("_assembled", None)
+        return state
+
     def __init__(self, name: str = "model", gravity=(0.0, 0.0, 0.0), planar=False):
         """planar: True (plane normal +z) or a normal vector marks a 2D mechanism built of 3D joints: its
         out-of-plane equations are dependent by design, dropped without a RedundantConstraintWarning and

@@ -9,6 +9,7 @@ joint friction element (active only while it sticks, see force_elements.friction
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -102,7 +103,25 @@ class System:
 
 
 def assemble_system(model) -> System:
-    """Assemble the System of a Model (layout, constraint rows, mass matrix, initial q and v)."""
+    """Assemble the System of a Model (layout, constraint rows, mass matrix, initial q and v).
+
+    A Model assembled before and unchanged since (same content fingerprint, system.fingerprint) gets a
+    copy of that System: the same arrays and caches (`derived`, the compiled model among them) with an
+    empty `run_state`, as MuJoCo reuses an mjModel with a new mjData.  Models with joint friction (their
+    stick/slip histories live on the System) are assembled every time."""
+    from .fingerprint import model_fingerprint
+    fp = model_fingerprint(model)
+    kept = getattr(model, "__dict__", {}).get("_assembled")
+    if kept is not None and kept[0] == fp:
+        return dataclasses.replace(kept[1], run_state={})
+    sys = _assemble_system(model)
+    if not sys.switched and hasattr(model, "__dict__"):
+        model.__dict__["_assembled"] = (fp, sys)   # not pickled or copied (Model.__getstate__)
+    return dataclasses.replace(sys, run_state={})
+
+
+def _assemble_system(model) -> System:
+    """The assembly itself (see assemble_system)."""
     bodies = [b for b in model.bodies.values() if not b.is_ground]
     fid = {model.ground: 0}
     fid.update({b: k + 1 for k, b in enumerate(bodies)})

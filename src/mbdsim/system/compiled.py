@@ -168,7 +168,19 @@ def _loads(sys):
 def compile_system(sys, rows, state=None) -> CompiledModel:
     """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported.
     With the assembled state=(q, v) a tree of one-degree-of-freedom joints gets its joint-coordinate
-    model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm)."""
+    model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm).  Kept in
+    sys.derived for the same rows and state (a System reused for an unchanged Model compiles once)."""
+    rows = np.asarray(rows, dtype=np.int64)
+    key = (rows.tobytes(), None if state is None else tuple(np.asarray(x, float).tobytes() for x in state))
+    kept = sys.derived.get("compiled")
+    if kept is not None and kept[0] == key:
+        return kept[1]
+    cm = _compile_system(sys, rows, state)
+    sys.derived["compiled"] = (key, cm)
+    return cm
+
+
+def _compile_system(sys, rows, state) -> CompiledModel:
     if getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows, sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
     if len(sys.aux_q_idx):

@@ -107,9 +107,9 @@ def decide_all(sys, t, q, v):
     from ..frames import body_frames
     from .friction import V_TOL, _base_rows, _coordinate, _rate, _timed
     key = (float(t), np.asarray(q).tobytes(), np.asarray(v).tobytes())
-    if sys.__dict__.get("_friction_decided") == key:
+    if sys.run_state.get("friction_decided") == key:
         return
-    sys._friction_decided = key
+    sys.run_state["friction_decided"] = key
     fr = _timed(body_frames(sys, q, v))
     elems = {n: sys.model.forces[n] for n in sys.switched}
     rest, prev = [], {}
