@@ -59,3 +59,19 @@ def test_pickle_and_copy_leave_the_cache_behind():
     for other in (pickle.loads(pickle.dumps(m)), copy.deepcopy(m)):
         assert "_assembled" not in other.__dict__
         assert np.array_equal(_run(other).q, _run(m).q)
+
+
+def test_assembly_kept_only_without_python_callables():
+    m = _double_pendulum()
+    m.add_motion("drive", "j1", displacement="0.3*t")
+    _run(m)
+    sys = assemble_system(m)
+    assert sys.derived["calls_python"] is False and "assembly" in sys.derived
+    level = [0.0]
+    m2 = _double_pendulum()
+    m2.add_motion("drive", "j1", displacement=lambda t: level[0] + 0.3 * t)
+    first = float(np.ravel(_run(m2).joint_coordinate("j1"))[0])
+    level[0] = 0.2                      # the same callable now gives other values: assembled anew
+    second = float(np.ravel(_run(m2).joint_coordinate("j1"))[0])
+    assert assemble_system(m2).derived["calls_python"] is True
+    assert abs(first) < 1e-9 and abs(second - 0.2) < 1e-9

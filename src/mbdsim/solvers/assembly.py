@@ -1,6 +1,8 @@
 """Assembly analysis: make initial positions and velocities consistent with the constraints."""
 from __future__ import annotations
 
+import dataclasses
+
 import warnings
 from dataclasses import dataclass, field
 
@@ -104,7 +106,27 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     """Assembly from a given state of an assembled System.
 
     The model's held values (joint initial values, given body velocities) apply when q0 / v0 are the
-    System's own initial arrays (sys.q0 / sys.v0); other states are corrected by the least change."""
+    System's own initial arrays (sys.q0 / sys.v0); other states are corrected by the least change.
+    The System's own initial state is assembled once per time and tolerance (kept in sys.derived, its
+    warnings issued again on each call) when the model calls no Python function: a System reused for
+    an unchanged Model starts from it."""
+    if q0 is not sys.q0 or v0 is not sys.v0 or len(sys.lock_rows) or sys.derived.get("calls_python", True):
+        return _assemble_state(sys, q0, v0, t, tol)
+    key = (float(t), float(tol))
+    kept = sys.derived.get("assembly")
+    if kept is None or kept[0] != key:
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            report = _assemble_state(sys, q0, v0, t, tol)
+        kept = sys.derived["assembly"] = (key, report, [(w.message, w.category) for w in caught])
+    _, report, issued = kept
+    for message, category in issued:
+        warnings.warn(message, category, stacklevel=3)
+    return dataclasses.replace(report, system=sys, q=report.q.copy(), v=report.v.copy())
+
+
+def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
+    """assemble_state without the cache."""
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:

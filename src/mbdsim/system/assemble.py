@@ -109,12 +109,13 @@ def assemble_system(model) -> System:
     copy of that System: the same arrays and caches (`derived`, the compiled model among them) with an
     empty `run_state`, as MuJoCo reuses an mjModel with a new mjData.  Models with joint friction (their
     stick/slip histories live on the System) are assembled every time."""
-    from .fingerprint import model_fingerprint
-    fp = model_fingerprint(model)
+    from .fingerprint import fingerprint
+    fp, callables = fingerprint(model)
     kept = getattr(model, "__dict__", {}).get("_assembled")
     if kept is not None and kept[0] == fp:
         return dataclasses.replace(kept[1], run_state={})
     sys = _assemble_system(model)
+    sys.derived["calls_python"] = callables   # results of calling them (assembly) are not kept
     if not sys.switched and hasattr(model, "__dict__"):
         model.__dict__["_assembled"] = (fp, sys)   # not pickled or copied (Model.__getstate__)
     return dataclasses.replace(sys, run_state={})

@@ -18,7 +18,14 @@ _OPAQUE = (types.FunctionType, types.BuiltinFunctionType, types.MethodType, type
 
 def model_fingerprint(model) -> bytes:
     """Digest of everything reachable from `model` (see the module docstring)."""
+    return fingerprint(model)[0]
+
+
+def fingerprint(model) -> tuple[bytes, bool]:
+    """(digest, whether a Python callable is reachable: what it returns may change while it stays the
+    same object, so results computed by calling it are not cached)."""
     h = hashlib.blake2b(digest_size=20)
+    callables = False
     seen: dict[int, int] = {}
     stack = [model]
     while stack:
@@ -46,6 +53,7 @@ def model_fingerprint(model) -> bytes:
             stack.extend(reversed(list(items)))
         elif isinstance(obj, _OPAQUE) or not hasattr(obj, "__dict__") and not hasattr(obj, "__slots__"):
             h.update(b"O%d" % k)            # by identity: the same callable (what it computes is run time)
+            callables = callables or callable(obj) and not isinstance(obj, type)
         else:
             h.update(type(obj).__qualname__.encode())
             fields = dict(vars(obj)) if hasattr(obj, "__dict__") else {}
@@ -54,4 +62,4 @@ def model_fingerprint(model) -> bytes:
                     fields[name] = getattr(obj, name)
             fields.pop("_assembled", None)  # the cache itself
             stack.append(fields)
-    return h.digest()
+    return h.digest(), callables
