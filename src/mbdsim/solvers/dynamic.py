@@ -25,6 +25,7 @@ from .assembly import assemble_state
 from .compiled_run import Stiff, integrate_compiled
 from .common import _worst_joints, accelerations, analysis_error, normalize, project_positions, project_velocities, qdot
 from .checks import check_initial_contacts
+from .autoswitch import OrderTrack
 from .events import EventTracker
 from .kinematic import check_model, time_grid
 from .state import state_factory
@@ -139,14 +140,19 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
             if USE_COMPILED:
-                res = integrate_compiled(sys, rep, times, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
-                                         stiff_check=True)
+                res = _with_history(integrate_compiled(sys, rep, times, AUTO_LOCAL * rt, AUTO_LOCAL * at,
+                                                       max_step, progress, stiff_check=True), times[0])
                 res.stats["method"] = "auto: " + res.stats["method"]
                 return res
         except NotCompiled as exc:
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
+            if exc.prefix is not None and _default_method(model) == "hht":   # HHT continues from there
+                from .autoswitch import continue_implicit
+                hr = None if user_rtol is None else max(user_rtol, HHT_RTOL_FLOOR)
+                return continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
+                                         progress, reason)
         else:
             reason = "compiled path disabled"
         method = _default_method(model)
@@ -171,7 +177,8 @@ def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resu
     if method == "auto":   # as in memory: rtol targets the outputs' global error (local rtol / 20)
         rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
     try:
-        return stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume, monitor)
+        return _with_history(stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume,
+                                                    monitor), times[0])
     except NotCompiled as exc:
         raise NotStreamable(str(exc)) from None
 
@@ -185,7 +192,18 @@ def _tolerances(method, rtol, atol):
 
 
 def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
-    """One named method over the output grid from the assembled state."""
+    """One named method over the output grid from the assembled state (res.stats with its order history)."""
+    return _with_history(_run_method(sys, rep, times, method, rtol, atol, max_step, progress), times[0])
+
+
+def _with_history(res, t0) -> Result:
+    """res with res.stats["order_history"] (one segment from t0 [s] when the run kept no history itself)."""
+    from .autoswitch import single_history
+    res.stats.setdefault("order_history", single_history(t0, res.stats.get("method"), res.stats.get("order")))
+    return res
+
+
+def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
     if method == "hht":
         from .hht import integrate_hht
         if getattr(sys.model, "sensors", None):
@@ -311,12 +329,13 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
     t0, t_end = times[0], times[-1]
     events.start(t0, y0)   # first: initial modes of switching elements (stick/slip) enter every solve
     out = [consistent_state(sys, y0, t0, rows, sf)]
-    nxt, nsteps, success, message, error, nsmall = 1, 0, True, "ok", None, 0
+    nxt, nsteps, success, message, error, nsmall, track = 1, 0, True, "ok", None, 0, None
     opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
     try:
         solver = solver_cls(rhs, t0, y0, t_end, **opts)
+        track = OrderTrack(t0, solver_cls.__name__, solver)
         while solver.status == "running":
-            t_old = solver.t
+            t_old, order = solver.t, track.order(solver)
             msg = solver.step()
             tiny = 1e-10 * max(1.0, abs(solver.t))
             if solver.status == "failed" or (solver.t - t_old < tiny and solver.status == "running"):
@@ -329,6 +348,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
             else:
                 nsmall = 0
             nsteps += 1
+            track.step(t_old, order)
             dense = solver.dense_output()
             t_new, y_new = solver.t, solver.y
             hit = events.check(t_old, t_new, dense)
@@ -364,7 +384,8 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
                  evaluate=traj.evaluate if traj.dense else None, success=success,
                  status=0 if success else -1, message=message,
-                 stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
+                 stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep, "order": track.history[-1][2]
+                        if track else None, "order_history": track.history if track else []})
     res.error = error
     res.sensor_events = list(events.sensor_events)
     res.steps = traj.step_states if traj.dense else None
