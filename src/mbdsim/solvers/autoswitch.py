@@ -113,9 +113,12 @@ def _scatter(n, parts):
 
 def merge_stats(a: dict, b: dict, t0: float, t_s: float, reason: str) -> dict:
     """Statistics of an explicit run `a` over [t0, t_s] followed by an implicit run `b` from t_s: counts
-    summed, "order" the order of the method that finished the run, "order_history" both segments."""
+    summed (the flagged explicit step, computed but not kept, counts as rejected), "order" the order of
+    the method that finished the run, "order_history" both segments."""
     out = {k: int(a.get(k, 0)) + int(b.get(k, 0)) for k in ("steps", "rejected", "nfev", "njev", "factorizations",
                                                           "projections")}
+    out["steps"] -= 1      # the explicit step that was flagged stiff is discarded (HHT redoes it): rejected
+    out["rejected"] += 1
     out.update(order=b.get("order"), switch_time=t_s, alpha=b.get("alpha"), formulation=a.get("formulation"),
                method=f"auto: {a['method']} until t = {t_s:.6g} s, then {b['method']} ({reason})",
                order_history=single_history(t0, a["method"], a.get("order"))
