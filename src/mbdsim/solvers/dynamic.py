@@ -53,14 +53,16 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
-    element of the model is compiled, switching to HHT when it detects stiffness; otherwise "hht"
+    element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
+    the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise "hht"
     ("dop853" for joint friction, sensors, or rtol below 1e-6). With "auto", rtol (default 1e-7) is
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
-    `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations.
+    `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
+    (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
     progress: optional callable progress(t) receiving the simulated time reached [s] now and then.
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
