@@ -231,3 +231,35 @@ def test_planar_chains_stay_explicit(n, rtol):
     assert _explicit_only(res), res.stats["method"]
     E = res.kinetic_energy() + res.potential_energy()
     assert np.max(np.abs(E - E[0])) < max(5 * rtol, 1e-9) * np.max(res.kinetic_energy())
+
+
+def test_hand_over_on_a_jointed_3d_model_keeps_constraints_accelerations_and_energy():
+    """A rod on a spherical joint, its tip held by a damped 1e8 N/m spring to ground (slightly
+    stretched at t = 0): stiff after the ringing decays. After the switch the outputs stay on the
+    constraints, the on-demand accelerations equal the index-1 solve at the output states, and the
+    energy balance E + dissipated = E(0) holds."""
+    from mbdsim.solvers.common import accelerations
+    from mbdsim.solvers.state import state_factory
+    from mbdsim.system.equations import constraint_terms
+    m = mb.Model("held rod", gravity=(0, -G, 0))
+    rod = m.add_body("rod", 1.0, (1e-4, 1.0 / 12, 1.0 / 12), position=(0.5, 0, 0))
+    m.add_spherical("ball", m.ground, rod, (0, 0, 0))
+    m.add_spring_damper("tip", (m.ground, (1.0, 0.3, 0.1)), (rod, (1.0, 0, 0)), 1e8, 2e4, np.sqrt(0.1) - 1e-5)
+    res = mb.simulate(m, 0.04, output_step=1e-3)
+    assert res.success and "stiffness detected" in res.stats["method"]
+    after = np.flatnonzero(res.time > res.stats["switch_time"])[::10]
+    sys, rows = res.system, res.stats["assembly"].rows
+    sf = state_factory(sys)
+    for k in after:
+        q, v, t = res.q[k], res.v[k], res.time[k]
+        phi, J, nu, _ = constraint_terms(sys, q, v, t)
+        assert np.max(np.abs(phi)) < 1e-11 and np.max(np.abs(J @ v - nu)) < 1e-9
+        vd, lam = accelerations(sys, q, v, t, rows, sf)
+        assert np.allclose(res.vd[k], vd, rtol=1e-8, atol=1e-8 * np.abs(vd).max())
+        assert np.allclose(res.lambda_[k], lam, rtol=1e-8, atol=1e-8 * np.abs(lam).max())
+    a = res.at(res.time[after])   # dense output at output times: the stored samples
+    assert np.array_equal(a.q, res.q[after]) and np.array_equal(a.v, res.v[after])
+    assert np.allclose(a.vd, res.vd[after], rtol=0, atol=1e-12 * np.abs(res.vd).max())
+    E = res.kinetic_energy() + res.potential_energy()
+    D = res.dissipated_energy()
+    assert np.max(np.abs(E + D - E[0])) < 5e-3 * E[0]   # E[0]: the spring's 0.5 k (1e-5 m)^2

@@ -49,8 +49,11 @@ class OrderTrack:
 
 def continue_implicit(sys, rep, times, stiff, rtol, atol, max_step, progress, reason) -> Result:
     """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and HHT from its
-    switch time on (rtol, atol: HHT's tolerances); `reason` goes into res.stats["method"]."""
-    from .compiled_run import _result
+    switch time on (rtol, atol: HHT's tolerances); `reason` goes into res.stats["method"]. Accelerations
+and multipliers at every output come from the compiled kernel when first asked for (as in a compiled
+run), and HHT's output states are projected by the compiled kernel (absolute-coordinate models), so
+HHT's part spends its time on its steps."""
+    from .compiled_run import _full_multipliers, _result
     from .hht import integrate_hht
     pre, t_s = stiff.prefix, float(stiff.time)
     run, tp, Y = pre["run"], pre["times"], pre["Y"]
@@ -61,12 +64,32 @@ def continue_implicit(sys, rep, times, stiff, rtol, atol, max_step, progress, re
     first.steps = lambda: run.step_states(t_s, np.concatenate([q_s, v_s]))
     rep_s = dataclasses.replace(rep, t=t_s, q=q_s, v=v_s)
     rest = np.concatenate([[t_s], np.asarray(times, float)[len(tp):]])
-    second = integrate_hht(sys, rep_s, rest, rtol, atol, max_step,
+    def outputs(ts, Yh):   # accelerations and multipliers at HHT's outputs: the compiled kernel, on demand
+        VD, LAM = run.outputs(ts, Yh)
+        return VD, _full_multipliers(sys, rep.rows, ts, Yh, VD, LAM)
+
+    second = integrate_hht(sys, rep_s, rest, rtol, atol, max_step, outputs=outputs,
+                           project=None if run.joint_space else _compiled_projection(run),
                            progress=None if progress is None else _Joined(progress, first, t_s))
     res = join(first, second, t_s)
     res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
     res.stats["assembly"] = rep
     return res
+
+
+def _compiled_projection(run):
+    """(t [s], y = [q, v]) -> (q, v) projected by the compiled kernel (mass-weighted minimum-norm Newton
+    steps, tolerance 1e-12, as the compiled run's own outputs); SolverError when it does not converge."""
+    from ..errors import SolverError
+    from .fastdyn import OK, project
+    a, w, nq = run.cm.arrays(), run.work.arrays(), run.sys.nq
+
+    def projected(t, y):
+        y = np.array(y, dtype=float)
+        if project(a, w, float(t), y[:nq], y[nq:], 1e-12, False) != OK:
+            raise SolverError("projection of an output onto the constraints does not converge", time=float(t))
+        return y[:nq], y[nq:]
+    return projected
 
 
 def join(first: Result, second: Result, t_s: float) -> Result:
