@@ -233,20 +233,26 @@ def test_planar_chains_stay_explicit(n, rtol):
     assert np.max(np.abs(E - E[0])) < max(5 * rtol, 1e-9) * np.max(res.kinetic_energy())
 
 
-def test_hand_over_on_a_jointed_3d_model_keeps_constraints_accelerations_and_energy():
-    """A rod on a spherical joint, its tip held by a damped 1e8 N/m spring to ground (slightly
-    stretched at t = 0): stiff after the ringing decays. After the switch the outputs stay on the
-    constraints, the on-demand accelerations equal the index-1 solve at the output states, and the
-    energy balance E + dissipated = E(0) holds."""
+@pytest.mark.parametrize("joint", ["spherical", "revolute"])
+def test_hand_over_on_a_jointed_model_keeps_constraints_accelerations_and_energy(joint):
+    """A rod on a spherical joint (absolute coordinates) or a revolute joint (a tree: joint coordinates),
+    its tip held by a damped 1e8 N/m spring to ground (slightly stretched at t = 0): stiff after the
+    ringing decays. After the switch the outputs stay on the constraints, the on-demand accelerations
+    equal the index-1 solve at the output states, and the energy balance E + dissipated = E(0) holds."""
     from mbdsim.solvers.common import accelerations
     from mbdsim.solvers.state import state_factory
     from mbdsim.system.equations import constraint_terms
     m = mb.Model("held rod", gravity=(0, -G, 0))
     rod = m.add_body("rod", 1.0, (1e-4, 1.0 / 12, 1.0 / 12), position=(0.5, 0, 0))
-    m.add_spherical("ball", m.ground, rod, (0, 0, 0))
-    m.add_spring_damper("tip", (m.ground, (1.0, 0.3, 0.1)), (rod, (1.0, 0, 0)), 1e8, 2e4, np.sqrt(0.1) - 1e-5)
+    if joint == "spherical":
+        m.add_spherical("ball", m.ground, rod, (0, 0, 0))
+        m.add_spring_damper("tip", (m.ground, (1.0, 0.3, 0.1)), (rod, (1.0, 0, 0)), 1e8, 2e4, np.sqrt(0.1) - 1e-5)
+    else:
+        m.add_revolute("hinge", m.ground, rod, (0, 0, 0), (0, 0, 1))
+        m.add_spring_damper("tip", (m.ground, (1.0, 0.3, 0)), (rod, (1.0, 0, 0)), 1e8, 2e4, 0.3 - 1e-5)
     res = mb.simulate(m, 0.04, output_step=1e-3)
     assert res.success and "stiffness detected" in res.stats["method"]
+    assert res.stats["formulation"].startswith("absolute" if joint == "spherical" else "joint")
     after = np.flatnonzero(res.time > res.stats["switch_time"])[::10]
     sys, rows = res.system, res.stats["assembly"].rows
     sf = state_factory(sys)
