@@ -28,7 +28,14 @@ if TYPE_CHECKING:
 
 
 class Result:
-    """Time history of an analysis; a failed run keeps every step computed before the failure."""
+    """Time history of an analysis; a failed run keeps every step computed before the failure.
+
+    `stats` (dict) of a dynamic analysis: "method" (what ran, and for the automatic method why), "steps",
+    "rejected", "nfev" (function evaluations), "njev" (Jacobian evaluations), "factorizations",
+    "order" (of the method that finished the run) and "order_history", a list of
+    `(t_start, method, order)` segments in time order, t_start in seconds (two for an automatic run that
+    handed over to HHT on stiffness, at `stats["switch_time"]`; BDF's own order changes), plus
+    "assembly" (the AssemblyReport)."""
 
     def __init__(self, system, time, q, v, vd, lambda_, evaluate: Callable | None = None,
                  success=True, status=0, message="ok", stats=None, accelerations: Callable | None = None):

@@ -193,11 +193,17 @@ class CompiledRun:
 
 
 class Stiff(Exception):
-    """The explicit method detected stiffness (the automatic method then switches to an implicit one)."""
+    """The explicit method detected stiffness (the automatic method then switches to an implicit one).
 
-    def __init__(self, t):
+    time: the start [s] of the step that was flagged; prefix: what the explicit run computed up to it
+    (the automatic method continues from there: mbdsim.solvers.autoswitch), a dict with run (the
+    CompiledRun, its checkpoints kept), times and Y (output times [s] <= time and their [q, v] rows),
+    y (the consistent [q, v] at `time`, absolute coordinates) and stats (the explicit run's statistics)."""
+
+    def __init__(self, t, prefix=None):
         super().__init__(f"stiff at t = {t:.9g} s")
         self.time = t
+        self.prefix = prefix
 
 
 def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, stiff_check=False) -> Result:
@@ -212,7 +218,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial)
     if status == STIFF:
-        raise Stiff(float(t_fail))
+        raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
     if status != 0:
         from .dynamic import _weak_joints
         try:
@@ -225,16 +231,21 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
                     state=y_fail[:sys.nq])
         last = f"{times[n - 1]:.9g}" if n else "none"
         success, message = False, f"{error}; last good output at t = {last} s"
-    stats = {"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
-             "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
-             "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
-             "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
-             "method": "DOP853 (compiled)",
-             "formulation": "joint coordinates (articulated body)" if run.joint_space else
-             "absolute coordinates (tree elimination)", "assembly": rep}
+    stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
     res.error = error
     return res
+
+
+def _stats(run, rep) -> dict:
+    """res.stats of a compiled run (steps, rejected, evaluations, factorisations, projections, order)."""
+    return {"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
+            "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
+            "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
+            "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
+            "method": "DOP853 (compiled)",
+            "formulation": "joint coordinates (articulated body)" if run.joint_space else
+            "absolute coordinates (tree elimination)", "assembly": rep}
 
 
 def _result(sys, rep, run, t_out, Y, success=True, message="ok", stats=None) -> Result:

@@ -25,6 +25,7 @@ from .assembly import assemble_state
 from .compiled_run import Stiff, integrate_compiled
 from .common import _worst_joints, accelerations, analysis_error, normalize, project_positions, project_velocities, qdot
 from .checks import check_initial_contacts
+from .autoswitch import OrderTrack
 from .events import EventTracker
 from .kinematic import check_model, time_grid
 from .state import state_factory
@@ -52,14 +53,16 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
-    element of the model is compiled, switching to HHT when it detects stiffness; otherwise "hht"
+    element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
+    the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise "hht"
     ("dop853" for joint friction, sensors, or rtol below 1e-6). With "auto", rtol (default 1e-7) is
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
     damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
-    `res.stats` reports the method used, steps, rejected steps, evaluations and factorisations.
+    `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
+    (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
     progress: optional callable progress(t) receiving the simulated time reached [s] now and then.
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
@@ -139,14 +142,19 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
             if USE_COMPILED:
-                res = integrate_compiled(sys, rep, times, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
-                                         stiff_check=True)
+                res = _with_history(integrate_compiled(sys, rep, times, AUTO_LOCAL * rt, AUTO_LOCAL * at,
+                                                       max_step, progress, stiff_check=True), times[0])
                 res.stats["method"] = "auto: " + res.stats["method"]
                 return res
         except NotCompiled as exc:
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
+            if exc.prefix is not None and _default_method(model) == "hht":   # HHT continues from there
+                from .autoswitch import continue_implicit
+                hr = None if user_rtol is None else max(user_rtol, HHT_RTOL_FLOOR)
+                return continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
+                                         progress, reason)
         else:
             reason = "compiled path disabled"
         method = _default_method(model)
@@ -171,7 +179,8 @@ def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resu
     if method == "auto":   # as in memory: rtol targets the outputs' global error (local rtol / 20)
         rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
     try:
-        return stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume, monitor)
+        return _with_history(stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume,
+                                                    monitor), times[0])
     except NotCompiled as exc:
         raise NotStreamable(str(exc)) from None
 
@@ -185,7 +194,18 @@ def _tolerances(method, rtol, atol):
 
 
 def _run(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
-    """One named method over the output grid from the assembled state."""
+    """One named method over the output grid from the assembled state (res.stats with its order history)."""
+    return _with_history(_run_method(sys, rep, times, method, rtol, atol, max_step, progress), times[0])
+
+
+def _with_history(res, t0) -> Result:
+    """res with res.stats["order_history"] (one segment from t0 [s] when the run kept no history itself)."""
+    from .autoswitch import single_history
+    res.stats.setdefault("order_history", single_history(t0, res.stats.get("method"), res.stats.get("order")))
+    return res
+
+
+def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
     if method == "hht":
         from .hht import integrate_hht
         if getattr(sys.model, "sensors", None):
@@ -311,12 +331,13 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
     t0, t_end = times[0], times[-1]
     events.start(t0, y0)   # first: initial modes of switching elements (stick/slip) enter every solve
     out = [consistent_state(sys, y0, t0, rows, sf)]
-    nxt, nsteps, success, message, error, nsmall = 1, 0, True, "ok", None, 0
+    nxt, nsteps, success, message, error, nsmall, track = 1, 0, True, "ok", None, 0, None
     opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
     try:
         solver = solver_cls(rhs, t0, y0, t_end, **opts)
+        track = OrderTrack(t0, solver_cls.__name__, solver)
         while solver.status == "running":
-            t_old = solver.t
+            t_old, order = solver.t, track.order(solver)
             msg = solver.step()
             tiny = 1e-10 * max(1.0, abs(solver.t))
             if solver.status == "failed" or (solver.t - t_old < tiny and solver.status == "running"):
@@ -329,6 +350,7 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
             else:
                 nsmall = 0
             nsteps += 1
+            track.step(t_old, order)
             dense = solver.dense_output()
             t_new, y_new = solver.t, solver.y
             hit = events.check(t_old, t_new, dense)
@@ -364,7 +386,8 @@ def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progres
     res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
                  evaluate=traj.evaluate if traj.dense else None, success=success,
                  status=0 if success else -1, message=message,
-                 stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep})
+                 stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep, "order": track.history[-1][2]
+                        if track else None, "order_history": track.history if track else []})
     res.error = error
     res.sensor_events = list(events.sensor_events)
     res.steps = traj.step_states if traj.dense else None

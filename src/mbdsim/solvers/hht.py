@@ -24,7 +24,7 @@ from ..results.stream import notify
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
-from .common import accelerations, analysis_error, increment, project_positions
+from .common import accelerations, analysis_error, increment, normalize, project_positions, project_velocities
 from .dynamic import consistent_state
 from .events import EventTracker
 from .state import state_factory
@@ -39,9 +39,14 @@ class _Step:
         self.t, self.q, self.v, self.a, self.lam, self.f = t, q, v, a, lam, f
 
 
-def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=None):
+def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=None, outputs=None, project=None):
     """HHT-alpha integration over the output grid `times`; returns a Result. progress: see
-    mbdsim.results.stream.notify; Ctrl-C ends the run with success=False and every output before it."""
+    mbdsim.results.stream.notify; Ctrl-C ends the run with success=False and every output before it.
+    outputs: optional callable (times [s], Y = [q, v] rows) -> (VD, LAM) giving the accelerations and
+    multipliers (all rows) at output states; with it they are computed on first use (as a compiled run
+    does; the automatic method passes the compiled kernel's), else at every output. project: optional
+    callable (t [s], y = [q, v]) -> (q, v) projecting an output state onto the constraints (default: the
+    minimum-norm Newton projection of mbdsim.solvers.common)."""
     rows, sf = rep.rows, state_factory(sys)
     beta, gamma = (1 - alpha) ** 2 / 4, 0.5 - alpha
     t0, t_end = float(times[0]), float(times[-1])
@@ -53,7 +58,8 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
     cur = _Step(t0, rep.q, rep.v, a0, lam0, _force_term(sys, rep.q, rep.v, t0, lam0, rows, sf))
     h = min(max_step or np.inf, (t_end - t0) / 100, _initial_step(sys, cur, rtol, atol))
     steps = [cur]
-    out = [consistent_state(sys, np.concatenate([rep.q, rep.v]), t0, rows, sf)]
+    sample = _dense if outputs is None else lambda *a: _dense_qv(*a, project=project)
+    out = [sample(sys, cur, cur, t0, rows, sf)]
     nxt, success, message, nrej, error = 1, True, "ok", 0, None
     tan = _Tangent()
     try:
@@ -91,10 +97,10 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
                 to_event = False
             steps.append(new)
             while nxt < len(times) and times[nxt] <= new.t + 1e-12 * max(1.0, abs(new.t)):
-                out.append(_dense(sys, cur, new, times[nxt], rows, sf))
+                out.append(sample(sys, cur, new, times[nxt], rows, sf))
                 nxt += 1
-            notify(progress, new.t, lambda n=len(out): Result(sys, times[:n], *[np.array([s[i] for s in out[:n]])
-                                                                                for i in range(4)], stats={"assembly": rep}))
+            notify(progress, new.t, lambda n=len(out): _outputs(sys, times[:n], out[:n], outputs,
+                                                                stats={"assembly": rep}))
             cur = new
             h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
     except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
@@ -107,18 +113,31 @@ def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=N
         states = []
         for t in ts:
             k = int(np.clip(np.searchsorted(tk, t) - 1, 0, len(steps) - 2)) if len(steps) > 1 else 0
-            states.append(_dense(sys, steps[k], steps[min(k + 1, len(steps) - 1)], t, rows, sf))
-        return tuple(np.array([s[i] for s in states]) for i in range(4))
+            states.append(sample(sys, steps[k], steps[min(k + 1, len(steps) - 1)], t, rows, sf))
+        cols = tuple(np.array([s[i] for s in states]) for i in range(len(states[0])))
+        if outputs is None:
+            return cols
+        return cols + outputs(np.asarray(ts, float), np.hstack(cols))
 
-    res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)], evaluate=evaluate,
-                 success=success, status=0 if success else -1, message=message,
-                 stats={"steps": len(steps) - 1, "rejected": nrej, "nfev": tan.nfev, "njev": tan.njev,
+    res = _outputs(sys, times[:n], out, outputs, evaluate=evaluate,
+                   success=success, status=0 if success else -1, message=message,
+                   stats={"steps": len(steps) - 1, "rejected": nrej, "nfev": tan.nfev, "njev": tan.njev,
                         "factorizations": tan.nlu, "order": 2, "method": "HHT", "alpha": alpha,
                         "assembly": rep})
     res.error = error
     res.steps = lambda: (np.array([s.t for s in steps]), np.array([s.q for s in steps]),
                          np.array([s.v for s in steps]))
     return res
+
+
+def _outputs(sys, times, out, outputs, **kw) -> Result:
+    """Result of the output states `out` ((q, v, vd, lam) each, or (q, v) with `outputs` computing vd and
+    lambda_ on first use)."""
+    cols = [np.array([s[i] for s in out]) for i in range(len(out[0]))]
+    if outputs is None:
+        return Result(sys, times, *cols, **kw)
+    Y = np.hstack(cols)
+    return Result(sys, times, *cols, None, None, accelerations=lambda: outputs(times, Y), **kw)
 
 
 def _force_term(sys, q, v, t, lam, rows, sf):
@@ -236,6 +255,16 @@ def _hermite_y(sys, s0, s1, t):
 def _dense(sys, s0, s1, t, rows, sf):
     """Consistent state at t in [s0.t, s1.t] from the Hermite interpolant, projected and completed."""
     return consistent_state(sys, _hermite_y(sys, s0, s1, t), t, rows, sf)
+
+
+def _dense_qv(sys, s0, s1, t, rows, sf, project=None):
+    """(q, v) of `_dense` (projected, by `project(t, y)` when given; accelerations and multipliers left
+    to the caller)."""
+    y = _hermite_y(sys, s0, s1, t)
+    if project is not None:
+        return project(t, y)
+    q, _, _ = project_positions(sys, normalize(sys, y[:sys.nq]), t, rows)
+    return q, project_velocities(sys, q, y[sys.nq:], t, rows)
 
 
 def _log_increment(sys, q0, q1, pred=None):

@@ -1,0 +1,175 @@
+"""The automatic method's hand-over from the explicit DOP853 to HHT-alpha when it detects stiffness.
+
+The compiled DOP853 stops at the start t_s of the step its stiffness test flagged (`compiled_run.Stiff`,
+whose `prefix` holds the outputs at times <= t_s, the consistent state at t_s and the run with its step
+checkpoints). HHT then continues from that state over the remaining output times, and the two parts are
+joined into one Result: outputs, accelerations and multipliers (on demand for the explicit part, as in a
+compiled run), dense output (`Result.at`: the explicit run's own steps up to t_s, HHT's interpolant
+after), the solver's step states, and the statistics (sums, and `order_history` naming which method
+and order held from which time). Nothing before t_s is integrated twice.
+
+Order history (res.stats["order_history"]): a list of (t_start [s], method, order) segments in time
+order; each method keeps a fixed order (DOP853: 8, HHT-alpha: 2, scipy's RK45: 5, Radau: 5) except
+scipy's BDF, which changes its order (1..5) itself and whose changes are recorded as they happen.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..results.result import Result
+
+ORDERS = {"DOP853": 8, "DOP853 (compiled)": 8, "RK45": 5, "Radau": 5, "HHT": 2}
+
+
+def single_history(t0: float, method: str, order: int | None) -> list:
+    """The order history of a run by one fixed-order method: [(t0 [s], method, order)]."""
+    return [(float(t0), method, order)]
+
+
+class OrderTrack:
+    """Order history of a scipy OdeSolver run: a new segment whenever the order of a step differs from
+    the previous step's (scipy's BDF chooses its order, 1..5, itself; after an event it restarts at 1)."""
+
+    def __init__(self, t0, name, solver):
+        self.name = name
+        self.history = [(float(t0), name, self.order(solver))]
+
+    def order(self, solver):
+        """The order the solver's next step uses."""
+        order = getattr(solver, "order", None)
+        return int(order) if order is not None else ORDERS.get(self.name)
+
+    def step(self, t_old, order):
+        """Record the order of the step just taken from t_old [s]."""
+        if order != self.history[-1][2]:
+            self.history.append((float(t_old), self.name, order))
+
+
+def continue_implicit(sys, rep, times, stiff, rtol, atol, max_step, progress, reason) -> Result:
+    """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and HHT from its
+    switch time on (rtol, atol: HHT's tolerances); `reason` goes into res.stats["method"]. Accelerations
+and multipliers at every output come from the compiled kernel when first asked for (as in a compiled
+run), and HHT's output states are projected by the compiled kernel (absolute-coordinate models), so
+HHT's part spends its time on its steps."""
+    from .compiled_run import _full_multipliers, _result
+    from .hht import integrate_hht
+    pre, t_s = stiff.prefix, float(stiff.time)
+    run, tp, Y = pre["run"], pre["times"], pre["Y"]
+    nq = sys.nq
+    q_s = _align_quaternions(sys, np.array(pre["y"][:nq]), Y[-1, :nq])
+    v_s = np.array(pre["y"][nq:])
+    first = _result(sys, rep, run, tp, Y, stats=pre["stats"])
+    first.steps = lambda: run.step_states(t_s, np.concatenate([q_s, v_s]))
+    rep_s = dataclasses.replace(rep, t=t_s, q=q_s, v=v_s)
+    rest = np.concatenate([[t_s], np.asarray(times, float)[len(tp):]])
+    def outputs(ts, Yh):   # accelerations and multipliers at HHT's outputs: the compiled kernel, on demand
+        VD, LAM = run.outputs(ts, Yh)
+        return VD, _full_multipliers(sys, rep.rows, ts, Yh, VD, LAM)
+
+    second = integrate_hht(sys, rep_s, rest, rtol, atol, max_step, outputs=outputs,
+                           project=None if run.joint_space else _compiled_projection(run),
+                           progress=None if progress is None else _Joined(progress, first, t_s))
+    res = join(first, second, t_s)
+    res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
+    res.stats["assembly"] = rep
+    return res
+
+
+def _compiled_projection(run):
+    """(t [s], y = [q, v]) -> (q, v) projected by the compiled kernel (mass-weighted minimum-norm Newton
+    steps, tolerance 1e-12, as the compiled run's own outputs); SolverError when it does not converge."""
+    from ..errors import SolverError
+    from .fastdyn import OK, project
+    a, w, nq = run.cm.arrays(), run.work.arrays(), run.sys.nq
+
+    def projected(t, y):
+        y = np.array(y, dtype=float)
+        if project(a, w, float(t), y[:nq], y[nq:], 1e-12, False) != OK:
+            raise SolverError("projection of an output onto the constraints does not converge", time=float(t))
+        return y[:nq], y[nq:]
+    return projected
+
+
+def join(first: Result, second: Result, t_s: float) -> Result:
+    """One Result of `first` (outputs at times <= t_s) and `second` (from t_s on; its first sample, at
+    t_s, is left out): outputs, on-demand accelerations and multipliers, dense output and step states."""
+    sl = slice(1, None)
+
+    def accelerations():
+        return (np.concatenate([first.vd, second.vd[sl]]), np.concatenate([first.lambda_, second.lambda_[sl]]))
+
+    evaluate = None
+    if first._evaluate is not None and second._evaluate is not None:
+        def evaluate(ts):
+            ts = np.asarray(ts, float)
+            lo = ts <= t_s
+            got = [(m, f(ts[m])) for m, f in ((lo, first._evaluate), (~lo, second._evaluate)) if m.any()]
+            return tuple(_scatter(len(ts), [(m, p[i]) for m, p in got]) for i in range(4))
+
+    res = Result(first.system, np.concatenate([first.time, second.time[sl]]),
+                 np.concatenate([first.q, second.q[sl]]), np.concatenate([first.v, second.v[sl]]), None, None,
+                 evaluate=evaluate, success=second.success, status=second.status, message=second.message,
+                 stats=dict(second.stats), accelerations=accelerations)
+    res.error = second.error
+    if first.steps is not None and second.steps is not None:
+        def steps():
+            a = first.steps() if callable(first.steps) else first.steps
+            b = second.steps() if callable(second.steps) else second.steps
+            if a is None or b is None:
+                return None
+            return tuple(np.concatenate([x, y[1:]]) for x, y in zip(a, b))
+        res.steps = steps
+    if hasattr(second, "sensor_events"):
+        res.sensor_events = list(second.sensor_events)
+    return res
+
+
+def _scatter(n, parts):
+    """(n, k) array with the rows of each (mask, rows) part at its mask."""
+    out = np.zeros((n, parts[0][1].shape[1]))
+    for mask, rows in parts:
+        out[mask] = rows
+    return out
+
+
+def merge_stats(a: dict, b: dict, t0: float, t_s: float, reason: str) -> dict:
+    """Statistics of an explicit run `a` over [t0, t_s] followed by an implicit run `b` from t_s: counts
+    summed (the flagged explicit step, computed but not kept, counts as rejected), "order" the order of
+    the method that finished the run, "order_history" both segments."""
+    out = {k: int(a.get(k, 0)) + int(b.get(k, 0)) for k in ("steps", "rejected", "nfev", "njev", "factorizations",
+                                                          "projections")}
+    out["steps"] -= 1      # the explicit step that was flagged stiff is discarded (HHT redoes it): rejected
+    out["rejected"] += 1
+    out.update(order=b.get("order"), switch_time=t_s, alpha=b.get("alpha"), formulation=a.get("formulation"),
+               method=f"auto: {a['method']} until t = {t_s:.6g} s, then {b['method']} ({reason})",
+               order_history=single_history(t0, a["method"], a.get("order"))
+               + single_history(t_s, b["method"], b.get("order")))
+    return out
+
+
+def _align_quaternions(sys, q, q_prev):
+    """q with each body's Euler parameters sign-flipped where they point away from q_prev's (the same
+    rotation; keeps the output rows continuous across the hand-over)."""
+    if len(sys.p_idx):
+        p, pp = q[sys.p_idx], q_prev[sys.p_idx]
+        flip = np.sum(p * pp, axis=1) < 0
+        q[sys.p_idx[flip]] = -p[flip]
+    return q
+
+
+class _Joined:
+    """Progress of the implicit part: times forwarded, partial Results offered with the explicit prefix
+    in front (so that a file written during the run holds every output so far)."""
+
+    def __init__(self, progress, first, t_s):
+        self.progress, self.first, self.t_s = progress, first, t_s
+
+    def __call__(self, t):
+        self.progress(float(t))
+
+    def offer(self, build):
+        offer = getattr(self.progress, "offer", None)
+        if offer is not None:
+            offer(lambda: join(self.first, build(), self.t_s))
