@@ -2,7 +2,7 @@
 
 Layout: `out` is a Parquet dataset directory (what `pandas.read_parquet(out)` reads as one table):
 ``part-000000.parquet``, ``part-000001.parquet``, ... one file per chunk of CHUNK_ROWS output times, with
-the columns of `Result.to_dataframe()` (joint angles and Euler parameters continuous across chunks), and
+the columns of `Result.to_dataframe()` written with pyarrow (no pandas on the writing path; joint angles and Euler parameters continuous across chunks), and
 ``_checkpoint.npz`` (ignored by Parquet readers) with everything the compiled integrator carries from one
 chunk to the next: time and step size [t, h], the integrator state y and its derivative f, the step
 statistics and stiffness counters, the last output row and the last written table row. Each file is
@@ -78,12 +78,10 @@ def _atomic(path: Path, write) -> None:
     os.replace(tmp, path)
 
 
-def write_part(path: Path, index: int, df) -> None:
-    """Chunk `index` of the run as part-<index>.parquet (atomic)."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    table = pa.Table.from_pandas(df, preserve_index=False)
-    _atomic(path / f"part-{index:06d}.parquet", lambda p: pq.write_table(table, p))
+def write_part(path: Path, index: int, cols: dict) -> None:
+    """Chunk `index` of the run as part-<index>.parquet (atomic); `cols`: {column name: 1-D array}, written
+    with pyarrow directly (pandas is not needed to write, only to read the dataset back)."""
+    _atomic(path / f"part-{index:06d}.parquet", lambda p: results_stream.write_parquet(cols, p))
 
 
 def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
@@ -98,26 +96,34 @@ def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
 
 
 # ----------------------------------------------------------------------------- tables
-def chunk_frame(res, prev_row):
-    """The `to_dataframe()` table of a chunk's Result; with prev_row (the previous chunk's last table row, a
-    pandas Series, also the chunk's first sample), angle columns continue it (multiples of 2 pi) and Euler
-    parameters keep its sign, and that first row is dropped."""
-    df = res.to_dataframe()
+def chunk_columns(res, prev_row):
+    """The `to_dataframe()` columns of a chunk's Result ({name: array}, see results.export.columns); with
+    prev_row (the previous chunk's last table row, {name: float}, also the chunk's first sample), angle
+    columns continue it (multiples of 2 pi) and Euler parameters keep its sign, and that first row is
+    dropped."""
+    from ..results.export import columns
+    cols = columns(res)
     if prev_row is None:
-        return df
-    for col in df.columns:
+        return cols
+    for col, x in cols.items():
         if col.endswith("[rad]"):
-            shift = np.round((prev_row[col] - df[col].iloc[0]) / (2 * np.pi)) * 2 * np.pi
+            shift = np.round((prev_row[col] - x[0]) / (2 * np.pi)) * 2 * np.pi
             if shift:
-                df[col] = df[col] + shift
-    for qw in [c for c in df.columns if c.endswith(".qw [-]")]:
+                cols[col] = x + shift
+    for qw in [c for c in cols if c.endswith(".qw [-]")]:
         stem = qw[:-len("qw [-]")]
-        cols = [f"{stem}q{c} [-]" for c in "wxyz"]
-        if all(c in df.columns for c in cols):
-            dot = float(np.dot(prev_row[cols].to_numpy(float), df[cols].iloc[0].to_numpy(float)))
+        names = [f"{stem}q{c} [-]" for c in "wxyz"]
+        if all(c in cols for c in names):
+            dot = float(np.dot([prev_row[c] for c in names], [cols[c][0] for c in names]))
             if dot < 0:
-                df[cols] = -df[cols]
-    return df.iloc[1:].reset_index(drop=True)
+                for c in names:
+                    cols[c] = -cols[c]
+    return {k: v[1:] for k, v in cols.items()}
+
+
+def last_row(cols: dict) -> dict:
+    """The last row of a columns dict as {name: float}."""
+    return {k: float(v[-1]) for k, v in cols.items()}
 
 
 # ----------------------------------------------------------------------------- compiled streaming
@@ -197,13 +203,13 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             VD, LAM = run.outputs(ts, Yc)
             return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
         cres = Result(sys, tout, rows[:, :sys.nq], rows[:, sys.nq:], None, None, accelerations=accelerations)
-        df = chunk_frame(cres, prev_row)
+        cols = chunk_columns(cres, prev_row)
         if monitor:   # history kept as one entry per chunk (its extremes): bounded memory
             n_t, n_c = (0, 0) if diag is None else (len(diag.time), len(diag.constraint_time))
             diag = run_monitors(cres, diag, first=prev_row is None)
             compact_tail(diag, n_t, n_c)
-        if len(df):
-            write_part(path, chunk, df)
+        if len(cols["time [s]"]):
+            write_part(path, chunk, cols)
         cres._fr = None   # break the Result <-> lazy frames cycle: the chunk's arrays go now, not at a GC
         last = (tout, rows, accelerations)
         if status != 0:
@@ -214,7 +220,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
-        prev_row, ylast = df.iloc[-1], rows[-1].copy()
+        prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
         _save_checkpoint(path, fp, chunk, i0, st, y, f, run.stats, ylast, prev_row)
     ts, rows, acc = last
@@ -247,14 +253,13 @@ def _save_checkpoint(path, fp, chunk, i0, st, y, f, stats, ylast, prev_row):
     def write(p):
         with open(p, "wb") as fh:
             np.savez(fh, fingerprint=np.array(fp), chunk=chunk, i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
-                     row=prev_row.to_numpy(float), columns=np.array(list(prev_row.index)))
+                     row=np.array(list(prev_row.values()), float), columns=np.array(list(prev_row)))
     _atomic(path / CHECKPOINT, write)
 
 
 def _load_checkpoint(path, fp):
     """The carried state of the last completed chunk, None when there is none; ModelError when it belongs
     to another run (other settings or model)."""
-    import pandas as pd
     file = path / CHECKPOINT
     if not file.exists():
         return None
@@ -262,7 +267,7 @@ def _load_checkpoint(path, fp):
         if str(z["fingerprint"]) != fp:
             raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (model, "
                              "times or tolerances differ); run without resume to start afresh")
-        prev = pd.Series(z["row"], index=[str(c) for c in z["columns"]])
+        prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
                 z["ylast"].copy(), prev)
 
@@ -270,9 +275,11 @@ def _load_checkpoint(path, fp):
 # ----------------------------------------------------------------------------- in-memory fallback
 def write_result(res: Result, out) -> Result:
     """Write a Result computed in memory in the same layout (parts of CHUNK_ROWS rows, no checkpoint)."""
+    from ..results.export import columns
     path = prepare(out, resume=False)
-    df = res.to_dataframe()
-    for k, start in enumerate(range(0, max(len(df), 1), CHUNK_ROWS)):
-        write_part(path, k, df.iloc[start:start + CHUNK_ROWS])
-    res.stats["out"], res.stats["samples"] = str(path), len(df)
+    cols = columns(res)
+    n = len(cols["time [s]"])
+    for k, start in enumerate(range(0, max(n, 1), CHUNK_ROWS)):
+        write_part(path, k, {c: v[start:start + CHUNK_ROWS] for c, v in cols.items()})
+    res.stats["out"], res.stats["samples"] = str(path), n
     return res
