@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import time
 from pathlib import Path
@@ -127,6 +128,37 @@ def last_row(cols: dict) -> dict:
 
 
 # ----------------------------------------------------------------------------- compiled streaming
+def _rms(x, scale) -> float:
+    s = 0.0
+    for xi, si in zip(x.tolist(), scale):
+        r = xi / si
+        s += r * r   # numba's x ** 2 (integer literal) is x * x
+    return math.sqrt(s / len(scale))
+
+
+def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
+    """`fastdop.initial_step` (Hairer's starting step [s]) in Python around the already loaded `fastdop.rhs`:
+    the same IEEE operations in the same order, so the same bits (tests/test_stream_memory.py compares
+    them), without loading that kernel's ~11 MB of machine code for one call per run. a, w: the compiled
+    model's and work arrays; y0, f0: state and its derivative at t0."""
+    from . import fastdop
+    scale = [atol + abs(v) * rtol for v in y0.tolist()]
+    d0, d1 = _rms(y0, scale), _rms(f0, scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, max_step)
+    y1 = y0 + h0 * f0
+    work = np.zeros(len(y0))
+    if fastdop.rhs(a, w, t0 + h0, y1, work) != fastdop.OK:
+        return h0
+    d2 = _rms(work - f0, scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, max_step)
+
+
+
 def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
@@ -148,8 +180,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         status = fastdop.rhs(a, w, times[0], y, f)
         if status != 0:
             raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
-        st = np.array([times[0], fastdop.initial_step(a, w, times[0], y, f, rtol, atol, run.max_step,
-                                                      np.zeros(len(y)), np.zeros(len(y)), np.zeros(len(y)))])
+        st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
         chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
         _write_meta(path, fp, times, rtol, atol)
     else:
