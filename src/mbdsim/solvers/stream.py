@@ -2,18 +2,23 @@
 
 Layout: `out` is a Parquet dataset directory (what `pandas.read_parquet(out)` reads as one table):
 ``part-000000.parquet``, ``part-000001.parquet``, ... one file per chunk of CHUNK_ROWS output times, with
-the columns of `Result.to_dataframe()` written with pyarrow (no pandas on the writing path; joint angles and Euler parameters continuous across chunks), and
-``_checkpoint.npz`` (ignored by Parquet readers) with everything the compiled integrator carries from one
-chunk to the next: time and step size [t, h], the integrator state y and its derivative f, the step
-statistics and stiffness counters, the last output row and the last written table row. Each file is
-written to a hidden temporary name and renamed (atomic on POSIX), part first, checkpoint second: a run
-killed at any moment (SIGKILL included) leaves every completed part readable and a checkpoint that is
-never ahead of the parts.
+the columns of `Result.to_dataframe()` (joint angles and Euler parameters continuous across chunks;
+written with pyarrow alone: pandas is needed to read them, not to write them), and ``_checkpoint.npz``
+(ignored by Parquet readers) with everything the compiled integrator carries from one chunk to the next:
+time and step size [t, h], the integrator state y and its derivative f, the step statistics and
+stiffness counters, the last output row and the last written table row. Each file is written to a
+hidden temporary name and renamed (atomic on POSIX), part first, checkpoint second: a run killed at any
+moment (SIGKILL included) leaves every completed part readable and a checkpoint that is never ahead of
+the parts.
 
-Memory is bounded by one chunk whatever the run's length. `resume=True` reloads the checkpoint (the
-run's settings and assembled initial state must match, checked by a fingerprint) and continues with
-exactly the carried state: the compiled step loop returns to Python at every chunk boundary in an
-uninterrupted run too, so a resumed run is bit-identical to an uninterrupted one.
+Memory is bounded by one chunk whatever the run's length (bench/stream_memory.py: a 1000 s run at
+1 ms output peaks under 300 MB resident, libraries and loaded kernels included; only the kernels the
+run calls are loaded: the starting step is computed here around the loaded rhs kernel).
+
+`resume=True` reloads the checkpoint (the run's settings and assembled initial state must match, checked
+by a fingerprint) and continues with exactly the carried state: the compiled step loop returns to Python
+at every chunk boundary in an uninterrupted run too, so a resumed run is bit-identical to an
+uninterrupted one.
 
 Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
 switch while streaming). Other methods and models run in memory and then write the same layout (no
@@ -156,7 +161,6 @@ def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
     else:
         h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, max_step)
-
 
 
 def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
