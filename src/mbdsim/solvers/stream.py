@@ -41,6 +41,7 @@ from ..results.result import Result
 
 CHUNK_ROWS = 5_000           # output times per part file (a chunk ends at the first step end past them)
 STREAM_KEEP = 8 * 2**20    # bytes of output states the returned Result may hold (else: the last part only)
+COLUMN_ROWS = 1000          # outputs per block when computing a part's table (bounds its work arrays)
 MARGIN = 1024                # extra rows for the outputs of a chunk's last step (grown when a step has more)
 CHECKPOINT = "_checkpoint.npz"
 META = "_run.json"
@@ -125,6 +126,25 @@ def chunk_columns(res, prev_row):
                 for c in names:
                     cols[c] = -cols[c]
     return {k: v[1:] for k, v in cols.items()}
+
+
+def part_columns(result_of, n: int, prev_row):
+    """`chunk_columns` of a part's n outputs, computed in blocks of at most COLUMN_ROWS + 1 outputs joined as
+    parts are (a block's first output repeats the previous block's last): the per-sample work arrays
+    (frames, accelerations, the Jacobians behind the reactions) stay bounded by a block, not a part.
+    result_of(s, e): the Result of the part's outputs s .. e-1."""
+    blocks, s = [], 0
+    while True:
+        e = min(s + COLUMN_ROWS + 1, n)
+        res = result_of(s, e)
+        blocks.append(chunk_columns(res, prev_row if s == 0 else last_row(blocks[-1])))
+        res._fr = None   # break the Result <-> lazy frames cycle: the block's arrays go now, not at a GC
+        if e >= n:
+            break
+        s = e - 1
+    if len(blocks) == 1:
+        return blocks[0]
+    return {k: np.concatenate([b[k] for b in blocks]) for k in blocks[0]}
 
 
 def last_row(cols: dict) -> dict:
@@ -237,8 +257,12 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         def accelerations(ts=tout, Yc=rows):
             VD, LAM = run.outputs(ts, Yc)
             return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
+
+        def result_of(s, e, ts=tout, Yc=rows):
+            return Result(sys, ts[s:e], Yc[s:e, :sys.nq], Yc[s:e, sys.nq:], None, None,
+                          accelerations=lambda: accelerations(ts[s:e], Yc[s:e]))
+        cols = part_columns(result_of, len(tout), prev_row)
         cres = Result(sys, tout, rows[:, :sys.nq], rows[:, sys.nq:], None, None, accelerations=accelerations)
-        cols = chunk_columns(cres, prev_row)
         if monitor:   # history kept as one entry per chunk (its extremes): bounded memory
             n_t, n_c = (0, 0) if diag is None else (len(diag.time), len(diag.constraint_time))
             diag = run_monitors(cres, diag, first=prev_row is None)
