@@ -194,5 +194,5 @@ def test_mutated_model_files(case):
 
 def test_print_fuzz_statistics():
     """Runs last in this file: the outcome counts (pytest -s shows them)."""
-    for k, c in STATS.items():
-        print(f"fuzz {k}: {sum(c.values())} examples: {dict(c)}")
+    for k, c in STATS.items():   # "energy checked" counts a subset of the "ok" mechanisms, not more examples
+        print(f"fuzz {k}: {sum(v for o, v in c.items() if o != 'energy checked')} examples: {dict(c)}")

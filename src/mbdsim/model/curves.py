@@ -22,7 +22,6 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from ..errors import ModelError
 from ._check import scalar
@@ -163,6 +162,7 @@ class Spline(Curve):
             raise ModelError("spline", "points", f"consecutive points {k} and {k + 1} coincide")
         u = np.concatenate([[0.0], np.cumsum(chord)])
         self.points = P
+        from scipy.interpolate import CubicSpline
         self._cs = CubicSpline(u, P, bc_type="periodic" if closed else "not-a-knot")
         self._c1, self._c2 = self._cs.derivative(1), self._cs.derivative(2)
         self.s_range, self.closed, self.h = (0.0, float(u[-1])), closed, float(u[-1]) * 1e-4

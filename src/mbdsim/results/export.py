@@ -136,7 +136,12 @@ def _element_columns(res, el):
 def to_dataframe(res, markers=False, euler=None):
     """Wide pandas DataFrame of a Result (columns: see the module docstring), SI units in the names."""
     import pandas as pd
+    return pd.DataFrame(columns(res, markers, euler))
 
+
+def columns(res, markers=False, euler=None):
+    """The columns of `to_dataframe` as an ordered dict {name: 1-D float array per output time}, without
+    pandas (the streamed writer builds its Parquet tables from it with pyarrow directly)."""
     cols = {"time [s]": np.asarray(res.time, dtype=float)}
     for body in res.system.bodies:
         cols.update(_frame_columns(res, body, body.name, not body.is_particle, euler))
@@ -152,4 +157,4 @@ def to_dataframe(res, markers=False, euler=None):
             cols[f"{m.name}.effort [{'N m' if m.dof == 'rotation' else 'N'}]"] = res.driver_effort(m)
     for el in model.forces.values():
         cols.update(_element_columns(res, el))
-    return pd.DataFrame(cols)
+    return cols

@@ -8,7 +8,6 @@ from __future__ import annotations
 from typing import Callable
 
 import numpy as np
-import scipy.optimize as so
 
 from ..errors import ModelError
 from ..model.joints import Joint
@@ -397,6 +396,7 @@ class Result:
         level, the last sample of the result included), the direction being that of the values around
         the run.  Convention at the start: a signal that starts at the level has not crossed it, so
         t = res.time[0] is never a crossing (note that scipy's solve_ivp events do report t0 then)."""
+        import scipy.optimize as so   # here, not at the top: only these refinements use scipy.optimize
         y = np.asarray(signal(self), dtype=float) - value
         out = []
         for k in range(len(y) - 1):
@@ -427,6 +427,7 @@ class Result:
         k = int(np.argmax(y >= np.max(y) - tol))
         if k in (0, len(y) - 1) or self._evaluate is None:
             return float(self.time[k]), float(sign * y[k])
+        import scipy.optimize as so
         f = lambda t: -sign * float(np.asarray(signal(self.at(t)))[0])  # noqa: E731
         flat = False
         try:

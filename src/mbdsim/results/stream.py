@@ -19,6 +19,8 @@ import os
 import time
 from pathlib import Path
 
+import numpy as np
+
 from ..errors import ModelError
 
 WRITE_INTERVAL = 2.0          # s of wall time between two writes, at least
@@ -34,6 +36,22 @@ def notify(progress, t, build=None) -> None:
     offer = getattr(progress, "offer", None)
     if offer is not None and build is not None:
         offer(build)
+
+
+def write_parquet(cols: dict, path) -> None:
+    """Write {column name: 1-D float array} as a Parquet file with pyarrow alone: the arrays are wrapped as
+    Arrow buffers (pa.array / pa.table on numpy arrays would import pandas, ~75 MB resident, which
+    nothing on the writing path needs). pandas.read_parquet reads the file."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+    arrays = []
+    for name, v in cols.items():
+        x = np.ascontiguousarray(v, dtype=float)
+        if x.ndim != 1:
+            raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
+        arrays.append(pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)]))
+    # float columns: dictionary pages only cost memory (~4 MB) and space (nearly every value is distinct)
+    pq.write_table(pa.Table.from_arrays(arrays, names=list(cols)), path, use_dictionary=False)
 
 
 class ResultFile:
@@ -57,15 +75,15 @@ class ResultFile:
             self.write(build())
 
     def write(self, res) -> None:
-        """Write `res.to_dataframe()` atomically (OSError when the file cannot be written)."""
+        """Write the table of `res.to_dataframe()` atomically (OSError when the file cannot be written)."""
         t0 = time.monotonic()
-        df = res.to_dataframe()
         self.path.parent.mkdir(parents=True, exist_ok=True)
         tmp = self.path.with_name(f".{self.path.name}.partial")
-        if self.path.suffix.lower() == ".parquet":
-            df.to_parquet(tmp, index=False, engine="pyarrow")
+        if self.path.suffix.lower() == ".parquet":   # pyarrow directly: no pandas import to write
+            from .export import columns
+            write_parquet(columns(res), tmp)
         else:
-            df.to_csv(tmp, index=False)
+            res.to_dataframe().to_csv(tmp, index=False)
         os.replace(tmp, self.path)
         self.writes += 1
         self.last = time.monotonic()

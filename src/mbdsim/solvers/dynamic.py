@@ -12,7 +12,6 @@ import bisect
 import os
 
 import numpy as np
-from scipy import integrate
 
 from ._threads import blas_single_thread
 from ..errors import ModelError, SolverError
@@ -35,8 +34,9 @@ if TYPE_CHECKING:
     from .._types import PathLike, Progress
     from ..model.model import Model
 
-SCIPY_METHODS = {"dop853": integrate.DOP853, "high-accuracy": integrate.DOP853, "rk45": integrate.RK45,
-                 "radau": integrate.Radau, "bdf": integrate.BDF}
+SCIPY_METHODS = {"dop853": "DOP853", "high-accuracy": "DOP853", "rk45": "RK45", "radau": "Radau", "bdf": "BDF"}
+# scipy.integrate's OdeSolver class of each method, by name: imported when a run uses the reference path
+# (~17 MB of scipy that the compiled runs do not load)
 COMPILED_METHODS = ("dop853", "high-accuracy")   # run by the compiled step loop when the model allows
 USE_COMPILED = True   # False: always the reference scipy path (tests compare the two)
 DEFAULT_TOL = {"auto": (1e-7, 1e-9), "dop853": (1e-10, 1e-12), "high-accuracy": (1e-10, 1e-12), "rk45": (1e-7, 1e-9),
@@ -224,7 +224,9 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
             return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
-    return _integrate_index1(sys, rep, times, SCIPY_METHODS[method], rtol, atol, max_step, progress)
+    from scipy import integrate
+    return _integrate_index1(sys, rep, times, getattr(integrate, SCIPY_METHODS[method]), rtol, atol, max_step,
+                             progress)
 
 
 HHT_RTOL_FLOOR = 1e-10     # HHT's Newton iterations converge to ~1e-12: its error estimate means nothing below

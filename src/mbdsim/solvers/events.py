@@ -13,7 +13,6 @@ on the dense output to 1e-13 s, and the integrator restarts there, so no discont
 from __future__ import annotations
 
 import numpy as np
-import scipy.optimize as so
 
 from ..system.force_elements import evaluator
 from ..system.frames import body_frames
@@ -77,7 +76,8 @@ class EventTracker:
         for k in cross:
             f = lambda t: self.values(t, dense(t))[k]  # noqa: E731
             try:
-                tk = so.brentq(f, t_old, t_new, xtol=1e-13, rtol=1e-15)
+                from scipy.optimize import brentq
+                tk = brentq(f, t_old, t_new, xtol=1e-13, rtol=1e-15)
             except ValueError:
                 continue
             best = min(best, tk)

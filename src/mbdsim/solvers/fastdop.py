@@ -15,7 +15,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
-from scipy.integrate._ivp import dop853_coefficients as _c
+from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
 from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs,
                       write_state)

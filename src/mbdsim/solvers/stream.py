@@ -2,18 +2,23 @@
 
 Layout: `out` is a Parquet dataset directory (what `pandas.read_parquet(out)` reads as one table):
 ``part-000000.parquet``, ``part-000001.parquet``, ... one file per chunk of CHUNK_ROWS output times, with
-the columns of `Result.to_dataframe()` (joint angles and Euler parameters continuous across chunks), and
-``_checkpoint.npz`` (ignored by Parquet readers) with everything the compiled integrator carries from one
-chunk to the next: time and step size [t, h], the integrator state y and its derivative f, the step
-statistics and stiffness counters, the last output row and the last written table row. Each file is
-written to a hidden temporary name and renamed (atomic on POSIX), part first, checkpoint second: a run
-killed at any moment (SIGKILL included) leaves every completed part readable and a checkpoint that is
-never ahead of the parts.
+the columns of `Result.to_dataframe()` (joint angles and Euler parameters continuous across chunks;
+written with pyarrow alone: pandas is needed to read them, not to write them), and ``_checkpoint.npz``
+(ignored by Parquet readers) with everything the compiled integrator carries from one chunk to the next:
+time and step size [t, h], the integrator state y and its derivative f, the step statistics and
+stiffness counters, the last output row and the last written table row. Each file is written to a
+hidden temporary name and renamed (atomic on POSIX), part first, checkpoint second: a run killed at any
+moment (SIGKILL included) leaves every completed part readable and a checkpoint that is never ahead of
+the parts.
 
-Memory is bounded by one chunk whatever the run's length. `resume=True` reloads the checkpoint (the
-run's settings and assembled initial state must match, checked by a fingerprint) and continues with
-exactly the carried state: the compiled step loop returns to Python at every chunk boundary in an
-uninterrupted run too, so a resumed run is bit-identical to an uninterrupted one.
+Memory is bounded by one chunk whatever the run's length (bench/stream_memory.py: a 1000 s run at
+1 ms output peaks under 300 MB resident, libraries and loaded kernels included; only the kernels the
+run calls are loaded: the starting step is computed here around the loaded rhs kernel).
+
+`resume=True` reloads the checkpoint (the run's settings and assembled initial state must match, checked
+by a fingerprint) and continues with exactly the carried state: the compiled step loop returns to Python
+at every chunk boundary in an uninterrupted run too, so a resumed run is bit-identical to an
+uninterrupted one.
 
 Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
 switch while streaming). Other methods and models run in memory and then write the same layout (no
@@ -23,6 +28,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import math
 import os
 import time
 from pathlib import Path
@@ -35,6 +41,7 @@ from ..results.result import Result
 
 CHUNK_ROWS = 5_000           # output times per part file (a chunk ends at the first step end past them)
 STREAM_KEEP = 8 * 2**20    # bytes of output states the returned Result may hold (else: the last part only)
+COLUMN_ROWS = 1000          # outputs per block when computing a part's table (bounds its work arrays)
 MARGIN = 1024                # extra rows for the outputs of a chunk's last step (grown when a step has more)
 CHECKPOINT = "_checkpoint.npz"
 META = "_run.json"
@@ -78,12 +85,10 @@ def _atomic(path: Path, write) -> None:
     os.replace(tmp, path)
 
 
-def write_part(path: Path, index: int, df) -> None:
-    """Chunk `index` of the run as part-<index>.parquet (atomic)."""
-    import pyarrow as pa
-    import pyarrow.parquet as pq
-    table = pa.Table.from_pandas(df, preserve_index=False)
-    _atomic(path / f"part-{index:06d}.parquet", lambda p: pq.write_table(table, p))
+def write_part(path: Path, index: int, cols: dict) -> None:
+    """Chunk `index` of the run as part-<index>.parquet (atomic); `cols`: {column name: 1-D array}, written
+    with pyarrow directly (pandas is not needed to write, only to read the dataset back)."""
+    _atomic(path / f"part-{index:06d}.parquet", lambda p: results_stream.write_parquet(cols, p))
 
 
 def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
@@ -98,29 +103,86 @@ def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
 
 
 # ----------------------------------------------------------------------------- tables
-def chunk_frame(res, prev_row):
-    """The `to_dataframe()` table of a chunk's Result; with prev_row (the previous chunk's last table row, a
-    pandas Series, also the chunk's first sample), angle columns continue it (multiples of 2 pi) and Euler
-    parameters keep its sign, and that first row is dropped."""
-    df = res.to_dataframe()
+def chunk_columns(res, prev_row):
+    """The `to_dataframe()` columns of a chunk's Result ({name: array}, see results.export.columns); with
+    prev_row (the previous chunk's last table row, {name: float}, also the chunk's first sample), angle
+    columns continue it (multiples of 2 pi) and Euler parameters keep its sign, and that first row is
+    dropped."""
+    from ..results.export import columns
+    cols = columns(res)
     if prev_row is None:
-        return df
-    for col in df.columns:
+        return cols
+    for col, x in cols.items():
         if col.endswith("[rad]"):
-            shift = np.round((prev_row[col] - df[col].iloc[0]) / (2 * np.pi)) * 2 * np.pi
+            shift = np.round((prev_row[col] - x[0]) / (2 * np.pi)) * 2 * np.pi
             if shift:
-                df[col] = df[col] + shift
-    for qw in [c for c in df.columns if c.endswith(".qw [-]")]:
+                cols[col] = x + shift
+    for qw in [c for c in cols if c.endswith(".qw [-]")]:
         stem = qw[:-len("qw [-]")]
-        cols = [f"{stem}q{c} [-]" for c in "wxyz"]
-        if all(c in df.columns for c in cols):
-            dot = float(np.dot(prev_row[cols].to_numpy(float), df[cols].iloc[0].to_numpy(float)))
+        names = [f"{stem}q{c} [-]" for c in "wxyz"]
+        if all(c in cols for c in names):
+            dot = float(np.dot([prev_row[c] for c in names], [cols[c][0] for c in names]))
             if dot < 0:
-                df[cols] = -df[cols]
-    return df.iloc[1:].reset_index(drop=True)
+                for c in names:
+                    cols[c] = -cols[c]
+    return {k: v[1:] for k, v in cols.items()}
+
+
+def part_columns(result_of, n: int, prev_row):
+    """`chunk_columns` of a part's n outputs, computed in blocks of at most COLUMN_ROWS + 1 outputs joined as
+    parts are (a block's first output repeats the previous block's last): the per-sample work arrays
+    (frames, accelerations, the Jacobians behind the reactions) stay bounded by a block, not a part.
+    result_of(s, e): the Result of the part's outputs s .. e-1."""
+    blocks, s = [], 0
+    while True:
+        e = min(s + COLUMN_ROWS + 1, n)
+        res = result_of(s, e)
+        blocks.append(chunk_columns(res, prev_row if s == 0 else last_row(blocks[-1])))
+        res._fr = None   # break the Result <-> lazy frames cycle: the block's arrays go now, not at a GC
+        if e >= n:
+            break
+        s = e - 1
+    if len(blocks) == 1:
+        return blocks[0]
+    return {k: np.concatenate([b[k] for b in blocks]) for k in blocks[0]}
+
+
+def last_row(cols: dict) -> dict:
+    """The last row of a columns dict as {name: float}."""
+    return {k: float(v[-1]) for k, v in cols.items()}
 
 
 # ----------------------------------------------------------------------------- compiled streaming
+def _rms(x, scale) -> float:
+    s = 0.0
+    for xi, si in zip(x.tolist(), scale):
+        r = xi / si
+        s += r * r   # numba's x ** 2 (integer literal) is x * x
+    return math.sqrt(s / len(scale))
+
+
+def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
+    """`fastdop.initial_step` (Hairer's starting step [s]) in Python around the already loaded `fastdop.rhs`:
+    the same IEEE operations in the same order, so the same bits (tests/test_stream_memory.py compares
+    them), without loading that kernel's ~11 MB of machine code for one call per run. a, w: the compiled
+    model's and work arrays; y0, f0: state and its derivative at t0."""
+    from . import fastdop
+    scale = [atol + abs(v) * rtol for v in y0.tolist()]
+    d0, d1 = _rms(y0, scale), _rms(f0, scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, max_step)
+    y1 = y0 + h0 * f0
+    work = np.zeros(len(y0))
+    if fastdop.rhs(a, w, t0 + h0, y1, work) != fastdop.OK:
+        return h0
+    d2 = _rms(work - f0, scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, max_step)
+
+
 def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
@@ -142,8 +204,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         status = fastdop.rhs(a, w, times[0], y, f)
         if status != 0:
             raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
-        st = np.array([times[0], fastdop.initial_step(a, w, times[0], y, f, rtol, atol, run.max_step,
-                                                      np.zeros(len(y)), np.zeros(len(y)), np.zeros(len(y)))])
+        st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
         chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
         _write_meta(path, fp, times, rtol, atol)
     else:
@@ -196,14 +257,18 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         def accelerations(ts=tout, Yc=rows):
             VD, LAM = run.outputs(ts, Yc)
             return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
+
+        def result_of(s, e, ts=tout, Yc=rows):
+            return Result(sys, ts[s:e], Yc[s:e, :sys.nq], Yc[s:e, sys.nq:], None, None,
+                          accelerations=lambda: accelerations(ts[s:e], Yc[s:e]))
+        cols = part_columns(result_of, len(tout), prev_row)
         cres = Result(sys, tout, rows[:, :sys.nq], rows[:, sys.nq:], None, None, accelerations=accelerations)
-        df = chunk_frame(cres, prev_row)
         if monitor:   # history kept as one entry per chunk (its extremes): bounded memory
             n_t, n_c = (0, 0) if diag is None else (len(diag.time), len(diag.constraint_time))
             diag = run_monitors(cres, diag, first=prev_row is None)
             compact_tail(diag, n_t, n_c)
-        if len(df):
-            write_part(path, chunk, df)
+        if len(cols["time [s]"]):
+            write_part(path, chunk, cols)
         cres._fr = None   # break the Result <-> lazy frames cycle: the chunk's arrays go now, not at a GC
         last = (tout, rows, accelerations)
         if status != 0:
@@ -214,7 +279,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
-        prev_row, ylast = df.iloc[-1], rows[-1].copy()
+        prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
         _save_checkpoint(path, fp, chunk, i0, st, y, f, run.stats, ylast, prev_row)
     ts, rows, acc = last
@@ -247,14 +312,13 @@ def _save_checkpoint(path, fp, chunk, i0, st, y, f, stats, ylast, prev_row):
     def write(p):
         with open(p, "wb") as fh:
             np.savez(fh, fingerprint=np.array(fp), chunk=chunk, i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
-                     row=prev_row.to_numpy(float), columns=np.array(list(prev_row.index)))
+                     row=np.array(list(prev_row.values()), float), columns=np.array(list(prev_row)))
     _atomic(path / CHECKPOINT, write)
 
 
 def _load_checkpoint(path, fp):
     """The carried state of the last completed chunk, None when there is none; ModelError when it belongs
     to another run (other settings or model)."""
-    import pandas as pd
     file = path / CHECKPOINT
     if not file.exists():
         return None
@@ -262,7 +326,7 @@ def _load_checkpoint(path, fp):
         if str(z["fingerprint"]) != fp:
             raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (model, "
                              "times or tolerances differ); run without resume to start afresh")
-        prev = pd.Series(z["row"], index=[str(c) for c in z["columns"]])
+        prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
                 z["ylast"].copy(), prev)
 
@@ -270,9 +334,11 @@ def _load_checkpoint(path, fp):
 # ----------------------------------------------------------------------------- in-memory fallback
 def write_result(res: Result, out) -> Result:
     """Write a Result computed in memory in the same layout (parts of CHUNK_ROWS rows, no checkpoint)."""
+    from ..results.export import columns
     path = prepare(out, resume=False)
-    df = res.to_dataframe()
-    for k, start in enumerate(range(0, max(len(df), 1), CHUNK_ROWS)):
-        write_part(path, k, df.iloc[start:start + CHUNK_ROWS])
-    res.stats["out"], res.stats["samples"] = str(path), len(df)
+    cols = columns(res)
+    n = len(cols["time [s]"])
+    for k, start in enumerate(range(0, max(n, 1), CHUNK_ROWS)):
+        write_part(path, k, {c: v[start:start + CHUNK_ROWS] for c, v in cols.items()})
+    res.stats["out"], res.stats["samples"] = str(path), n
     return res
