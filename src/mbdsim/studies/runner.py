@@ -139,7 +139,8 @@ def execute(study, client=None, workers=None, out=None, chunk_size=None, progres
             if len(pending) == 0:
                 pass
             elif serial:
-                for chunk in chunks_of(pending, chunk_size or 1):
+                # chunks as for one worker: rows are journaled (and a DataFrame built) per chunk, not per run
+                for chunk in chunks_of(pending, chunk_size or default_chunk_size(len(pending), 1)):
                     sink.add(run_chunk(study.plan, chunk))
                     bar.advance(task, len(chunk))
             else:
