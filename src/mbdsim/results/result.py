@@ -275,7 +275,9 @@ class Result:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
         body = None if on is None else ms.resolve_body(self.system, on, "on")
-        F, T = joint_reaction(self.system, self.q, self.lambda_, jt, body, A=self.frames.A)
+        from ..solvers.compiled_run import jacobians_of
+        lam = self.lambda_
+        F, T = joint_reaction(self.system, self.q, lam, jt, body, A=self.frames.A, J=jacobians_of(self.system, lam))
         return self._express(F, frame), self._express(T, frame)
 
     @property

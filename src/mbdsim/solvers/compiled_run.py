@@ -266,7 +266,10 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     from .minnorm import min_norm_multipliers
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows`
     rows = np.asarray(rows, dtype=np.int64)
-    dep = np.setdiff1d(np.arange(sys.nc), rows).astype(np.int64)
+    key = ("dependent rows", rows.tobytes())
+    dep = sys.derived.get(key)
+    if dep is None:   # the same rows at every call of a run: computed once
+        dep = sys.derived[key] = np.setdiff1d(np.arange(sys.nc), rows).astype(np.int64)
     LAM = np.ascontiguousarray(LAM, dtype=float)
     out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
     min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
@@ -274,4 +277,16 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
         load = np.einsum("nri,nr->ni", J[bad][:, rows], LAM[bad][:, rows])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
         out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
+    if J.nbytes <= JACOBIAN_KEEP:   # the reactions read from these multipliers reuse their Jacobians
+        sys.derived["jacobians of multipliers"] = (out, J)
     return out
+
+
+JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed are kept up to this size
+
+
+def jacobians_of(sys, lambda_):
+    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array the last
+    `_full_multipliers` call returned (the object itself, not equal values), else None."""
+    kept = sys.derived.get("jacobians of multipliers")
+    return kept[1] if kept is not None and kept[0] is lambda_ else None
