@@ -117,3 +117,15 @@ def test_door_determinacy_and_newton():
         F = res.reaction_force("top") + res.reaction_force("bottom")
     expected = 10.0 * (res.acceleration("door") - np.array([0.0, 0.0, -9.81]))
     assert np.allclose(F, expected, rtol=0, atol=1e-9 * 98.1)
+
+
+@pytest.mark.parametrize("name", ["slider_crank", "door_spherical"])
+def test_lazy_frames_accelerations_equal_body_frames(name):
+    """A compiled Result's frames get their acceleration terms on first use, on the rotation matrices
+    already computed: the same arrays as body_frames with the accelerations."""
+    res = _run(name)
+    fr = res.frames
+    full = body_frames(res.system, res.q, res.v, res.vd)
+    for key in ("r", "A", "rd", "w", "rdd", "alpha"):
+        assert np.array_equal(getattr(fr, key), getattr(full, key)), key
+    assert np.abs(full.alpha).max() > 0 and np.abs(full.rdd).max() > 0

@@ -479,10 +479,14 @@ class _LazyFrames(Frames):
         self._res = res
 
     def _full(self, key):
-        if key not in self.__dict__:
+        if key not in self.__dict__:   # body_frames' acceleration terms, on the rotations already computed
             res = self._res
-            full = body_frames(res.system, res.q, res.v, res.vd)
-            self.__dict__.update(_rdd=full.rdd, _alpha=full.alpha, _lam=res.lambda_)
+            sys, vd, rig = res.system, np.asarray(res.vd, dtype=float), res.system.rigid_fid
+            rdd, alpha = np.zeros(self.r.shape), np.zeros(self.r.shape)
+            rdd[..., 1:, :] = vd[..., sys.rd_idx]
+            if len(rig):
+                alpha[..., rig, :] = np.einsum("...ij,...j->...i", self.A[..., rig, :, :], vd[..., sys.w_idx])
+            self.__dict__.update(_rdd=rdd, _alpha=alpha, _lam=res.lambda_)
         return self.__dict__[key]
 
     rdd = property(lambda self: self._full("_rdd"), lambda self, x: self.__dict__.__setitem__("_rdd", x))
