@@ -200,6 +200,11 @@ def report(results, args, same, loads, stages=None):
                   ", ".join(f"{k} {stages[k]:.1f}" for k in STAGES) + f" (total {total:.1f}); inside them the "
                   "compiled kernels: " + ", ".join(f"{k[7:]} {v:.1f}" for k, v in stages.items() if k.startswith("kernel"))
                   + f" (total {compiled:.1f}), Python {total - compiled:.1f}.\n")
+        if ex_cpu:
+            ratio += (f"Bound: the compiled kernels alone take {compiled:.1f} ms per variant, so even with no Python "
+                      f"and no Dask at all {args.workers} dedicated cores would give at most "
+                      f"{60000 * args.workers / compiled:.0f} variants/min, {args.workers * ex_cpu / compiled:.1f}x the "
+                      f"Exudyn loop; 10x needs at most {args.workers * ex_cpu / 10:.1f} ms of CPU per variant.\n")
     table = "\n".join(lines)
     print(table + ratio)
     head = (f"# Study throughput: slider-crank variants per minute\n\n"
