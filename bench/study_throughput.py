@@ -190,7 +190,7 @@ def report(results, args, same, loads, stages=None):
     warm_cpu = next((v for k, v in cpu.items() if "warm" in k), None)
     if ex_cpu and warm_cpu:   # what the wall clock would give on dedicated cores (the machine is shared)
         ideal = 60000 * args.workers / warm_cpu
-        ratio += (f"On CPU time (independent of the other load on the machine): dask warm {warm_cpu:.1f} ms per "
+        ratio += (f"On CPU time (far less sensitive than the wall clock to the other load on the machine, though contention inflates it too): dask warm {warm_cpu:.1f} ms per "
                   f"variant in the workers, {ideal:.0f} variants/min on {args.workers} dedicated cores, "
                   f"{ideal / (60000 / ex_cpu):.2f}x the Exudyn loop ({ex_cpu:.1f} ms per variant on one core).\n")
     if stages:
