@@ -62,6 +62,64 @@ def timed(fn):
     return time.perf_counter() - t0, time.process_time() - c0, out
 
 
+STAGES = ("build", "assembly", "compile and run", "outputs")
+
+
+def breakdown(design) -> dict:
+    """CPU ms per variant of each stage of a run in this process (build the model, assemble, compile and
+    integrate, measure the outputs) and of the compiled kernels inside them (timed by wrapping them here)."""
+    from mbdsim.results.diagnostics import monitor   # noqa: F401 - imported before timing
+    from mbdsim.solvers import compiled_run, fastdop, minnorm
+    from mbdsim.solvers.assembly import assemble_state
+    from mbdsim.solvers.dynamic import AUTO_LOCAL
+    from mbdsim.studies.measures import evaluate_outputs
+    from mbdsim.system import kernels
+    from mbdsim.system.assemble import assemble_system
+    kernel_time = {}
+
+    def wrap(mod, name):
+        fn = getattr(mod, name)
+
+        def timed_kernel(*a, **k):
+            c = time.process_time()
+            try:
+                return fn(*a, **k)
+            finally:
+                kernel_time[name] = kernel_time.get(name, 0.0) + time.process_time() - c
+        setattr(mod, name, timed_kernel)
+        return mod, name, fn
+    saved = [wrap(fastdop, n) for n in ("run", "outputs_at", "from_checkpoint")] + \
+        [wrap(minnorm, "min_norm_multipliers"), wrap(kernels, "jacobian_batch")]
+    stage = dict.fromkeys(STAGES, 0.0)
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            for params in design.to_dict("records"):
+                c0 = time.process_time()
+                model = slider_crank(**params)
+                c1 = time.process_time()
+                sys_ = assemble_system(model)
+                rep = assemble_state(sys_, sys_.q0, sys_.v0, 0.0)
+                c2 = time.process_time()
+                res = compiled_run.integrate_compiled(sys_, rep, np.linspace(0.0, 2.0, 201), AUTO_LOCAL * 1e-6,
+                                                      AUTO_LOCAL * 1e-9, None, None, stiff_check=True)
+                c3 = time.process_time()
+                evaluate_outputs(OUTPUTS, res)
+                c4 = time.process_time()
+                for k, dt in zip(STAGES, (c1 - c0, c2 - c1, c3 - c2, c4 - c3)):
+                    stage[k] += dt
+    finally:
+        for mod, name, fn in saved:
+            setattr(mod, name, fn)
+    n = len(design)
+    return {**{k: 1000 * v / n for k, v in stage.items()}, **{f"kernel {k}": 1000 * v / n for k, v in kernel_time.items()}}
+
+
+def worker_cpu(client) -> float:
+    """CPU seconds used so far by all the cluster's worker processes (tasks, Dask's own work included)."""
+    return sum(client.run(time.process_time).values())
+
+
 def exudyn_loop(design):
     from exudyn_slider_crank import run_variant   # bench/exudyn_slider_crank.py
     run_variant(**design.iloc[0].to_dict())       # warm-up
@@ -96,8 +154,10 @@ def main(argv=None):
             LocalCluster(n_workers=args.workers, threads_per_worker=1, dashboard_address=None) as cluster, \
             Client(cluster) as client:
         make_study(2 * args.workers).run(client=client, chunk_size=1, progress=False)   # warm the workers
+        cpu0 = worker_cpu(client)
         secs, _, warm = timed(lambda: study.run(client=client, progress=False))
-    results.append((f"study, dask {args.workers} workers (warm cluster)", secs, math.nan, args.workers))
+        cpu = worker_cpu(client) - cpu0
+    results.append((f"study, dask {args.workers} workers (warm cluster)", secs, cpu, args.workers))
     cols = ["peak_rod_force", "slider_peak_acceleration"]
     same = all(np.array_equal(serial[cols].to_numpy(), df[cols].to_numpy()) for df in (cold, warm))
     if args.exudyn:
@@ -107,10 +167,10 @@ def main(argv=None):
         dev = np.max(np.abs(ex[:, 0] / serial.peak_rod_force.to_numpy() - 1))
         results.append((f"  (Exudyn peak rod force vs mbdsim: max deviation {100 * dev:.2f} %)", math.nan, math.nan, 0))
     loads = (load0, os.getloadavg()[0])
-    report(results, args, same, loads)
+    report(results, args, same, loads, breakdown(design))
 
 
-def report(results, args, same, loads):
+def report(results, args, same, loads, stages=None):
     lines = ["| method | seconds | variants/min | per worker | CPU ms/variant |", "|---|---:|---:|---:|---:|"]
     rate = {}
     for name, secs, cpu, nw in results:
@@ -125,6 +185,26 @@ def report(results, args, same, loads):
     serial = next(v for k, v in rate.items() if "serial" in k)
     ratio = (f"\nRatio to the Exudyn loop: dask warm {warm / ex:.2f}x, serial study {serial / ex:.2f}x "
              f"(target 10x); variants per minute, dask warm: {warm:.0f} (target 1000).\n") if ex else ""
+    cpu = {name: 1000 * c / args.n for name, secs, c, nw in results if not math.isnan(c)}
+    ex_cpu = next((v for k, v in cpu.items() if "Exudyn" in k), None)
+    warm_cpu = next((v for k, v in cpu.items() if "warm" in k), None)
+    if ex_cpu and warm_cpu:   # what the wall clock would give on dedicated cores (the machine is shared)
+        ideal = 60000 * args.workers / warm_cpu
+        ratio += (f"On CPU time (far less sensitive than the wall clock to the other load on the machine, though contention inflates it too): dask warm {warm_cpu:.1f} ms per "
+                  f"variant in the workers, {ideal:.0f} variants/min on {args.workers} dedicated cores, "
+                  f"{ideal / (60000 / ex_cpu):.2f}x the Exudyn loop ({ex_cpu:.1f} ms per variant on one core).\n")
+    if stages:
+        compiled = sum(v for k, v in stages.items() if k.startswith("kernel"))
+        total = sum(stages[k] for k in STAGES)
+        ratio += ("\nCPU ms per variant in one process, by stage: " +
+                  ", ".join(f"{k} {stages[k]:.1f}" for k in STAGES) + f" (total {total:.1f}); inside them the "
+                  "compiled kernels: " + ", ".join(f"{k[7:]} {v:.1f}" for k, v in stages.items() if k.startswith("kernel"))
+                  + f" (total {compiled:.1f}), Python {total - compiled:.1f}.\n")
+        if ex_cpu:
+            ratio += (f"Bound: the compiled kernels alone take {compiled:.1f} ms per variant, so even with no Python "
+                      f"and no Dask at all {args.workers} dedicated cores would give at most "
+                      f"{60000 * args.workers / compiled:.0f} variants/min, {args.workers * ex_cpu / compiled:.1f}x the "
+                      f"Exudyn loop; 10x needs at most {args.workers * ex_cpu / 10:.1f} ms of CPU per variant.\n")
     table = "\n".join(lines)
     print(table + ratio)
     head = (f"# Study throughput: slider-crank variants per minute\n\n"
@@ -133,7 +213,7 @@ def report(results, args, same, loads):
             f"{platform.python_version()}), {time.strftime('%Y-%m-%d %H:%M')}; load average "
             f"{loads[0]:.1f} at the start, {loads[1]:.1f} at the end (the cores are shared: wall-clock rates "
             "are pessimistic by about that factor over the core count; the CPU column is this process's "
-            "CPU time).\n\n"
+            "CPU time, for the warm Dask row the workers' CPU time, Dask's own work included).\n\n"
             "Each variant: slider-crank (crank, rod, three masses, drive speed from a Latin hypercube), dynamics "
             "over 2 s, output every 10 ms, rtol 1e-6; outputs: peak rod force at the crank pin (refined on the "
             "dense output) and the slider's peak acceleration.  The loop and the serial study run the same "

@@ -301,6 +301,25 @@ def test_row_store_journal_keeps_every_finished_row(tmp_path):
     assert not journal_path(out).exists() and list(load_rows(out, "abc").run) == [0, 1, 2, 3, 4]
 
 
+def test_row_store_takes_dict_rows(tmp_path):
+    """Rows given as dicts (a study in this process: one run at a time) are journaled at once and written
+    to the Parquet file with the DataFrame rows of a resumed run, in the same columns."""
+    from mbdsim.studies.store import RowStore, journal_path, load_rows
+    out = tmp_path / "d.parquet"
+    store = RowStore(out, None, interval=3600.0)
+    store.append([{"run": 0, "x": 0.5, "status": "ok", "study_id": "s"}])
+    store.append([{"run": 1, "x": math.nan, "status": "error", "study_id": "s"}])
+    got = load_rows(out, "s")                                             # from the journal alone
+    assert not out.exists() and list(got.run) == [0, 1] and math.isnan(got.x[1])
+    store.close()
+    assert not journal_path(out).exists()
+    again = RowStore(out, load_rows(out, "s"), interval=3600.0)
+    again.append([{"run": 2, "x": 2.0, "status": "ok", "study_id": "s"}])
+    again.close()
+    df = pd.read_parquet(out)
+    assert list(df.run) == [0, 1, 2] and list(df.columns) == ["run", "x", "status", "study_id"] and df.x[2] == 2.0
+
+
 def test_callable_outputs():
     """An output may be a callable of the Result: the same number as the expression; one that raises or
     returns an array makes that run an 'error' row naming the output."""

@@ -281,7 +281,9 @@ class Result:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
         body = None if on is None else ms.resolve_body(self.system, on, "on")
-        F, T = joint_reaction(self.system, self.q, self.lambda_, jt, body)
+        from ..solvers.compiled_run import jacobians_of
+        lam = self.lambda_
+        F, T = joint_reaction(self.system, self.q, lam, jt, body, A=self.frames.A, J=jacobians_of(self.system, lam))
         return self._express(F, frame), self._express(T, frame)
 
     @property
@@ -485,10 +487,14 @@ class _LazyFrames(Frames):
         self._res = res
 
     def _full(self, key):
-        if key not in self.__dict__:
+        if key not in self.__dict__:   # body_frames' acceleration terms, on the rotations already computed
             res = self._res
-            full = body_frames(res.system, res.q, res.v, res.vd)
-            self.__dict__.update(_rdd=full.rdd, _alpha=full.alpha, _lam=res.lambda_)
+            sys, vd, rig = res.system, np.asarray(res.vd, dtype=float), res.system.rigid_fid
+            rdd, alpha = np.zeros(self.r.shape), np.zeros(self.r.shape)
+            rdd[..., 1:, :] = vd[..., sys.rd_idx]
+            if len(rig):
+                alpha[..., rig, :] = np.einsum("...ij,...j->...i", self.A[..., rig, :, :], vd[..., sys.w_idx])
+            self.__dict__.update(_rdd=rdd, _alpha=alpha, _lam=res.lambda_)
         return self.__dict__[key]
 
     rdd = property(lambda self: self._full("_rdd"), lambda self, x: self.__dict__.__setitem__("_rdd", x))

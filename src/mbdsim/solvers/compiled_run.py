@@ -268,33 +268,36 @@ def _result(sys, rep, run, t_out, Y, success=True, message="ok", stats=None) -> 
 def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
-    rows, so that the determinate components are exact. All samples at once, with r x d and d x d solves
-    only (d dependent rows)."""
+    rows, so that the determinate components are exact. All samples in one compiled call with r x r and
+    d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm), the SVD pseudo-inverse where
+    the rows are dependent at the sample's configuration too (a change point)."""
     if len(rows) == sys.nc or not len(times):
         return LAM
     from ..system.equations import jacobians
+    from .minnorm import min_norm_multipliers
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows`
-    rows = np.asarray(rows)
-    dep = np.setdiff1d(np.arange(sys.nc), rows)
-    Jr, lam_r = J[:, rows], LAM[:, rows]
-    load = np.einsum("nri,nr->ni", Jr, lam_r)
-    out = np.zeros_like(LAM)
-    try:
-        # J_d = C_d J_r (C_d = J_d J_r^T G^-1, G = J_r J_r^T), so J^T lam = J_r^T lam_r <=> lam[rows] + C_d^T lam[dep]
-        # = lam_r, whose least-norm solution is w = (I + C_d^T C_d)^-1 lam_r (Woodbury: a d x d solve),
-        # lam[rows] = w, lam[dep] = C_d w
-        JrT = np.transpose(Jr, (0, 2, 1))
-        Cd = np.transpose(np.linalg.solve(Jr @ JrT, Jr @ np.transpose(J[:, dep], (0, 2, 1))), (0, 2, 1))
-        S = np.eye(len(dep)) + Cd @ np.transpose(Cd, (0, 2, 1))
-        z = np.linalg.solve(S, np.einsum("ndr,nr->nd", Cd, lam_r)[..., None])[..., 0]
-        w = lam_r - np.einsum("ndr,nd->nr", Cd, z)
-        out[:, rows], out[:, dep] = w, np.einsum("ndr,nr->nd", Cd, w)
-        bad = ~np.all(np.isfinite(out), axis=1)
-    except np.linalg.LinAlgError:
-        bad = np.ones(len(times), dtype=bool)
-    scale = np.abs(load).max(axis=1) + 1e-300
-    bad |= np.abs(np.einsum("nri,nr->ni", J, out) - load).max(axis=1) > 1e-9 * scale
+    rows = np.asarray(rows, dtype=np.int64)
+    key = ("dependent rows", rows.tobytes())
+    dep = sys.derived.get(key)
+    if dep is None:   # the same rows at every call of a run: computed once
+        dep = sys.derived[key] = np.setdiff1d(np.arange(sys.nc), rows).astype(np.int64)
+    LAM = np.ascontiguousarray(LAM, dtype=float)
+    out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
+    min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
     if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
+        load = np.einsum("nri,nr->ni", J[bad][:, rows], LAM[bad][:, rows])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
-        out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load[bad])
+        out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
+    if J.nbytes <= JACOBIAN_KEEP:   # the reactions read from these multipliers reuse their Jacobians
+        sys.derived["jacobians of multipliers"] = (out, J)
     return out
+
+
+JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed are kept up to this size
+
+
+def jacobians_of(sys, lambda_):
+    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array the last
+    `_full_multipliers` call returned (the object itself, not equal values), else None."""
+    kept = sys.derived.get("jacobians of multipliers")
+    return kept[1] if kept is not None and kept[0] is lambda_ else None

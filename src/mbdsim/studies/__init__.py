@@ -13,6 +13,14 @@
 
 Modules: design (parameter specs, samplers), measures (output expressions), variant (one run; the Dask
 task), runner (Dask, Parquet, resume), store, spec (study files), sensitivity, plots, models (factories).
+
+Throughput (docs/studies.md, bench/study_throughput.py): kernels compiled once per process and reused by
+every variant (a variant's compiled model is its own numeric arrays, from its own assembly); chunks of
+variants per Dask task; outputs evaluated on all samples at once, extrema refined with grids of dense-output
+times (refine), reactions from one compiled minimum-norm solve (mbdsim.solvers.minnorm) with the Result's
+geometry reused; run monitors skipped unless a callable output may read them.  Several parameter sets in
+one compiled call would only save the calls' overhead (tens of microseconds against milliseconds of
+integration and per-variant assembly), so variants run one after the other inside a chunk.
 """
 from .spec import load_study
 from .study import Study

@@ -94,12 +94,15 @@ def _jsonable(value):
 class RowStore:
     """The rows of one study run going to `out` (None: kept in memory only).
 
-    `append(frame)` journals the rows and rewrites the Parquet file when FLUSH_INTERVAL has passed;
-    `close()` writes the Parquet file with every row and removes the journal."""
+    `append(rows)` journals the rows (a DataFrame or a list of dicts) and rewrites the Parquet file when
+    FLUSH_INTERVAL has passed; `close()` writes the Parquet file with every row and removes the journal.
+    Rows given as dicts stay dicts until a Parquet write (no DataFrame per batch: a study in this process
+    journals every run as it finishes)."""
 
     def __init__(self, out, previous: pd.DataFrame | None, interval: float = FLUSH_INTERVAL):
         self.out = None if out is None else Path(out)
         self.frames = [] if previous is None else [previous]
+        self.rows = []
         self.interval = interval
         self._last = time.monotonic()
         self._dirty = False
@@ -113,12 +116,15 @@ class RowStore:
                 self.flush()
                 self._journal.truncate(0)
 
-    def append(self, df: pd.DataFrame) -> None:
-        self.frames.append(df)
+    def append(self, rows) -> None:
+        if isinstance(rows, pd.DataFrame):
+            self.frames.append(rows)
+            rows = rows.to_dict("records") if self._journal is not None else []
+        else:
+            self.rows.extend(rows)
         if self._journal is None:
             return
-        lines = "".join(json.dumps({k: _jsonable(v) for k, v in row.items()}) + "\n"
-                        for row in df.to_dict("records"))
+        lines = "".join(json.dumps({k: _jsonable(v) for k, v in row.items()}) + "\n" for row in rows)
         self._journal.write(lines)
         self._journal.flush()
         self._dirty = True
@@ -129,7 +135,8 @@ class RowStore:
         """Rewrite the Parquet file with every row; the journal starts afresh."""
         if self.out is None or not self._dirty:
             return
-        write_rows(self.out, pd.concat(self.frames, ignore_index=True))
+        write_rows(self.out, pd.concat(self.frames + ([pd.DataFrame(self.rows)] if self.rows else []),
+                                       ignore_index=True))
         self._journal.seek(0)
         self._journal.truncate()
         self._last, self._dirty = time.monotonic(), False

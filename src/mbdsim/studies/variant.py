@@ -95,9 +95,10 @@ def build_model(plan: Plan, params: dict):
     return model_from_dict(data, source=plan.source)
 
 
-def run_analysis(model, analysis: dict):
+def run_analysis(model, analysis: dict, monitor: bool = True):
     """The Result of the study's analysis on `model` (analysis: type, end_time [s], output_step [s],
-    and for dynamics method, rtol, atol, max_step)."""
+    and for dynamics method, rtol, atol, max_step).  monitor=False skips simulate's run monitors (their
+    warnings are silenced in a study and no output expression reads Result.diagnostics)."""
     import mbdsim as mb
     kind = analysis.get("type", "dynamics")
     if kind == "statics":
@@ -108,7 +109,12 @@ def run_analysis(model, analysis: dict):
     if kind == "quasi_static":
         return mb.quasi_static(model, end, step)
     opts = {k: analysis[k] for k in ("method", "rtol", "atol", "max_step") if analysis.get(k) is not None}
-    return mb.simulate(model, end, step, **opts)
+    return mb.simulate(model, end, step, monitor=monitor, **opts)
+
+
+def needs_diagnostics(plan: Plan) -> bool:
+    """Whether the runs need simulate's monitors: only a callable output can read Result.diagnostics."""
+    return any(callable(spec) for spec in plan.outputs.values())
 
 
 def run_variant(plan: Plan, params: dict) -> dict:
@@ -119,7 +125,7 @@ def run_variant(plan: Plan, params: dict) -> dict:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")      # assembly notes and redundancy reports, once per variant
-            res = run_analysis(build_model(plan, params), plan.analysis)
+            res = run_analysis(build_model(plan, params), plan.analysis, needs_diagnostics(plan))
             if getattr(res, "success", True):
                 row.update(evaluate_outputs(plan.outputs, res))
                 status, message = "ok", "ok"

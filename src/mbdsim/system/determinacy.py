@@ -19,6 +19,7 @@ from __future__ import annotations
 import numpy as np
 
 from .equations import jacobians
+from .frames import body_frames
 from .reactions import joint_reaction
 
 REL_TOL = 1e-8
@@ -70,11 +71,10 @@ def indeterminate_components(sys, q, joint, on=None, express=None) -> np.ndarray
     if d == 0:
         return out
     scale = np.max(np.abs(J), axis=(1, 2)) + 1e-300            # a unit multiplier's load, per sample
-    for k in range(sys.nc):                                    # one null direction at a time, all samples
+    A = body_frames(sys, q).A                                  # the geometry once for every direction
+    for k in np.flatnonzero(np.any(Nl != 0, axis=(0, 1))):    # one null direction at a time, all samples
         lam = Nl[:, :, k]
-        if not np.any(lam):
-            continue
-        F, T = joint_reaction(sys, q, lam, joint, on)
+        F, T = joint_reaction(sys, q, lam, joint, on, A=A, J=J)
         if express is not None:
             F, T = express(F), express(T)
         comp = np.abs(np.concatenate([F, T], axis=1))
