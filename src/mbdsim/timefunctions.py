@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
-from scipy.integrate import quad
 
 __all__ = ["TimeFunction", "time_function", "integrated", "double_integrated"]
 
@@ -203,6 +202,7 @@ class _Cumulative:
 
     def _quad(self, a, b):
         size = max(1e-300, *(abs(self._integrand(s)) for s in np.linspace(a, b, 5))) * abs(b - a)
+        from scipy.integrate import quad   # imported here: scipy.integrate costs ~0.3 s at start-up
         return quad(self._integrand, a, b, epsabs=1e-13 * size, epsrel=1e-13, limit=200)[0]
 
     def _anchor(self, k):

@@ -8,7 +8,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 
 def skew(a: np.ndarray) -> np.ndarray:
@@ -93,7 +92,7 @@ def as_matrix(orientation) -> np.ndarray:
     """Accept None, a 3x3 matrix or a scipy Rotation; return a proper orthonormal 3x3 matrix."""
     if orientation is None:
         return np.eye(3)
-    if isinstance(orientation, Rotation):
+    if type(orientation).__module__.startswith("scipy.spatial"):   # a scipy Rotation (not imported here)
         return orientation.as_matrix()
     A = np.asarray(orientation, dtype=float)
     if A.shape != (3, 3):

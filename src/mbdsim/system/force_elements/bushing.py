@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from ...model.element_specs import Bushing
 from ..frames import point_state
@@ -28,6 +27,7 @@ def bushing_state(sys, fr, elem):
     to_i = lambda vec: np.einsum("nji,nj->ni", Ai, vec)  # noqa: E731
     x = to_i(d)
     xd = to_i(v_j - v_i - cross(w_i, d))
+    from scipy.spatial.transform import Rotation
     a = Rotation.from_matrix(np.einsum("nji,njk->nik", Ai, Aj)).as_rotvec().reshape(-1, 3)
     w = to_i(w_j - w_i)
     return x, xd, a, w, Ai, p_i, p_j
