@@ -119,8 +119,10 @@ def test_random_mechanisms(case):
     if conservative and "HHT" not in res.stats.get("method", ""):
         E = res.kinetic_energy() + res.potential_energy()
         scale = max(np.max(res.kinetic_energy()), np.ptp(res.potential_energy()), 1e-9)
-        # the global error of a run at rtol stays within a few hundred rtol of the energy scale here
-        assert np.max(np.abs(E - E[0])) <= 1e3 * RTOL * scale + 1e-12, res.stats.get("method")
+        # the global error of a run at rtol stays within a few hundred rtol of the energy scale here; a
+        # nearly static model drifts by round-off of its absolute energy (V measured from the origin)
+        roundoff = 1e3 * np.finfo(float).eps * np.max(np.abs(E))
+        assert np.max(np.abs(E - E[0])) <= 1e3 * RTOL * scale + 1e-12 + roundoff, res.stats.get("method")
         STATS["mechanisms"]["energy checked"] += 1
 
 
