@@ -44,6 +44,7 @@ def spring_chain():
 def test_python_initial_step_is_the_kernels_bit_for_bit(make, tol):
     from mbdsim.solvers import fastdop
     from mbdsim.solvers.assembly import assemble_state
+    from mbdsim.solvers import compiled_run
     from mbdsim.solvers.compiled_run import CompiledRun
     from mbdsim.system.assemble import assemble_system
     sys_ = assemble_system(make())
@@ -60,7 +61,7 @@ def test_python_initial_step_is_the_kernels_bit_for_bit(make, tol):
             n = len(yk)
             h_kernel = fastdop.initial_step(a, w, 0.0, yk, f, run.rtol, run.atol, run.max_step,
                                             np.zeros(n), np.zeros(n), np.zeros(n))
-            h_python = stream.initial_step(a, w, 0.0, yk, f, run.rtol, run.atol, run.max_step)
+            h_python = compiled_run.initial_step(a, w, 0.0, yk, f, run.rtol, run.atol, run.max_step)
             assert h_python == h_kernel and h_python > 0, (make.__name__, tol, max_step, trial)
 
 

@@ -8,6 +8,8 @@ per-step storage).
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ..errors import AnalysisInterrupted, MbdsimError, SolverError
@@ -60,8 +62,7 @@ class CompiledRun:
             iout = 1
         st = np.array([t0, 0.0])
         if status == 0:
-            st[1] = fastdop.initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step, np.zeros(n),
-                                         np.zeros(n), np.zeros(n))
+            st[1] = initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step)
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         keep = checkpoints and n * 8 * 64 <= CHECKPOINT_BUDGET
         SY, ST, ns = np.zeros((64 if keep else 0, n)), np.zeros((64 if keep else 0, 2)), np.zeros(1, np.int64)
@@ -301,3 +302,32 @@ def jacobians_of(sys, lambda_):
     `_full_multipliers` call returned (the object itself, not equal values), else None."""
     kept = sys.derived.get("jacobians of multipliers")
     return kept[1] if kept is not None and kept[0] is lambda_ else None
+
+
+def _rms(x, scale) -> float:
+    s = 0.0
+    for xi, si in zip(x.tolist(), scale):
+        r = xi / si
+        s += r * r   # numba's x ** 2 (integer literal) is x * x
+    return math.sqrt(s / len(scale))
+
+
+def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
+    """`fastdop.initial_step` (Hairer's starting step [s]) in Python around the already loaded `fastdop.rhs`:
+    the same IEEE operations in the same order, so the same bits (tests/test_stream_memory.py compares
+    them), without loading that kernel's ~11 MB of machine code for one call per run. a, w: the compiled
+    model's and work arrays; y0, f0: state and its derivative at t0."""
+    scale = [atol + abs(v) * rtol for v in y0.tolist()]
+    d0, d1 = _rms(y0, scale), _rms(f0, scale)
+    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
+    h0 = min(h0, max_step)
+    y1 = y0 + h0 * f0
+    work = np.zeros(len(y0))
+    if fastdop.rhs(a, w, t0 + h0, y1, work) != fastdop.OK:
+        return h0
+    d2 = _rms(work - f0, scale) / h0
+    if d1 <= 1e-15 and d2 <= 1e-15:
+        h1 = max(1e-6, h0 * 1e-3)
+    else:
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+    return min(100.0 * h0, h1, max_step)

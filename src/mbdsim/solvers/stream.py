@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import math
 import os
 import time
 from pathlib import Path
@@ -153,42 +152,12 @@ def last_row(cols: dict) -> dict:
 
 
 # ----------------------------------------------------------------------------- compiled streaming
-def _rms(x, scale) -> float:
-    s = 0.0
-    for xi, si in zip(x.tolist(), scale):
-        r = xi / si
-        s += r * r   # numba's x ** 2 (integer literal) is x * x
-    return math.sqrt(s / len(scale))
-
-
-def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
-    """`fastdop.initial_step` (Hairer's starting step [s]) in Python around the already loaded `fastdop.rhs`:
-    the same IEEE operations in the same order, so the same bits (tests/test_stream_memory.py compares
-    them), without loading that kernel's ~11 MB of machine code for one call per run. a, w: the compiled
-    model's and work arrays; y0, f0: state and its derivative at t0."""
-    from . import fastdop
-    scale = [atol + abs(v) * rtol for v in y0.tolist()]
-    d0, d1 = _rms(y0, scale), _rms(f0, scale)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, max_step)
-    y1 = y0 + h0 * f0
-    work = np.zeros(len(y0))
-    if fastdop.rhs(a, w, t0 + h0, y1, work) != fastdop.OK:
-        return h0
-    d2 = _rms(work - f0, scale) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1, max_step)
-
-
 def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
     from . import fastdop
-    from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers
+    from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import INTERRUPTED
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v))
     path = prepare(out, resume)
