@@ -75,3 +75,15 @@ def test_assembly_kept_only_without_python_callables():
     second = float(np.ravel(_run(m2).joint_coordinate("j1"))[0])
     assert assemble_system(m2).derived["calls_python"] is True
     assert abs(first) < 1e-9 and abs(second - 0.2) < 1e-9
+
+
+def test_fingerprint_is_deterministic_and_sees_deep_changes():
+    """The same content gives the same digest whatever else was allocated in between; a change deep in
+    an entity (a marker of a body) gives another."""
+    m = _double_pendulum()
+    first = model_fingerprint(m)
+    junk = [dict(a=k) for k in range(1000)]   # allocations between two walks
+    assert model_fingerprint(m) == first and model_fingerprint(_double_pendulum()) == first
+    del junk
+    m.bodies["b"].add_marker("tip", point=(2.0, 0.0, 0.0))
+    assert model_fingerprint(m) != first

@@ -422,27 +422,10 @@ class Result:
         return self._extremum(signal, -1)
 
     def _extremum(self, signal, sign):
-        y = sign * np.asarray(signal(self), dtype=float)
-        # the first sample at the maximum up to rounding (a plateau - a joint stopped by friction - counts from
-        # its start, not from wherever the last bit of noise happens to peak)
-        tol = 1e-12 * np.max(np.abs(y))
-        k = int(np.argmax(y >= np.max(y) - tol))
-        if k in (0, len(y) - 1) or self._evaluate is None:
-            return float(self.time[k]), float(sign * y[k])
-        import scipy.optimize as so
-        f = lambda t: -sign * float(np.asarray(signal(self.at(t)))[0])  # noqa: E731
-        flat = False
-        try:
-            r = so.minimize_scalar(f, bracket=(self.time[k - 1], self.time[k], self.time[k + 1]),
-                                   method="brent", tol=1e-12)
-        except ValueError:   # flat top (a neighbour sample equals the maximum): bounded search instead
-            r = so.minimize_scalar(f, bounds=(self.time[k - 1], self.time[k + 1]), method="bounded",
-                                   options={"xatol": 1e-12})
-            flat = True
-        t = float(r.x) if self.time[k - 1] <= r.x <= self.time[k + 1] else float(self.time[k])
-        val = float(np.asarray(signal(self.at(t)))[0])
-        better = sign * val > y[k] + tol if flat else sign * val >= y[k]   # a plateau keeps its first sample
-        return (t, val) if better else (float(self.time[k]), float(sign * y[k]))
+        # the first sample at the extreme value up to rounding (a plateau - a joint stopped by friction -
+        # counts from its start), refined on the dense output a grid of times per call (results.refine)
+        from .refine import extremum
+        return extremum(self, signal, sign)
 
     # ------------------------------------------------------------ export
     def to_dataframe(self, markers: bool = False, euler: str | None = None) -> pd.DataFrame:

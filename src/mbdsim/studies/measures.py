@@ -12,7 +12,7 @@ Signals (arrays over the output times; SI units, ground axes unless a frame is g
     potential_energy()      (keywords as in Result: frame=, on=, relative_to=, kind=)
 Element-wise: x(v), y(v), z(v) (components of an (N, 3) signal), norm(v), abs, sqrt, sin, cos, degrees.
 Reductions to a scalar: max, min, peak (max |s|), time_of_max, time_of_min (refined on the dense output,
-mbdsim.studies.refine: the conventions of Result.maximum/minimum, a grid of times per evaluation), mean,
+mbdsim.results.refine: the conventions of Result.maximum/minimum, a grid of times per evaluation), mean,
 rms, std, initial, final, integral (trapezoid over time), crossing(s, value, direction=0) (time of the
 first crossing, refined like Result.crossings; NaN when none).
 Example: "max(norm(reaction_force('crank_rod')))", "peak(x(acceleration('slider')))".
@@ -32,7 +32,7 @@ from functools import lru_cache
 import numpy as np
 
 from ..errors import ModelError
-from . import refine
+from ..results import refine
 
 __all__ = ["compile_output", "evaluate_outputs", "fill_template", "OutputError"]
 

@@ -27,6 +27,7 @@ def fingerprint(model) -> tuple[bytes, bool]:
     h = hashlib.blake2b(digest_size=20)
     callables = False
     seen: dict[int, int] = {}
+    alive = []            # every object seen stays referenced, so no id is reused during the walk
     stack = [model]
     while stack:
         obj = stack.pop()
@@ -39,6 +40,7 @@ def fingerprint(model) -> tuple[bytes, bool]:
             h.update(b"@%d" % seen[k])
             continue
         seen[k] = len(seen)
+        alive.append(obj)
         if isinstance(obj, np.ndarray):
             h.update(b"A" + str(obj.dtype).encode() + str(obj.shape).encode())
             h.update(obj.tobytes() if obj.dtype != object else repr(obj.tolist()).encode())

@@ -1,10 +1,10 @@
 """Extrema and level crossings of a Result's signal refined on the dense output, a grid of times per call.
 
-`Result.maximum` and `Result.crossings` refine with scalar searches (Brent), one `Result.at` per probe:
-about 25 dense-output evaluations per measure, each paying the Python cost of a Result.  A study measures
-thousands of runs, so here each level evaluates GRID times in ONE `res.at(times)` call (the dense output
-of a step is redone once for all the times inside it), and a local polynomial through the grid values
-locates the extremum or the root far below the grid spacing:
+A scalar search (Brent) takes one `Result.at` per probe: about 25 dense-output evaluations per measure,
+each paying the Python cost of a Result.  Here each level evaluates GRID times in ONE `res.at(times)`
+call (the dense output of a step is redone once for all the times inside it), and a local polynomial
+through the grid values locates the extremum or the root far below the grid spacing.  Result.maximum /
+Result.minimum and the studies' measures use `extremum`; the studies' crossing measures `first_crossing`:
 
 - extremum: the vertex of the quartic through the best sample k and its two neighbours on each side (a
   parabola at the ends) centres the first grid, +-REFINE_HALF of a sample step wide (the whole bracket
@@ -19,8 +19,8 @@ locates the extremum or the root far below the grid spacing:
   successive estimates within the grid spacing end the search (one call when the signal is smooth).
 
 The best value ever evaluated wins, so a refinement is never worse than the samples; the conventions at
-plateaus, ends and exact hits are those of Result.maximum / Result.crossings, and the values agree with
-theirs to their tolerances (tests/test_study.py).
+plateaus, ends and exact hits are those of Result.crossings, and the values agree with a Brent search on
+the dense output to its tolerance (tests/test_study.py).
 """
 from __future__ import annotations
 
