@@ -4,10 +4,11 @@ by their bytes, containers element by element), functions and other opaque objec
 
 `assemble_system` keeps the last System of a Model with its fingerprint; any change made since (an
 added entity, `body.mass = 2.0`, an array edited in place) gives another fingerprint and a new
-assembly.  The walk costs about a microsecond per field."""
+assembly.  The walk costs one to two microseconds per field (0.7 ms for a chain of 8 bodies)."""
 from __future__ import annotations
 
 import hashlib
+import struct
 import types
 
 import numpy as np
@@ -24,44 +25,66 @@ def model_fingerprint(model) -> bytes:
 def fingerprint(model) -> tuple[bytes, bool]:
     """(digest, whether a Python callable is reachable: what it returns may change while it stays the
     same object, so results computed by calling it are not cached)."""
-    h = hashlib.blake2b(digest_size=20)
-    callables = False
+    parts: list = []
+    add = parts.append
     seen: dict[int, int] = {}
     alive = []            # every object seen stays referenced, so no id is reused during the walk
+    callables = False
+    model_attrs = getattr(model, "__dict__", None)
     stack = [model]
+    pop, push, extend = stack.pop, stack.append, stack.extend
     while stack:
-        obj = stack.pop()
+        obj = pop()
+        t = type(obj)
+        if t is float:
+            add(b"f" + _DOUBLE(obj))
+            continue
+        if t is str:
+            b = obj.encode("utf-8", "surrogatepass")
+            add(b"s%d:" % len(b) + b)
+            continue
+        if t is int or t is bool:
+            add(b"i%d" % obj if t is int else (b"T" if obj else b"F"))
+            continue
+        if obj is None:
+            add(b"N")
+            continue
         if isinstance(obj, _SCALARS):
-            h.update(type(obj).__name__.encode())
-            h.update(repr(obj).encode())
+            add(b"g" + type(obj).__name__.encode() + repr(obj).encode())
             continue
         k = id(obj)
         if k in seen:                       # shared or cyclic reference: its position in the walk
-            h.update(b"@%d" % seen[k])
+            add(b"@%d" % seen[k])
             continue
         seen[k] = len(seen)
         alive.append(obj)
-        if isinstance(obj, np.ndarray):
-            h.update(b"A" + str(obj.dtype).encode() + str(obj.shape).encode())
-            h.update(obj.tobytes() if obj.dtype != object else repr(obj.tolist()).encode())
-        elif isinstance(obj, dict):
-            h.update(b"D%d" % len(obj))
-            for key, val in obj.items():
-                stack.append(val)
-                stack.append(key)
-        elif isinstance(obj, (list, tuple, set, frozenset)):
-            items = sorted(obj, key=repr) if isinstance(obj, (set, frozenset)) else obj
-            h.update(b"L%d" % len(items))
-            stack.extend(reversed(list(items)))
+        if t is np.ndarray:
+            add(b"A" + str(obj.dtype).encode() + str(obj.shape).encode())
+            add(obj.tobytes() if obj.dtype != object else repr(obj.tolist()).encode())
+        elif t is dict or isinstance(obj, dict):
+            items = [kv for kv in obj.items() if kv[0] != "_assembled"] if obj is model_attrs else obj.items()
+            add(b"D%d" % len(items))      # (the model's own cache is not part of it)
+            for key, val in items:
+                push(val)
+                push(key)
+        elif t is list or t is tuple or isinstance(obj, (list, tuple)):
+            add(b"L%d" % len(obj))
+            extend(reversed(obj))
+        elif isinstance(obj, (set, frozenset)):
+            items = sorted(obj, key=repr)
+            add(b"S%d" % len(items))
+            extend(reversed(items))
         elif isinstance(obj, _OPAQUE) or not hasattr(obj, "__dict__") and not hasattr(obj, "__slots__"):
-            h.update(b"O%d" % k)            # by identity: the same callable (what it computes is run time)
+            add(b"O%d" % k)                 # by identity: the same callable (what it computes is run time)
             callables = callables or callable(obj) and not isinstance(obj, type)
         else:
-            h.update(type(obj).__qualname__.encode())
-            fields = dict(vars(obj)) if hasattr(obj, "__dict__") else {}
-            for name in getattr(type(obj), "__slots__", ()):
-                if hasattr(obj, name):
-                    fields[name] = getattr(obj, name)
-            fields.pop("_assembled", None)  # the cache itself
-            stack.append(fields)
-    return h.digest(), callables
+            add(b"C" + t.__qualname__.encode())
+            slots = getattr(t, "__slots__", ())
+            if slots:
+                push([getattr(obj, n, None) for n in slots])
+            if hasattr(obj, "__dict__"):
+                push(obj.__dict__)
+    return hashlib.blake2b(b"".join(parts), digest_size=20).digest(), callables
+
+
+_DOUBLE = struct.Struct("<d").pack
