@@ -17,15 +17,7 @@ import pytest
 import mbdsim as mb
 from mbdsim.results import stream as results_stream
 from mbdsim.solvers import stream
-
-
-def double_pendulum():
-    m = mb.Model("dp", gravity=(0.0, -9.81, 0.0))
-    a = m.add_body("a", 1.0, inertia=(0.01, 0.01, 0.01), position=(0.5, 0.0, 0.0))
-    b = m.add_body("b", 1.0, inertia=(0.01, 0.01, 0.01), position=(1.5, 0.0, 0.0))
-    m.add_revolute("j1", m.ground, a, (0, 0, 0), (0, 0, 1))
-    m.add_revolute("j2", a, b, (1.0, 0, 0), (0, 0, 1))
-    return m
+from test_stream_resume import double_pendulum
 
 
 def spring_chain():

@@ -90,17 +90,22 @@ def _packed(sys):
 
 
 def _terms_compiled(sys, q, v, t, jacobian):
-    packed = _packed(sys)
-    kind, bi, bj, v1, v2, v3, drv, fns = packed
-    fr = body_frames(sys, q, v)
+    phi_, J, nu, gamma = _kernel_terms(sys, body_frames(sys, q, v), t)
+    return phi_, (J if jacobian else None), nu, gamma
+
+
+def _kernel_terms(sys, fr, t, v1=None):
+    """phi, phi_q, nu, gamma of the packed rows from the compiled kernel at frames fr and time t [s]; v1:
+    the packed first vectors when the caller rewrote some (curve points), else the packed ones."""
+    kind, bi, bj, p1, v2, v3, drv, fns = _packed(sys)
     f = np.array([fn.value(t) for fn in fns], dtype=float)
     fd = np.array([fn.d1(t) for fn in fns], dtype=float)
     fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
     phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
     J = np.zeros((sys.nc, sys.nv))
-    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, v1, v2, v3, drv, f, fd, fdd,
-                              sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
-    return phi_, (J if jacobian else None), nu, gamma
+    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, p1 if v1 is None else v1, v2, v3, drv,
+                              f, fd, fdd, sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
+    return phi_, J, nu, gamma
 
 
 def _mixed_plan(sys):
@@ -116,7 +121,7 @@ def _mixed_plan(sys):
 def _terms_mixed(sys, q, v, t, jacobian):
     """constraint_terms of a system with rows the kernel does not evaluate (see there)."""
     from .constraints.path import curve_extra_quad, curve_locals
-    kind, bi, bj, v1, v2, v3, drv, fns = _packed(sys)
+    v1 = _packed(sys)[3]
     curve_groups, rest = _mixed_plan(sys)
     q, v = np.asarray(q), np.asarray(v)
     fr = body_frames(sys, q, v)
@@ -127,13 +132,7 @@ def _terms_mixed(sys, q, v, t, jacobian):
         v1 = v1.copy()
         for g, idx, (_, _, c, _, _) in curves:
             v1[idx] = np.repeat(c, 3, axis=0)
-    f = np.array([fn.value(t) for fn in fns], dtype=float)
-    fd = np.array([fn.d1(t) for fn in fns], dtype=float)
-    fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
-    phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
-    J = np.zeros((sys.nc, sys.nv))
-    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, v1, v2, v3, drv, f, fd, fdd,
-                              sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
+    phi_, J, nu, gamma = _kernel_terms(sys, fr, t, v1)
     for g, idx, (aux, sd, _, t1, t2) in curves:
         gamma[idx] += curve_extra_quad(fr, g, sd, t1, t2)
         J[idx, np.repeat(sys.aux_v_idx[aux], 3)] -= t1.reshape(-1)
