@@ -290,7 +290,7 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
         out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
     if J.nbytes <= JACOBIAN_KEEP:   # the reactions read from these multipliers reuse their Jacobians
-        sys.derived["jacobians of multipliers"] = (out, J)
+        sys.run_state["jacobians of multipliers"] = (out, J)   # this run's samples: run state
     return out
 
 
@@ -300,7 +300,7 @@ JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed 
 def jacobians_of(sys, lambda_):
     """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array the last
     `_full_multipliers` call returned (the object itself, not equal values), else None."""
-    kept = sys.derived.get("jacobians of multipliers")
+    kept = sys.run_state.get("jacobians of multipliers")
     return kept[1] if kept is not None and kept[0] is lambda_ else None
 
 

@@ -77,11 +77,13 @@ class System:
     # issue 11: why the compiled core cannot run this system (rows of numpy-only kinds: screw, constant-
     # velocity, couplers, user constraints; sensors); empty when it can.  compile_system checks it.
     not_compiled: list = field(default_factory=list)
-    # Caches of functions of this System alone (packed constraint rows, friction base rows): computed on
-    # first use, never changed after.  Not run state.
+    # Caches of functions of this System alone (packed constraint rows, friction base rows, the compiled
+    # model, the assembled initial state): computed on first use, never changed after, shared by the
+    # copies assemble_system hands out for an unchanged Model.  Not run state.
     derived: dict = field(default_factory=dict)
-    # Per-analysis mutable state (force-element memory, joint-angle anchors of load callables): every
-    # analysis assembles its own System, so it starts empty; nothing else may be added at run time.
+    # Per-analysis mutable state (force-element memory, joint-angle anchors of load callables, the
+    # multipliers' Jacobians): every analysis gets its own System copy with it empty; nothing else may
+    # be added at run time.
     run_state: dict = field(default_factory=dict)
 
     @property
