@@ -87,3 +87,22 @@ def test_fingerprint_is_deterministic_and_sees_deep_changes():
     del junk
     m.bodies["b"].add_marker("tip", point=(2.0, 0.0, 0.0))
     assert model_fingerprint(m) != first
+
+
+def test_energies_from_the_state_equal_the_frame_forms():
+    """Kinetic and gravity energies straight from (q, v) against the forms through the body frames, on a
+    model with rigid bodies and a particle, in motion at random states."""
+    from mbdsim.system import measures as ms
+    from mbdsim.system.frames import body_frames
+    m = _double_pendulum()
+    m.add_particle("p", 0.7, position=(0.3, -0.4, 0.2), velocity=(0.1, 0.2, -0.3))
+    sys = assemble_system(m)
+    rng = np.random.default_rng(11)
+    q = np.tile(sys.q0, (4, 1)) + 0.1 * rng.standard_normal((4, sys.nq))
+    for p in sys.p_idx:
+        q[:, p] /= np.linalg.norm(q[:, p], axis=1, keepdims=True)
+    v = rng.standard_normal((4, sys.nv))
+    fr = body_frames(sys, q, v)
+    assert np.allclose(ms.kinetic_energy_v(sys, v), ms.kinetic_energy(sys, fr), rtol=1e-13, atol=0)
+    assert np.allclose(ms.gravity_potential_q(sys, q), ms.gravity_potential(sys, fr), rtol=1e-13, atol=1e-15)
+    assert np.all(ms.kinetic_energy_v(sys, v) > 0)

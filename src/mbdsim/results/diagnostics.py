@@ -104,9 +104,8 @@ def _energy_terms(res):
             return None, f"energy balance not checked: element '{e.name}' has no energy bookkeeping"
         if getattr(ev, "needs_lambda", False):
             return None, f"energy balance not checked: friction '{e.name}' needs the multipliers"
-    fr = res.frames
     T, V = res.kinetic_energy(), res.potential_energy()
-    P_d = dissipation_power(sys, fr, res.time) if any(
+    P_d = dissipation_power(sys, res.frames, res.time) if any(
         hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None
     P_w = None
     if applied:

@@ -124,6 +124,24 @@ def kinetic_energy(sys, fr) -> np.ndarray:
     return T
 
 
+def kinetic_energy_v(sys, v) -> np.ndarray:
+    """Total kinetic energy (N,) [J] straight from the velocity variables v (N, nv): CM velocities [m/s,
+    ground axes] and body-axes angular velocities [rad/s] (no rotation matrices needed)."""
+    v = np.atleast_2d(np.asarray(v, dtype=float))
+    rd = v[:, sys.rd_idx]
+    T = 0.5 * np.einsum("b,nbi,nbi->n", sys.mass[1:], rd, rd)
+    if len(sys.rigid_fid):
+        w_B = v[:, sys.w_idx]
+        T += 0.5 * np.einsum("nri,rij,nrj->n", w_B, sys.inertia_B[sys.rigid_fid], w_B)
+    return T
+
+
+def gravity_potential_q(sys, q) -> np.ndarray:
+    """Gravity potential energy (N,) [J] from the coordinates q (N, nq), zero at the ground origin."""
+    r = np.atleast_2d(np.asarray(q, dtype=float))[:, sys.r_idx]
+    return -np.einsum("b,nbi,i->n", sys.mass[1:], r, np.asarray(sys.model.gravity, dtype=float))
+
+
 def gravity_potential(sys, fr) -> np.ndarray:
     """Gravity potential energy (N,) [J], zero at the ground origin."""
     return -np.einsum("f,nfi,i->n", sys.mass, fr.r, sys.model.gravity)
