@@ -106,3 +106,18 @@ def test_energies_from_the_state_equal_the_frame_forms():
     assert np.allclose(ms.kinetic_energy_v(sys, v), ms.kinetic_energy(sys, fr), rtol=1e-13, atol=0)
     assert np.allclose(ms.gravity_potential_q(sys, q), ms.gravity_potential(sys, fr), rtol=1e-13, atol=1e-15)
     assert np.all(ms.kinetic_energy_v(sys, v) > 0)
+
+
+def test_user_callable_objects_are_flagged_expression_functions_are_not():
+    class Ramp:
+        def __init__(self, rate):
+            self.rate = rate
+
+        def __call__(self, t):
+            return self.rate * t
+    m = _double_pendulum()
+    m.add_motion("drive", "j1", displacement="0.3*t")
+    assert assemble_system(m).derived["calls_python"] is False
+    m2 = _double_pendulum()
+    m2.add_motion("drive", "j1", displacement=Ramp(0.3))
+    assert assemble_system(m2).derived["calls_python"] is True

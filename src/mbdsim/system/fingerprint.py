@@ -79,6 +79,9 @@ def fingerprint(model) -> tuple[bytes, bool]:
             callables = callables or callable(obj) and not isinstance(obj, type)
         else:
             add(b"C" + t.__qualname__.encode())
+            # a user's callable object (mbdsim's own, e.g. expression time functions, are walked by value
+            # and hold any user function they wrap, which is flagged there)
+            callables = callables or (callable(obj) and not t.__module__.startswith("mbdsim."))
             slots = getattr(t, "__slots__", ())
             if slots:
                 push([getattr(obj, n, None) for n in slots])
