@@ -10,6 +10,7 @@ import os
 import signal
 import warnings
 from collections import Counter
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -39,6 +40,18 @@ class Hang(BaseException):
 
 def _alarm(*_):
     raise Hang()
+
+
+@contextmanager
+def _deadline():
+    """Raise Hang inside the block once it runs past HANG_S (SIGALRM; the previous handler restored)."""
+    old = signal.signal(signal.SIGALRM, _alarm)
+    signal.alarm(HANG_S)
+    try:
+        yield
+    finally:
+        signal.alarm(0)
+        signal.signal(signal.SIGALRM, old)
 
 
 def _settings(n):
@@ -96,10 +109,8 @@ def mechanisms(draw):
 @_settings(N_MECH)
 def test_random_mechanisms(case):
     model, conservative = case
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(HANG_S)
     try:
-        with warnings.catch_warnings():
+        with _deadline(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             res = mb.simulate(model, 0.3, 0.01, rtol=RTOL)
     except Hang:
@@ -108,9 +119,6 @@ def test_random_mechanisms(case):
     except MbdsimError as exc:
         STATS["mechanisms"][f"refused: {type(exc).__name__}"] += 1
         return
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
     if not res.success:
         assert isinstance(res.error, MbdsimError) and res.message
         STATS["mechanisms"][f"failed run: {type(res.error).__name__}"] += 1
@@ -170,10 +178,8 @@ def mutated_files(draw):
 @_settings(N_FILES)
 def test_mutated_model_files(case):
     name, data = case
-    old = signal.signal(signal.SIGALRM, _alarm)
-    signal.alarm(HANG_S)
     try:
-        with warnings.catch_warnings():
+        with _deadline(), warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
                 model = model_from_dict(data, source=name)
@@ -189,9 +195,6 @@ def test_mutated_model_files(case):
         STATS["files"]["loaded and ran" if res.success else "loaded, run failed (named)"] += 1
     except Hang:
         pytest.fail(f"a mutated {name} ran past {HANG_S} s")
-    finally:
-        signal.alarm(0)
-        signal.signal(signal.SIGALRM, old)
 
 
 def test_print_fuzz_statistics():

@@ -114,14 +114,9 @@ class ForceElementsMixin:
             raise ModelError(entity, "joint", f"body_j of {jt.name!r} is a particle: it has no rotation")
 
     def _stop_dof(self, entity, jt, dof):
-        from .joint_kinds import axis_dofs
-        allowed = {jt.kind: axis_dofs(jt.kind, loads=True)}   # the first is the default dof
-        if not allowed[jt.kind]:
-            raise ModelError(entity, "joint", f"needs a translational, revolute or cylindrical joint, "
-                             f"{jt.name!r} is {jt.kind}")
-        dof = allowed[jt.kind][0] if dof is None else dof
-        if dof not in allowed[jt.kind]:
-            raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {jt.kind} joint {jt.name!r}")
+        from .joint_kinds import pick_axis_dof
+        dof = pick_axis_dof(entity, jt, dof, True, f"needs a translational, revolute or cylindrical joint, "
+                            f"{jt.name!r} is {jt.kind}")
         if dof == "rotation":
             self._rotational_joint(entity, jt, "rotational stop")
         return dof

@@ -76,6 +76,22 @@ def axis_dofs(kind: str, loads: bool = False) -> tuple:
     return k.axis_dofs
 
 
+def pick_axis_dof(entity: str, joint, dof, loads: bool, no_axis: str) -> str:
+    """The axis freedom of `joint` that `entity` acts on: `dof` ("rotation"/"translation") or, when None,
+    the kind's first; ModelError(entity, "joint", no_axis) when the kind has none for a motion or coupler
+    (loads=False) or a load (loads=True), ModelError(entity, "dof") when `dof` is not one of them."""
+    from ..errors import ModelError
+    allowed = axis_dofs(joint.kind, loads)
+    if not allowed:
+        raise ModelError(entity, "joint", no_axis)
+    if dof is None:
+        return allowed[0]
+    if dof not in allowed:
+        raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {joint.kind} joint {joint.name!r} "
+                         f"(choose from {allowed})")
+    return dof
+
+
 def kinds_with_axis(loads: bool = False) -> tuple:
     """Names of the kinds that have axis freedoms (for error messages)."""
     return tuple(n for n in JOINT_KINDS if axis_dofs(n, loads))

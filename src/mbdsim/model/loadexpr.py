@@ -242,16 +242,9 @@ class ExprLoadsMixin:
         self._claim(name, "joint force")
         try:
             jt = self._lookup(joint, self.joints, entity, "joint")
-            from .joint_kinds import axis_dofs, kinds_with_axis
-            allowed = {jt.kind: axis_dofs(jt.kind, loads=True)}
-            if not allowed[jt.kind]:
-                raise ModelError(entity, "joint", f"a {jt.kind} joint has no single axis; use a "
-                                 f"{', '.join(kinds_with_axis(loads=True))} joint")
-            if dof is None:
-                dof = allowed[jt.kind][0]
-            if dof not in allowed[jt.kind]:
-                raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {jt.kind} joint {jt.name!r} "
-                                 f"(choose from {allowed[jt.kind]})")
+            from .joint_kinds import kinds_with_axis, pick_axis_dof
+            dof = pick_axis_dof(entity, jt, dof, True, f"a {jt.kind} joint has no single axis; use a "
+                                f"{', '.join(kinds_with_axis(loads=True))} joint")
             if jt.body_j.is_particle and dof == "rotation":
                 raise ModelError(entity, "joint", f"body_j of joint {jt.name!r} is a particle: no torque")
             val = load_value(self, entity, "value", value)

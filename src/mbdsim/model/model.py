@@ -376,16 +376,9 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
 
     @staticmethod
     def _motion_dof(entity, joint, dof):
-        from .joint_kinds import axis_dofs, kinds_with_axis
-        allowed = {joint.kind: axis_dofs(joint.kind)}
-        if not allowed[joint.kind]:
-            raise ModelError(entity, "joint", f"cannot drive a {joint.kind} joint; use "
-                             f"{', '.join(kinds_with_axis())}")
-        if dof is None:
-            return allowed[joint.kind][0]
-        if dof not in allowed[joint.kind]:
-            raise ModelError(entity, "dof", f"{dof!r} is not a coordinate of {joint.kind} joint {joint.name!r}")
-        return dof
+        from .joint_kinds import kinds_with_axis, pick_axis_dof
+        return pick_axis_dof(entity, joint, dof, False,
+                             f"cannot drive a {joint.kind} joint; use {', '.join(kinds_with_axis())}")
 
     def _repr_html_(self) -> str:  # Jupyter summary
         from ..viewer.notebook import model_html; return model_html(self)  # noqa: E702

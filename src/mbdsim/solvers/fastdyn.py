@@ -21,7 +21,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
     @njit(cache=True, _nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
-from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, expr_loads
+from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, _rot, expr_loads
 from ..system.kernels import frames_into, quat_step, rows_kernel
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 from . import fasttree
@@ -54,14 +54,6 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
                         wk[42][1])
     if cm[43][7].shape[0]:
         expr_loads(cm[43], wk[44], t, y, r, A, rd, w, cm[6], F)
-
-
-@njit(cache=True, _nrt=False)
-def _rot(A, f, x0, x1, x2):
-    """A[f] x (body axes -> ground)."""
-    return (A[f, 0, 0] * x0 + A[f, 0, 1] * x1 + A[f, 0, 2] * x2,
-            A[f, 1, 0] * x0 + A[f, 1, 1] * x1 + A[f, 1, 2] * x2,
-            A[f, 2, 0] * x0 + A[f, 2, 1] * x1 + A[f, 2, 2] * x2)
 
 
 @njit(cache=True, _nrt=False)

@@ -24,6 +24,7 @@ from .kernels import _dot1
 
 @njit(cache=True, _nrt=False)
 def _rot(A, f, s0, s1, s2):
+    """A[f] s (body axes -> ground)."""
     return (A[f, 0, 0] * s0 + A[f, 0, 1] * s1 + A[f, 0, 2] * s2,
             A[f, 1, 0] * s0 + A[f, 1, 1] * s1 + A[f, 1, 2] * s2,
             A[f, 2, 0] * s0 + A[f, 2, 1] * s1 + A[f, 2, 2] * s2)
