@@ -362,11 +362,11 @@ class Result:
 
     def kinetic_energy(self) -> Array:
         """Total kinetic energy [J], (N,)."""
-        return ms.kinetic_energy_v(self.system, self.v)
+        return ms.kinetic_energy(self.system, self.v)
 
     def potential_energy(self) -> Array:
         """Gravity plus every elastic element's potential energy [J], (N,)."""
-        V = ms.gravity_potential_q(self.system, self.q)
+        V = ms.gravity_potential(self.system, self.q)
         for el in self.system.model.forces.values():
             ev = evaluator(el)
             if hasattr(ev, "potential"):

@@ -115,16 +115,7 @@ def joint_coordinate(sys, fr, joint, dof=None):
     return ang, angd, sl, sld
 
 
-def kinetic_energy(sys, fr) -> np.ndarray:
-    """Total kinetic energy (N,) [J]."""
-    m = sys.mass
-    T = 0.5 * np.einsum("f,nfi,nfi->n", m, fr.rd, fr.rd)
-    w_B = np.einsum("nfji,nfj->nfi", fr.A, fr.w)
-    T += 0.5 * np.einsum("nfi,fij,nfj->n", w_B, sys.inertia_B, w_B)
-    return T
-
-
-def kinetic_energy_v(sys, v) -> np.ndarray:
+def kinetic_energy(sys, v) -> np.ndarray:
     """Total kinetic energy (N,) [J] straight from the velocity variables v (N, nv): CM velocities [m/s,
     ground axes] and body-axes angular velocities [rad/s] (no rotation matrices needed)."""
     v = np.atleast_2d(np.asarray(v, dtype=float))
@@ -136,15 +127,10 @@ def kinetic_energy_v(sys, v) -> np.ndarray:
     return T
 
 
-def gravity_potential_q(sys, q) -> np.ndarray:
+def gravity_potential(sys, q) -> np.ndarray:
     """Gravity potential energy (N,) [J] from the coordinates q (N, nq), zero at the ground origin."""
     r = np.atleast_2d(np.asarray(q, dtype=float))[:, sys.r_idx]
     return -np.einsum("b,nbi,i->n", sys.mass[1:], r, np.asarray(sys.model.gravity, dtype=float))
-
-
-def gravity_potential(sys, fr) -> np.ndarray:
-    """Gravity potential energy (N,) [J], zero at the ground origin."""
-    return -np.einsum("f,nfi,i->n", sys.mass, fr.r, sys.model.gravity)
 
 
 def relative_rotation_vector(sys, fr, joint):
