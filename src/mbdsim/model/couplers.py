@@ -13,14 +13,13 @@ from typing import Any
 
 from ..errors import ModelError
 from ._check import scalar
+from .joint_kinds import JOINT_KINDS, coupled_dofs
 from .joints import Joint
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from .._types import JointRef
 
-COUPLED_KINDS = {"revolute": ("rotation",), "translational": ("translation",),
-                 "cylindrical": ("rotation", "translation"), "screw": ("rotation",)}
 
 
 @dataclass(eq=False)
@@ -115,9 +114,10 @@ class CouplersMixin:
     # ----------------------------------------------------------------- helpers
     def _coupled(self, entity, field, joint, dof_field, dof, single=False):
         jt = self._lookup(joint, self.joints, entity, field)
-        allowed = COUPLED_KINDS.get(jt.kind)
-        if allowed is None or (single and len(allowed) > 1):
-            kinds = "revolute, translational, screw" + ("" if single else " or cylindrical")
+        allowed = coupled_dofs(jt.kind)
+        if not allowed or (single and len(allowed) > 1):
+            names = [k for k in JOINT_KINDS if coupled_dofs(k) and (not single or len(coupled_dofs(k)) == 1)]
+            kinds = ", ".join(names[:-1]) + " or " + names[-1]
             raise ModelError(entity, field, f"joint {jt.name!r} is {jt.kind}; coordinates of {kinds} joints "
                              "can be coupled")
         dof = allowed[0] if dof is None else dof

@@ -26,7 +26,8 @@ class JointKind:
     beyond +-pi along an analysis; translation_constraints: constraints on the relative translation
     (what a particle as body_j feels); planar_dof: in-plane freedoms left in a planar model (None: it
     depends on the placement); fields: the model-file fields besides name/body_i/body_j, in the order
-    of the Model method `add_<name>`."""
+    of the Model method `add_<name>`; coupled: the axis freedoms a coupler may tie (None: axis_dofs; a
+    screw's slide follows its angle, so only the angle is coupled)."""
 
     name: str
     dof: int
@@ -38,6 +39,7 @@ class JointKind:
     loads: bool = False
     angle: bool = False
     planar_dof: int | None = None
+    coupled: tuple | None = None
 
     @property
     def method(self) -> str:
@@ -62,7 +64,7 @@ JOINT_KINDS: dict[str, JointKind] = {k.name: k for k in (
     JointKind("perpendicular", 5, 0, 0, ("axis_i", "axis_j")),
     JointKind("atpoint", 3, 0, 3, ("point",), planar_dof=1),
     # a screw reports its angle [rad] (slide = lead * angle / 2 pi); motions and couplers drive either
-    JointKind("screw", 1, 1, 2, ("point", "axis", "lead"), "angle [rad]", (ROT, TRA), False, True),
+    JointKind("screw", 1, 1, 2, ("point", "axis", "lead"), "angle [rad]", (ROT, TRA), False, True, coupled=(ROT,)),
     JointKind("constant_velocity", 2, 3, 3, ("point", "axis_i", "axis_j"), _ROTVEC),
 )}
 
@@ -74,6 +76,14 @@ def axis_dofs(kind: str, loads: bool = False) -> tuple:
     if k is None or (loads and not k.loads):
         return ()
     return k.axis_dofs
+
+
+def coupled_dofs(kind: str) -> tuple:
+    """The axis freedoms of `kind` a coupler or gear may tie ("rotation"/"translation"); () when none."""
+    k = JOINT_KINDS.get(kind)
+    if k is None:
+        return ()
+    return k.axis_dofs if k.coupled is None else k.coupled
 
 
 def pick_axis_dof(entity: str, joint, dof, loads: bool, no_axis: str) -> str:

@@ -66,6 +66,22 @@ def project_velocities(sys, q, v, t, rows):
     return v - min_norm_solve(J, J @ v - nu)
 
 
+def consistent_state(sys, y, t, rows, sf):
+    """(q, v, vd, lambda_) at time t [s] from y = [q, v]: q projected onto phi(q, t) = 0, v onto
+    phi_q v = nu (minimum-norm corrections), then the accelerations and multipliers of all rows."""
+    q, v = y[:sys.nq], y[sys.nq:]
+    q, _, _ = project_positions(sys, normalize(sys, q), t, rows)
+    v = project_velocities(sys, q, v, t, rows)
+    vd, lam = accelerations(sys, q, v, t, rows, sf)
+    return q, v, vd, lam
+
+
+def _weak_joints(sys, q, v, t, rows):
+    """Joints whose constraint rows are closest to dependent at (q, t) (failure reports)."""
+    _, J, _, _ = constraint_terms(sys, normalize(sys, q), v, t)
+    return _worst_joints(sys, J, rows)
+
+
 def analysis_error(exc: BaseException, t) -> Exception:
     """The mbdsim error that ends an analysis for exception `exc` caught at about time t [s]: mbdsim errors
     as they are, KeyboardInterrupt as AnalysisInterrupted, anything else (numpy/LAPACK failures, a bug

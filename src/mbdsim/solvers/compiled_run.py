@@ -221,7 +221,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
     if status != 0:
-        from .dynamic import _weak_joints
+        from .common import _weak_joints
         try:
             joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
                                                                    rep.rows)

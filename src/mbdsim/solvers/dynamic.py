@@ -1,4 +1,5 @@
-"""Dynamic analysis: the driver loop (output sampling, dense output, projection, events, Result).
+"""Dynamic analysis: `simulate` (checks, method choice, tolerances) over the compiled DOP853, the
+index-1 scipy methods and HHT (those two through the one driver of mbdsim.solvers.driver).
 
 Index-1 methods ("dop853" - the high-accuracy default for smooth problems -, "rk45", "radau", "bdf"):
 the equations of motion are solved for accelerations at every stage (augmented KKT system), the
@@ -8,26 +9,21 @@ the drift at the Newton tolerance (~1e-12).  "hht" is the implicit HHT-alpha met
 """
 from __future__ import annotations
 
-import bisect
 import os
 
 import numpy as np
 
 from ._threads import blas_single_thread
-from ..errors import ModelError, SolverError
+from ..errors import ModelError
 from ..results.result import Result
-from ..results.stream import notify
 from ..system.assemble import assemble_system
 from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
 from .assembly import assemble_state
 from .compiled_run import Stiff, integrate_compiled
-from .common import _worst_joints, accelerations, analysis_error, normalize, project_positions, project_velocities, qdot
+from .common import _weak_joints, consistent_state  # noqa: F401  (names other modules import from here)
 from .checks import check_initial_contacts
-from .autoswitch import OrderTrack
-from .events import EventTracker
 from .kinematic import check_model, time_grid
-from .state import state_factory
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -225,8 +221,10 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
     from scipy import integrate
-    return _integrate_index1(sys, rep, times, getattr(integrate, SCIPY_METHODS[method]), rtol, atol, max_step,
-                             progress)
+
+    from .index1 import integrate_index1
+    return integrate_index1(sys, rep, times, getattr(integrate, SCIPY_METHODS[method]), rtol, atol, max_step,
+                            progress)
 
 
 HHT_RTOL_FLOOR = 1e-10     # HHT's Newton iterations converge to ~1e-12: its error estimate means nothing below
@@ -278,132 +276,3 @@ def _default_method(model) -> str:
             getattr(model, "sensors", None):
         return "dop853"
     return "hht"
-
-
-class _Trajectory:
-    """Accepted steps' dense outputs, for evaluation at any time inside the integrated span."""
-
-    def __init__(self, sys, rows, sf):
-        self.sys, self.rows, self.sf = sys, rows, sf
-        self.t_end, self.dense = [], []
-
-    def add(self, t_old, t_new, dense):
-        self.t_end.append(t_new)
-        self.dense.append((t_old, dense))
-
-    def state(self, t):
-        k = min(bisect.bisect_left(self.t_end, t), len(self.dense) - 1)
-        y = self.dense[k][1](t)
-        return consistent_state(self.sys, y, t, self.rows, self.sf)
-
-    def step_states(self):
-        """(t, q, v) at the start of every accepted step and at the end (Euler parameters normalised)."""
-        ts = [d[0] for d in self.dense] + [self.t_end[-1]]
-        ys = [d(t0) for t0, d in self.dense] + [self.dense[-1][1](self.t_end[-1])]
-        Y = np.array(ys)
-        q = np.array([normalize(self.sys, y[:self.sys.nq]) for y in Y])
-        return np.array(ts), q, Y[:, self.sys.nq:]
-
-    def evaluate(self, ts):
-        states = [self.state(t) for t in ts]
-        return tuple(np.array([s[i] for s in states]) for i in range(4))
-
-
-def consistent_state(sys, y, t, rows, sf):
-    """Project y = [q, v] onto the constraints and complete it with vd and lambda_."""
-    q, v = y[:sys.nq], y[sys.nq:]
-    q, _, _ = project_positions(sys, normalize(sys, q), t, rows)
-    v = project_velocities(sys, q, v, t, rows)
-    vd, lam = accelerations(sys, q, v, t, rows, sf)
-    return q, v, vd, lam
-
-
-def _integrate_index1(sys, rep, times, solver_cls, rtol, atol, max_step, progress=None):
-    rows, sf = rep.rows, state_factory(sys)
-    nq = sys.nq
-
-    def rhs(t, y):
-        q, v = y[:nq], y[nq:]
-        vd, _ = accelerations(sys, normalize(sys, q), v, t, rows, sf)
-        return np.concatenate([qdot(sys, q, v), vd])
-
-    traj = _Trajectory(sys, rows, sf)
-    events = EventTracker(sys, rows, sf)
-    y0 = np.concatenate([rep.q, rep.v])
-    t0, t_end = times[0], times[-1]
-    events.start(t0, y0)   # first: initial modes of switching elements (stick/slip) enter every solve
-    out = [consistent_state(sys, y0, t0, rows, sf)]
-    nxt, nsteps, success, message, error, nsmall, track = 1, 0, True, "ok", None, 0, None
-    opts = dict(rtol=rtol, atol=atol, max_step=max_step if max_step else np.inf)
-    try:
-        solver = solver_cls(rhs, t0, y0, t_end, **opts)
-        track = OrderTrack(t0, solver_cls.__name__, solver)
-        while solver.status == "running":
-            t_old, order = solver.t, track.order(solver)
-            msg = solver.step()
-            tiny = 1e-10 * max(1.0, abs(solver.t))
-            if solver.status == "failed" or (solver.t - t_old < tiny and solver.status == "running"):
-                nsmall = nsmall + 1 if solver.status == "running" else 99
-                if nsmall > 20:
-                    y = solver.y
-                    raise SolverError(f"step size collapsed ({msg or 'steps below 1e-10 s'}): lock-up or "
-                                      "singular configuration", time=solver.t,
-                                      joints=_weak_joints(sys, y[:nq], y[nq:], solver.t, rows), state=y[:nq])
-            else:
-                nsmall = 0
-            nsteps += 1
-            track.step(t_old, order)
-            dense = solver.dense_output()
-            t_new, y_new = solver.t, solver.y
-            hit = events.check(t_old, t_new, dense)
-            if hit is not None:   # stop the step at the event and restart there
-                t_new, y_new = hit, dense(hit)
-            traj.add(t_old, t_new, dense)
-            while nxt < len(times) and times[nxt] <= t_new + 1e-14 * max(1.0, abs(t_new)):
-                out.append(traj.state(min(times[nxt], t_new)))
-                nxt += 1
-            notify(progress, t_new, lambda n=len(out): _partial(sys, times, out[:n], rep))
-            q, v = y_new[:nq], y_new[nq:]
-            q, _, _ = project_positions(sys, normalize(sys, q), t_new, rows)
-            v = project_velocities(sys, q, v, t_new, rows)
-            y = np.concatenate([q, v])
-            if hit is not None:
-                events.after(t_new, y)
-                if events.stop:   # a sensor with action "stop" (issue 11): the event is the last sample
-                    if t_new > times[len(out) - 1]:
-                        out.append(consistent_state(sys, y, t_new, rows, sf))
-                        times = np.append(times[:len(out) - 1], t_new)
-                    message = f"stopped by sensor '{events.sensor_events[-1].name}' at t = {t_new:.12g} s"
-                    break
-                if t_new < t_end:
-                    solver = solver_cls(rhs, t_new, y, t_end, **opts)
-                continue
-            solver.y = y
-            if hasattr(solver, "f"):
-                solver.f = rhs(solver.t, y)
-    except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
-        exc = analysis_error(exc, traj.t_end[-1] if traj.t_end else t0)
-        success, message, error = False, f"{exc}; last good output at t = {times[len(out) - 1]:.9g} s", exc
-    n = len(out)
-    res = Result(sys, times[:n], *[np.array([s[i] for s in out]) for i in range(4)],
-                 evaluate=traj.evaluate if traj.dense else None, success=success,
-                 status=0 if success else -1, message=message,
-                 stats={"steps": nsteps, "method": solver_cls.__name__, "assembly": rep, "order": track.history[-1][2]
-                        if track else None, "order_history": track.history if track else []})
-    res.error = error
-    res.sensor_events = list(events.sensor_events)
-    res.steps = traj.step_states if traj.dense else None
-    return res
-
-
-def _partial(sys, times, out, rep) -> Result:
-    """The Result of the output states `out` so far (written to disk during a run)."""
-    return Result(sys, times[:len(out)], *[np.array([s[i] for s in out]) for i in range(4)],
-                  stats={"assembly": rep}, message="partial (run in progress)")
-
-
-def _weak_joints(sys, q, v, t, rows):
-    """Joints whose constraint rows are closest to dependent at (q, t)."""
-    from ..system.equations import constraint_terms
-    _, J, _, _ = constraint_terms(sys, normalize(sys, q), v, t)
-    return _worst_joints(sys, J, rows)

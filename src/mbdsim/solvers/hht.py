@@ -20,12 +20,12 @@ import scipy.linalg as sla
 
 from ..errors import SolverError
 from ..results.result import Result
-from ..results.stream import notify
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
-from .common import accelerations, analysis_error, increment, normalize, project_positions, project_velocities
-from .dynamic import consistent_state
+from .common import accelerations, increment, normalize, project_positions, project_velocities
+from .common import consistent_state
+from .driver import Step, drive
 from .events import EventTracker
 from .state import state_factory
 
@@ -39,95 +39,136 @@ class _Step:
         self.t, self.q, self.v, self.a, self.lam, self.f = t, q, v, a, lam, f
 
 
+class HHTStepper:
+    """HHT-alpha steps for `solvers.driver.drive`, error-controlled, over [t0, t_end] [s] from the
+    assembled state `rep`; outputs are (q, v, vd, lambda_) tuples, or (q, v) when `outputs` completes
+    them on demand (see integrate_hht)."""
+
+    out_tol = 1e-12
+
+    def __init__(self, sys, rep, t0, t_end, rtol, atol, max_step, alpha, sf, outputs=None, project=None):
+        self.sys, self.rep, self.rows, self.sf = sys, rep, rep.rows, sf
+        self.rtol, self.atol, self.max_step, self.alpha = rtol, atol, max_step, alpha
+        self.beta, self.gamma = (1 - alpha) ** 2 / 4, 0.5 - alpha
+        self.t_end, self.outputs = float(t_end), outputs
+        a0, lam_full = accelerations(sys, rep.q, rep.v, t0, self.rows, sf)
+        lam0 = lam_full[self.rows]
+        self.cur = _Step(t0, rep.q, rep.v, a0, lam0, _force_term(sys, rep.q, rep.v, t0, lam0, self.rows, sf))
+        self.h = min(max_step or np.inf, (self.t_end - t0) / 100, _initial_step(sys, self.cur, rtol, atol))
+        self.steps = [self.cur]
+        self.sample = _dense if outputs is None else lambda *a: _dense_qv(*a, project=project)
+        self.nrej = 0
+        self.tan = _Tangent()
+
+    @property
+    def t(self) -> float:
+        return self.cur.t
+
+    @property
+    def y(self) -> np.ndarray:
+        return np.concatenate([self.cur.q, self.cur.v])
+
+    def first(self):
+        return self.here()
+
+    def here(self):
+        cur = self.cur
+        return self.sample(self.sys, cur, cur, cur.t, self.rows, self.sf)
+
+    def step(self, t_stop=None):
+        """The next accepted step (Newton failures refresh the tangent, then cut the step; the error
+        estimate rejects and shrinks it); with t_stop, the step is at most as long as to reach t_stop."""
+        sys, cur, tan = self.sys, self.cur, self.tan
+        if t_stop is not None:
+            self.h = t_stop - cur.t
+        while True:
+            h = self.h = min(self.h, self.t_end - cur.t, self.max_step or np.inf)
+            new, ok = _try_step(sys, cur, h, self.alpha, self.beta, self.gamma, self.rows, self.sf, tan)
+            if not ok:
+                self.nrej += 1
+                if not tan.fresh:       # first refresh the tangent, then cut the step
+                    tan.K = None
+                    continue
+                tan.K = None
+                self.h *= 0.25
+                if self.h < 1e-14 * max(1.0, abs(cur.t)):
+                    raise SolverError("HHT step size underflow (Newton does not converge)", time=cur.t,
+                                      joints=_names(sys, self.rows), state=cur.q)
+                continue
+            err = _error(cur, new, h, self.beta, self.rtol, self.atol)
+            if err > 1.0:
+                self.nrej += 1
+                self.h *= max(0.2, 0.9 * err ** (-1 / 3))
+                if self.h < 1e-14 * max(1.0, abs(cur.t)):   # the tolerance cannot be met: a floor, not a hang
+                    raise SolverError(f"HHT step size underflow: the error estimate stays above the tolerance "
+                                      f"(rtol {self.rtol:g}, atol {self.atol:g}) at steps below {self.h:.3g} s",
+                                      time=cur.t, joints=_names(sys, self.rows), state=cur.q)
+                continue
+            return Step(cur.t, new.t, np.concatenate([new.q, new.v]),
+                        lambda t, a=cur, b=new: _hermite_y(sys, a, b, t),
+                        lambda t, a=cur, b=new: self.sample(sys, a, b, t, self.rows, self.sf), (new, err))
+
+    def to_event(self, step, t_hit):
+        """The step redone to end at the event (HHT's interpolant is only third order: cutting it there
+        would leave the event state inaccurate); reached: it does end there."""
+        tol = 1e-13 * max(1.0, abs(step.t_new))
+        if t_hit >= step.t_new - tol:
+            return step, True
+        step = self.step(t_stop=t_hit)
+        return step, abs(step.t_new - t_hit) <= tol
+
+    def take(self, step):
+        new, err = step.data
+        self.steps.append(new)
+        self.cur = new
+        self.h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
+
+    def restart(self):
+        """Nothing to restart: each HHT step starts from its own state."""
+
+    def has_steps(self) -> bool:
+        return True
+
+    def evaluate(self, ts):
+        steps, sys = self.steps, self.sys
+        tk = np.array([s.t for s in steps])
+        states = []
+        for t in ts:
+            k = int(np.clip(np.searchsorted(tk, t) - 1, 0, len(steps) - 2)) if len(steps) > 1 else 0
+            states.append(self.sample(sys, steps[k], steps[min(k + 1, len(steps) - 1)], t, self.rows, self.sf))
+        cols = tuple(np.array([s[i] for s in states]) for i in range(len(states[0])))
+        if self.outputs is None:
+            return cols
+        return cols + self.outputs(np.asarray(ts, float), np.hstack(cols))
+
+    def step_states(self):
+        steps = self.steps
+        return np.array([s.t for s in steps]), np.array([s.q for s in steps]), np.array([s.v for s in steps])
+
+    def stats(self) -> dict:
+        tan = self.tan
+        return {"steps": len(self.steps) - 1, "rejected": self.nrej, "nfev": tan.nfev, "njev": tan.njev,
+                "factorizations": tan.nlu, "order": 2, "method": "HHT", "alpha": self.alpha, "assembly": self.rep}
+
+    def result(self, times, out, **kw) -> Result:
+        return _outputs(self.sys, times, out, self.outputs, **kw)
+
+
 def integrate_hht(sys, rep, times, rtol, atol, max_step, alpha=ALPHA, progress=None, outputs=None, project=None):
-    """HHT-alpha integration over the output grid `times`; returns a Result. progress: see
+    """HHT-alpha integration over the output grid `times` [s]; returns a Result. progress: see
     mbdsim.results.stream.notify; Ctrl-C ends the run with success=False and every output before it.
     outputs: optional callable (times [s], Y = [q, v] rows) -> (VD, LAM) giving the accelerations and
     multipliers (all rows) at output states; with it they are computed on first use (as a compiled run
     does; the automatic method passes the compiled kernel's), else at every output. project: optional
     callable (t [s], y = [q, v]) -> (q, v) projecting an output state onto the constraints (default: the
-    minimum-norm Newton projection of mbdsim.solvers.common)."""
-    rows, sf = rep.rows, state_factory(sys)
-    beta, gamma = (1 - alpha) ** 2 / 4, 0.5 - alpha
-    t0, t_end = float(times[0]), float(times[-1])
-    events = EventTracker(sys, rows, sf)
+    minimum-norm Newton projection of mbdsim.solvers.common). Events: a step that changes the sign of a
+    switching function is redone to end at its root (mbdsim.solvers.driver)."""
+    sf = state_factory(sys)
+    t0 = float(times[0])
+    events = EventTracker(sys, rep.rows, sf)
     events.start(t0, np.concatenate([rep.q, rep.v]))
-    to_event = False
-    a0, lam_full = accelerations(sys, rep.q, rep.v, t0, rows, sf)
-    lam0 = lam_full[rows]
-    cur = _Step(t0, rep.q, rep.v, a0, lam0, _force_term(sys, rep.q, rep.v, t0, lam0, rows, sf))
-    h = min(max_step or np.inf, (t_end - t0) / 100, _initial_step(sys, cur, rtol, atol))
-    steps = [cur]
-    sample = _dense if outputs is None else lambda *a: _dense_qv(*a, project=project)
-    out = [sample(sys, cur, cur, t0, rows, sf)]
-    nxt, success, message, nrej, error = 1, True, "ok", 0, None
-    tan = _Tangent()
-    try:
-        while cur.t < t_end - 1e-14 * max(1.0, abs(t_end)):
-            h = min(h, t_end - cur.t, max_step or np.inf)
-            new, ok = _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan)
-            if not ok:
-                nrej += 1
-                if not tan.fresh:       # first refresh the tangent, then cut the step
-                    tan.K = None
-                    continue
-                tan.K = None
-                h *= 0.25
-                if h < 1e-14 * max(1.0, abs(cur.t)):
-                    raise SolverError("HHT step size underflow (Newton does not converge)", time=cur.t,
-                                      joints=_names(sys, rows), state=cur.q)
-                continue
-            err = _error(cur, new, h, beta, rtol, atol)
-            if err > 1.0:
-                nrej += 1
-                h *= max(0.2, 0.9 * err ** (-1 / 3))
-                if h < 1e-14 * max(1.0, abs(cur.t)):   # the tolerance cannot be met: a floor, not a hang
-                    raise SolverError(f"HHT step size underflow: the error estimate stays above the tolerance "
-                                      f"(rtol {rtol:g}, atol {atol:g}) at steps below {h:.3g} s", time=cur.t,
-                                      joints=_names(sys, rows), state=cur.q)
-                continue
-            if not to_event and events.items:
-                hit = events.check(cur.t, new.t, lambda t, a=cur, b=new: _hermite_y(sys, a, b, t))
-                if hit is not None and hit < new.t - 1e-13 * max(1.0, abs(new.t)):
-                    h, to_event = hit - cur.t, True     # redo the step so that it ends at the event
-                    continue
-                to_event = hit is not None
-            if to_event:                                # the step ends at an event: switch modes
-                events.after(new.t, np.concatenate([new.q, new.v]))
-                to_event = False
-            steps.append(new)
-            while nxt < len(times) and times[nxt] <= new.t + 1e-12 * max(1.0, abs(new.t)):
-                out.append(sample(sys, cur, new, times[nxt], rows, sf))
-                nxt += 1
-            notify(progress, new.t, lambda n=len(out): _outputs(sys, times[:n], out[:n], outputs,
-                                                                stats={"assembly": rep}))
-            cur = new
-            h *= min(2.0, max(0.5, 0.9 * max(err, 1e-10) ** (-1 / 3)))
-    except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
-        exc = analysis_error(exc, cur.t)
-        success, message, error = False, f"{exc}; last good step at t = {cur.t:.9g} s", exc
-    n = len(out)
-
-    def evaluate(ts):
-        tk = np.array([s.t for s in steps])
-        states = []
-        for t in ts:
-            k = int(np.clip(np.searchsorted(tk, t) - 1, 0, len(steps) - 2)) if len(steps) > 1 else 0
-            states.append(sample(sys, steps[k], steps[min(k + 1, len(steps) - 1)], t, rows, sf))
-        cols = tuple(np.array([s[i] for s in states]) for i in range(len(states[0])))
-        if outputs is None:
-            return cols
-        return cols + outputs(np.asarray(ts, float), np.hstack(cols))
-
-    res = _outputs(sys, times[:n], out, outputs, evaluate=evaluate,
-                   success=success, status=0 if success else -1, message=message,
-                   stats={"steps": len(steps) - 1, "rejected": nrej, "nfev": tan.nfev, "njev": tan.njev,
-                        "factorizations": tan.nlu, "order": 2, "method": "HHT", "alpha": alpha,
-                        "assembly": rep})
-    res.error = error
-    res.steps = lambda: (np.array([s.t for s in steps]), np.array([s.q for s in steps]),
-                         np.array([s.v for s in steps]))
-    return res
+    stepper = HHTStepper(sys, rep, t0, times[-1], rtol, atol, max_step, alpha, sf, outputs, project)
+    return drive(stepper, sys, rep, times, events, progress)
 
 
 def _outputs(sys, times, out, outputs, **kw) -> Result:
