@@ -6,8 +6,10 @@ share one interface, after scipy's OdeSolver split of stepper and driver:
     first()                 the output tuple at the start state (t0)
     step() -> Step          the next accepted step from `t` (not taken yet): (t_old, t_new [s], dense(t) -> y =
                             [q, v] on the step, sample(t) -> output tuple, y_new)
-    to_event(step, t_hit)   (step, reached): the step ending at the event time t_hit (the dense output cut
-                            there, or the step redone to end there); reached: it ends at the event
+    to_event(step, t_hit, locate)   (step, reached): the step ending at the event time t_hit (the dense
+                            output cut there, or the step redone to end there, as often as locate(step),
+                            the earliest root on a step's own dense output, still finds one before its end);
+                            reached: it ends at the event
     take(step)              accept the step: `t` and `y` (consistent [q, v]) move to its end
     restart()               begin afresh from (t, y) after an event switched modes
     here()                  the output tuple at (t, y)
@@ -57,7 +59,7 @@ def drive(stepper, sys, rep, times, events, progress=None):
             hit = events.check(step.t_old, step.t_new, step.dense)
             event = False
             if hit is not None:
-                step, event = stepper.to_event(step, hit)
+                step, event = stepper.to_event(step, hit, lambda s: events.locate(s.t_old, s.t_new, s.dense)[0])
             while nxt < len(times) and times[nxt] <= step.t_new + stepper.out_tol * max(1.0, abs(step.t_new)):
                 out.append(step.sample(min(times[nxt], step.t_new)))
                 nxt += 1

@@ -65,13 +65,22 @@ class EventTracker:
 
     def check(self, t_old, t_new, dense):
         """Earliest event time in (t_old, t_new], or None."""
+        best, fired, g1 = self.locate(t_old, t_new, dense)
+        if g1 is not None and not fired:
+            self.prev = g1
+        self.fired = fired
+        return best
+
+    def locate(self, t_old, t_new, dense):
+        """(earliest root in (t_old, t_new] of a switching function that changed sign since the last
+        accepted event state, or None; the indices crossing there; the values at t_new, or None when
+        there is nothing to watch), without changing the tracker."""
         if not self.items and not self.sensors:
-            return None
+            return None, [], None
         g1 = self.values(t_new, dense(t_new))
         cross = np.where((np.sign(g1) != np.sign(self.prev)) & (self.prev != 0))[0]
         if len(cross) == 0:
-            self.prev = g1
-            return None
+            return None, [], g1
         best, roots = t_new, {}
         for k in cross:
             f = lambda t: self.values(t, dense(t))[k]  # noqa: E731
@@ -82,8 +91,8 @@ class EventTracker:
                 continue
             best = min(best, tk)
             roots[k] = tk
-        self.fired = [k for k, tk in roots.items() if tk <= best + 1e-12 * max(1.0, abs(best))]
-        return best if best > t_old else None
+        fired = [k for k, tk in roots.items() if tk <= best + 1e-12 * max(1.0, abs(best))]
+        return (best if best > t_old else None), fired, g1
 
     def after(self, t, y):
         q, v = y[:self.sys.nq], y[self.sys.nq:]

@@ -102,7 +102,7 @@ class Index1Stepper:
         self._sampler(step)
         return step
 
-    def to_event(self, step, t_hit):
+    def to_event(self, step, t_hit, locate=None):
         """Cut the step at the event on its dense output."""
         step.t_new, step.y_new = t_hit, step.dense(t_hit)
         return step, True
