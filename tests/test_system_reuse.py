@@ -129,3 +129,18 @@ def test_user_callable_objects_are_flagged_expression_functions_are_not():
     m2 = _double_pendulum()
     m2.add_motion("drive", "j1", displacement=Ramp(0.3))
     assert assemble_system(m2).derived["calls_python"] is True
+
+
+def test_single_use_assembles_afresh_and_keeps_nothing():
+    """Inside assembly.single_use (the study runs) a Model's System is neither looked up nor kept; the
+    analysis is the same as a kept one's."""
+    from mbdsim.system.assemble import single_use
+    m = _double_pendulum()
+    with single_use():
+        s1, s2 = assemble_system(m), assemble_system(m)
+        res = _run(m)
+    assert "_assembled" not in m.__dict__ and s1.derived is not s2.derived
+    assert s1.derived["calls_python"]        # nothing computed from the model's callables is cached
+    ref = _run(m)
+    assert "_assembled" in m.__dict__
+    assert np.array_equal(res.q, ref.q)

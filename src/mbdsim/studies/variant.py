@@ -121,9 +121,10 @@ def run_variant(plan: Plan, params: dict) -> dict:
     """One row: the outputs, status ('ok', 'failed': the analysis stopped early, 'error': it raised),
     message and wall time [s].  Never raises for a problem of the variant itself."""
     t0 = time.perf_counter()
+    from ..system.assemble import single_use
     row = {name: math.nan for name in plan.outputs}
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), single_use():   # each variant's model is built and run once
             warnings.simplefilter("ignore")      # assembly notes and redundancy reports, once per variant
             res = run_analysis(build_model(plan, params), plan.analysis, needs_diagnostics(plan))
             if getattr(res, "success", True):

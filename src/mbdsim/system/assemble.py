@@ -9,6 +9,8 @@ joint friction element (active only while it sticks, see force_elements.friction
 """
 from __future__ import annotations
 
+import contextlib
+import contextvars
 import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
@@ -104,6 +106,21 @@ class System:
         return np.arange(self.nc - len(self.lock_rows))
 
 
+_KEEP = contextvars.ContextVar("mbdsim_keep_assembly", default=True)
+
+
+@contextlib.contextmanager
+def single_use():
+    """Within this context every Model is assembled afresh and its System is not kept for reuse (no
+    content fingerprint is taken: about 1 ms for a small model), for code that builds each Model once and
+    analyses it once, such as the runs of a study."""
+    token = _KEEP.set(False)
+    try:
+        yield
+    finally:
+        _KEEP.reset(token)
+
+
 def assemble_system(model) -> System:
     """Assemble the System of a Model (layout, constraint rows, mass matrix, initial q and v).
 
@@ -111,6 +128,10 @@ def assemble_system(model) -> System:
     copy of that System: the same arrays and caches (`derived`, the compiled model among them) with an
     empty `run_state`, as MuJoCo reuses an mjModel with a new mjData.  Models with joint friction (their
     stick/slip histories live on the System) are assembled every time."""
+    if not _KEEP.get():
+        sys = _assemble_system(model)
+        sys.derived["calls_python"] = True   # unknown: nothing computed from the model's callables is kept
+        return dataclasses.replace(sys, run_state={})
     from .fingerprint import fingerprint
     fp, callables = fingerprint(model)
     kept = getattr(model, "__dict__", {}).get("_assembled")
