@@ -57,3 +57,16 @@ def test_axis_dofs_of_motions_and_loads():
     assert axis_dofs("revolute") == ("rotation",) and axis_dofs("translational") == ("translation",)
     assert axis_dofs("screw") == ("rotation", "translation") and axis_dofs("screw", loads=True) == ()
     assert axis_dofs("spherical") == () and axis_dofs("nonesuch") == ()
+
+
+def test_slide_and_coupled_freedoms_come_from_the_registry():
+    from mbdsim.model.joint_kinds import coupled_dofs, has_slide
+    assert [k for k in JOINT_KINDS if has_slide(k)] == ["translational", "cylindrical"]
+    assert coupled_dofs("screw") == ("rotation",) and coupled_dofs("cylindrical") == ("rotation", "translation")
+    assert coupled_dofs("spherical") == () and coupled_dofs("nonesuch") == ()
+    # a slide coordinate moves along the axis: a translational joint's coordinate follows the body
+    m = mb.Model(gravity=(0, 0, 0))
+    b = m.add_body("b", 1.0, (1, 1, 1), position=(0, 0, 0), velocity=(0.3, 0, 0))
+    m.add_translational("s", m.ground, b, (0, 0, 0), (1, 0, 0))
+    res = mb.simulate(m, 1.0, 0.5)
+    assert np.allclose(np.ravel(res.joint_coordinate("s")), 0.3 * res.time, atol=1e-9)

@@ -23,7 +23,8 @@ class JointKind:
     coord_names: how those values read, for messages and docs; axis_dofs: freedoms along/about the
     joint axis that a motion or coupler may drive (the first is the default); loads: joint forces,
     stops and friction may act on axis_dofs; angle: the first coordinate is an angle [rad] continued
-    beyond +-pi along an analysis; translation_constraints: constraints on the relative translation
+    beyond +-pi along an analysis; slide: a coordinate is a slide [m] along the joint axis (the last of
+    Result.joint_coordinate); translation_constraints: constraints on the relative translation
     (what a particle as body_j feels); planar_dof: in-plane freedoms left in a planar model (None: it
     depends on the placement); fields: the model-file fields besides name/body_i/body_j, in the order
     of the Model method `add_<name>`; coupled: the axis freedoms a coupler may tie (None: axis_dofs; a
@@ -40,6 +41,7 @@ class JointKind:
     angle: bool = False
     planar_dof: int | None = None
     coupled: tuple | None = None
+    slide: bool = False
 
     @property
     def method(self) -> str:
@@ -50,8 +52,9 @@ class JointKind:
 _ROTVEC = "a relative rotation vector [rad] (angular velocity [rad/s]) in body_i axes"
 JOINT_KINDS: dict[str, JointKind] = {k.name: k for k in (
     JointKind("revolute", 1, 1, 3, ("point", "axis"), "angle [rad]", (ROT,), True, True, 1),
-    JointKind("translational", 1, 1, 2, ("point", "axis"), "slide [m]", (TRA,), True, False, 1),
-    JointKind("cylindrical", 2, 2, 2, ("point", "axis"), "(angle [rad], slide [m])", (ROT, TRA), True, True),
+    JointKind("translational", 1, 1, 2, ("point", "axis"), "slide [m]", (TRA,), True, False, 1, slide=True),
+    JointKind("cylindrical", 2, 2, 2, ("point", "axis"), "(angle [rad], slide [m])", (ROT, TRA), True, True,
+              slide=True),
     JointKind("spherical", 3, 3, 3, ("point",), _ROTVEC, planar_dof=1),
     JointKind("universal", 2, 3, 3, ("point", "axis_i", "axis_j"), _ROTVEC),
     JointKind("planar", 3, 3, 1, ("point", "normal", "u_axis"), "(u [m], v [m], angle [rad])", planar_dof=3),
@@ -105,6 +108,12 @@ def pick_axis_dof(entity: str, joint, dof, loads: bool, no_axis: str) -> str:
 def kinds_with_axis(loads: bool = False) -> tuple:
     """Names of the kinds that have axis freedoms (for error messages)."""
     return tuple(n for n in JOINT_KINDS if axis_dofs(n, loads))
+
+
+def has_slide(kind: str) -> bool:
+    """True when a coordinate of `kind` is a slide [m] along the joint axis."""
+    k = JOINT_KINDS.get(kind)
+    return bool(k and k.slide)
 
 
 def is_angle(kind: str) -> bool:

@@ -33,7 +33,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.joints import Joint
 from ..system import measures as ms
-from ..model.joint_kinds import is_angle
+from ..model.joint_kinds import has_slide, is_angle
 
 ROTATION_JOINTS = ("spherical", "universal", "fixed", "constant_velocity")
 _TWO_PI = 2.0 * np.pi
@@ -104,7 +104,7 @@ def acceleration(res, joint, kind=None):
     ang = sl = None
     if is_angle(jt.kind) and not g.particle_j:
         ang = _spin_acc(g, fr, axes[2])
-    if jt.kind in ("translational", "cylindrical"):
+    if has_slide(jt.kind):
         sl = _slide_acc(g, fr, axes[2])
     return _pick(ang, sl)
 

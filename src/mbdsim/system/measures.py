@@ -12,7 +12,7 @@ from ..errors import ModelError
 from ..model.body import Body, Marker
 from .constraints import primitives as pr
 from .frames import Frames
-from ..model.joint_kinds import is_angle
+from ..model.joint_kinds import has_slide, is_angle
 
 
 def resolve(sys, target, field="target"):
@@ -109,7 +109,7 @@ def joint_coordinate(sys, fr, joint, dof=None):
     ang = angd = sl = sld = None
     if is_angle(joint.kind) and not g.particle_j:
         ang, _, angd = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
-    if joint.kind in ("translational", "cylindrical"):
+    if has_slide(joint.kind):
         sl = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)).phi
         sld = pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
     return ang, angd, sl, sld
