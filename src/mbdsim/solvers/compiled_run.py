@@ -55,14 +55,12 @@ class CompiledRun:
         n = len(y)
         Y = np.zeros((nout, len(y0)))
         f = np.zeros(n)
-        status = fastdop.rhs(a, w, t0, y, f)
         iout = 0
-        if status == 0 and abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
+        if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
             Y[0] = y0
             iout = 1
-        st = np.array([t0, 0.0])
-        if status == 0:
-            st[1] = initial_step(a, w, t0, y, f, self.rtol, self.atol, self.max_step)
+        st = np.array([t0, 0.0])   # h = 0: the kernel starts with f(t0, y0) and its starting step
+        status = 0
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         keep = checkpoints and n * 8 * 64 <= CHECKPOINT_BUDGET
         SY, ST, ns = np.zeros((64 if keep else 0, n)), np.zeros((64 if keep else 0, 2)), np.zeros(1, np.int64)
@@ -77,12 +75,15 @@ class CompiledRun:
                 status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
                                            self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
                                            1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns)
+                if st[1] == 0.0:   # the start failed: not even the initial state is an output
+                    iout = 0
+                    break
                 notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
-        if self.joint_space:   # the last state as absolute coordinates (failure reports)
+        if self.joint_space and status != 0:   # the last state as absolute coordinates (failure reports)
             ymax = np.zeros(len(y0))
             fastdyn.write_state(a, w, y, ymax, ymax[:0])
             y = ymax

@@ -150,7 +150,8 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
 @njit(cache=True, _nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
         proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns):
-    """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end, writing the
+    """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end (h = 0: the start,
+    where f and the starting step are computed first; a failure there returns with h still 0), writing the
     projected output states at tout[iout:] into Y (accelerations: `outputs_at`, on demand); stops after
     `chunk` outputs. Returns (status, next iout).
     stats: steps, rejected, rhs evaluations, projections, stiffness counters (int64, accumulated);
@@ -164,6 +165,12 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     n = y.shape[0]
     ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
     t, h = st[0], st[1]
+    if h <= 0.0:   # the start (st = [t0, 0]): f = ydot(t0, y) and Hairer's starting step, here rather than
+        s_ = rhs(cm, wk, t, y, f)   # from Python, so that a run loads one kernel (not counted in stats)
+        if s_ != OK:
+            return s_, iout
+        h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
+        st[1] = h
     written = 0
     steps0 = stats[0]
     rejected = False
