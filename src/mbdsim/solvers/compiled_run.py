@@ -51,13 +51,14 @@ class CompiledRun:
         CHECKPOINT_BUDGET bytes, else None) for dense output on demand. After each chunk of outputs,
         `notify(progress, t, build)` with build() = partial(Y, n_written) when `partial` is given."""
         a, w = self.cm.arrays(), self.work.arrays()
-        y, nout = self.state_of(y0), len(tout)
+        nout = len(tout)
+        y = np.zeros(self.state_size) if self.joint_space else np.array(y0, dtype=float)  # trees: set by run
         n = len(y)
         Y = np.zeros((nout, len(y0)))
         f = np.zeros(n)
+        Y[0] = y0   # the start row (a tree's joint state is read from it; else the first output overwrites it)
         iout = 0
         if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
-            Y[0] = y0
             iout = 1
         st = np.array([t0, 0.0])   # h = 0: the kernel starts with f(t0, y0) and its starting step
         status = 0
@@ -94,12 +95,19 @@ class CompiledRun:
         """True when the model is integrated in joint coordinates (a tree of one-DOF joints)."""
         return int(self.cm.dims[5]) == 1
 
+    @property
+    def state_size(self) -> int:
+        """Length of the integrator's state: nq + nv, or twice the moving joints of a tree."""
+        if not self.joint_space:
+            return int(self.cm.dims[0] + self.cm.dims[1])
+        return 2 * int(np.count_nonzero(self.cm.tree[7] >= 0))
+
     def state_of(self, yrow):
         """The integrator's state of an output row [q, v] (joint coordinates and rates for a tree)."""
         yrow = np.asarray(yrow, dtype=float)
         if not self.joint_space:
             return yrow.copy()
-        y = np.zeros(2 * int(np.count_nonzero(self.cm.tree[7] >= 0)))
+        y = np.zeros(self.state_size)
         fastdyn.read_state(self.cm.arrays(), self.work.arrays(), yrow, y)
         return y
 

@@ -17,8 +17,8 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
-from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, rhs,
-                      write_state)
+from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, read_state,
+                      rhs, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 
@@ -151,7 +151,8 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
         proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end (h = 0: the start,
-    where f and the starting step are computed first; a failure there returns with h still 0), writing the
+    where f and the starting step are computed first, and a joint-coordinate tree's y from the absolute
+    state in Y[0]; a failure there returns with h still 0), writing the
     projected output states at tout[iout:] into Y (accelerations: `outputs_at`, on demand); stops after
     `chunk` outputs. Returns (status, next iout).
     stats: steps, rejected, rhs evaluations, projections, stiffness counters (int64, accumulated);
@@ -166,7 +167,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
     t, h = st[0], st[1]
     if h <= 0.0:   # the start (st = [t0, 0]): f = ydot(t0, y) and Hairer's starting step, here rather than
-        s_ = rhs(cm, wk, t, y, f)   # from Python, so that a run loads one kernel (not counted in stats)
+        if cm[31][5] == 1:          # from Python, so that a run loads one kernel (not counted in stats);
+            read_state(cm, wk, Y[0], y)   # a joint-coordinate tree's y from the absolute start row Y[0]
+        s_ = rhs(cm, wk, t, y, f)
         if s_ != OK:
             return s_, iout
         h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
