@@ -33,7 +33,9 @@ CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted incre
 CORR_ABS = 1e-6       # ... [m or rad, largest slot] halves the sub-step (branch guard)
 HMIN_REL = 1e-12      # smallest sub-step [s] relative to max(1, |t|)
 # stats (int64): 0 outputs solved, 1 sub-steps accepted, 2 sub-steps retried, 3 projections,
-# 4 factorisations
+# 4 factorisations, 5 solved configurations where the factorisation dropped dependent loop rows
+# (`kkt_tree.pivoted_chol`: a change point or a lock-up, where the constraints do not determine the
+# rates; those come from the prediction)
 
 
 @njit(cache=True, _nrt=False)
@@ -115,6 +117,8 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
             status = project(cm, wk, t + h, q, v, tol, True)
             stats[3] += 1
             stats[4] += 1
+        if status == OK and cm[31][4] == 0 and wk[41][0] < cm[30][8].shape[0]:
+            stats[5] += 1
         if status == OK:
             status = accelerations(cm, wk, t + h, q, v, vd, lam, False)
         if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):

@@ -33,7 +33,7 @@ class KinematicRun:
         self.sys, self.rows = sys, rep.rows
         self.cm = compile_system(sys, rep.rows, (rep.q, rep.v))
         self.work = Work.for_model(self.cm)
-        self.stats = np.zeros(5, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
+        self.stats = np.zeros(6, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
 
     @property
     def joint_space(self) -> bool:
@@ -73,6 +73,17 @@ class KinematicRun:
             status = INTERRUPTED
         return Y, VD, LAM, iout, status, float(st[0]), np.concatenate([q, v])
 
+    def outputs(self, times, Y):
+        """(VD, LAM): accelerations and multipliers of the independent rows recomputed at the output rows
+        Y = [q, v] (times [s]), as `CompiledRun.outputs`; SolverError naming the time if singular."""
+        sys, a, w = self.sys, self.cm.arrays(), self.work.arrays()
+        VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
+        for k, t in enumerate(np.asarray(times, float)):
+            y = np.array(Y[k], dtype=float)
+            if fastdyn.accelerations(a, w, float(t), y[:sys.nq], y[sys.nq:], VD[k], LAM[k], True) != OK:
+                raise SolverError(_MESSAGES[fastdyn.SINGULAR] + " at an output time", time=float(t))
+        return VD, LAM
+
     def states_at(self, times, Y, VD, LAM, ts):
         """(q, v, vd, lambda_) at the times ts [s]: the same kinematic solve from the output at or before
         each t (all of ts in one compiled call); an output time gives its stored sample."""
@@ -82,7 +93,7 @@ class KinematicRun:
         Yo, VDo, LAMo = np.zeros((n, Y.shape[1])), np.zeros((n, sys.nv)), np.zeros((n, sys.nc))
         S, dx6, a6, p6 = self._scratch()
         done = fastkin.states_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM, ts,
-                                 Yo, VDo, LAMo, PROJ_TOL, np.zeros(5, np.int64), S, dx6, a6, p6, np.zeros(sys.nq),
+                                 Yo, VDo, LAMo, PROJ_TOL, np.zeros(6, np.int64), S, dx6, a6, p6, np.zeros(sys.nq),
                                  np.zeros(sys.nv), np.zeros(sys.nv), np.zeros(sys.nc), np.zeros(3))
         if done < n:
             raise SolverError(_MESSAGES[fastdyn.PROJECTION] + " (kinematic solve)", time=float(ts[done]))
@@ -92,8 +103,10 @@ class KinematicRun:
 
 def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     """Kinematic analysis of the zero-DOF System `sys` (rep: its assembled state, rep.dof == 0) over the
-    output grid `times` [s]; None when the compiled model is a joint-coordinate tree (the caller
-    integrates it). Raises NotCompiled when the model needs the reference path. res.stats: "method"
+    output grid `times` [s]; None when the compiled model is a joint-coordinate tree or a successful
+    sweep met a change point (loop rows dependent at a solved configuration, e.g. a driven parallelogram
+    with its links collinear: the rates there are decided by continuity, not by the constraints): the
+    caller integrates the model instead. A sweep that fails (lock-up) is reported as it is. Raises NotCompiled when the model needs the reference path. res.stats: "method"
     METHOD, "steps" the outputs solved (the first is the assembled state), "substeps" and "rejected" the
     sub-steps taken and retried between outputs, "nfev" and "njev" 0 (no right-hand side, no Jacobian
     by differences), "factorizations" and "projections" counted, "order" None (no integration formula:
@@ -106,6 +119,8 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     partial = lambda Y, VD, LAM, n: _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n],  # noqa: E731
                                             stats={"assembly": rep})
     Y, VD, LAM, n, status, t_fail, y_fail = run.sweep(times[0], y0, times, progress, partial)
+    if status == OK and run.stats[5]:   # rates left to continuity somewhere: integrate instead
+        return None
     success, message, error = True, "ok", None
     if status != OK:
         from .dynamic import _weak_joints
