@@ -208,9 +208,19 @@ def test_pendulum_stays_explicit_and_meets_the_quarter_period(rtol):
 
 @pytest.mark.parametrize("rtol", [1e-2, 1e-6, 1e-10])
 def test_slider_crank_stays_explicit_and_follows_the_kinematics(rtol):
+    """Driven (zero DOF): "auto" solves it as a kinematic analysis (no stiffness test, no hand-over;
+    tests/test_kinematic_dof0.py), the named DOP853 integrates it without flagging stiffness."""
     m, slider = slider_crank()
     res = mb.simulate(m, 1.0, output_step=0.01, rtol=rtol)
-    assert _explicit_only(res)
+    assert res.success and res.stats["order_history"] == [(0.0, "kinematic (0 DOF)", None)]
+    th = np.pi / 6 + 3 * res.time + 2 * res.time ** 2
+    x = 0.1 * np.cos(th) + np.sqrt(0.35 ** 2 - (0.1 * np.sin(th)) ** 2)
+    assert np.max(np.abs(res.position(slider)[:, 0] - x)) < 1e-10
+    from mbdsim.solvers.compiled_run import integrate_compiled
+    from mbdsim.solvers.assembly import assemble
+    rep = assemble(m)
+    res = integrate_compiled(rep.system, rep, res.time, 0.05 * rtol, 0.05 * rtol * 1e-2, None, stiff_check=True)
+    assert res.success and res.stats["method"] == "DOP853 (compiled)"   # (Stiff would have been raised)
     th = np.pi / 6 + 3 * res.time + 2 * res.time ** 2
     x = 0.1 * np.cos(th) + np.sqrt(0.35 ** 2 - (0.1 * np.sin(th)) ** 2)
     assert np.max(np.abs(res.position(slider)[:, 0] - x)) < 1e-10   # driven: the constraints decide

@@ -48,7 +48,8 @@ def test_driven_parallelogram_through_change_points():
     m.gravity = np.array([0.0, -9.81, 0.0])
     m.add_motion("drive", m.joints["A"], displacement="2*pi*t")
     res = _run(m, 2.0)
-    assert res.success
+    # zero DOF, but its change points leave the rates to continuity: integrated, not a kinematic sweep
+    assert res.success and res.stats["method"] == "auto: DOP853 (compiled)"
     th = np.pi / 2 + w * res.time
     assert np.max(np.abs(_crank_angle(res) - th)) < 1e-8
     assert np.max(np.abs(res.angular_velocity("rocker")[:, 2] - w)) < 1e-6

@@ -14,7 +14,8 @@ from pathlib import Path
 
 _HERE = Path(__file__).parent
 KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py", "solvers/kkt_tree.py",
-                  "solvers/fastdyn.py", "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py")
+                  "solvers/fastdyn.py", "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py",
+                  "solvers/fastkin.py")
 
 
 def _digest() -> str:

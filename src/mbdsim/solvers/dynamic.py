@@ -51,7 +51,10 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
     element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
     the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise "hht"
-    ("dop853" for joint friction, sensors, or rtol below 1e-6). With "auto", rtol (default 1e-7) is
+    ("dop853" for joint friction, sensors, or rtol below 1e-6). A model with zero degrees of freedom
+    (fully driven: assembly's dof == 0) on the compiled core is solved by "auto" as a kinematic
+    analysis instead, exact to the Newton tolerance at every output (mbdsim.solvers.kinsweep;
+    res.stats["method"] "auto: kinematic (0 DOF)"; DOP853 when it meets a change point). With "auto", rtol (default 1e-7) is
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
@@ -137,6 +140,13 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     if method == "auto":
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
+            if USE_COMPILED and rep.dof == 0 and sys.nv:   # fully driven: a kinematic sweep, no integration
+                from .kinsweep import integrate_kinematic
+                res = integrate_kinematic(sys, rep, times, progress)
+                if res is not None:   # (None: a joint-coordinate tree, integrated below)
+                    res = _with_history(res, times[0])
+                    res.stats["method"] = "auto: " + res.stats["method"]
+                    return res
             if USE_COMPILED:
                 res = _with_history(integrate_compiled(sys, rep, times, AUTO_LOCAL * rt, AUTO_LOCAL * at,
                                                        max_step, progress, stiff_check=True), times[0])

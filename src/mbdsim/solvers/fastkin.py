@@ -1,0 +1,209 @@
+"""Compiled kinematic sweep of a zero-degree-of-freedom model (numba): no integration.
+
+When the joints and motion drivers fix every degree of freedom, the state at each time t is solved
+from the constraints alone (docs/theory.md section 6a, "Zero-DOF models"):
+
+    phi(q, t) = 0                       positions (Newton, from a Taylor prediction)
+    phi_q v = nu                        velocities
+    M vd + phi_q^T lambda_ = Q,  phi_q vd = gamma    accelerations and multipliers (reactions)
+
+State layout as in `fastdyn` (y = [q, v]: CM positions [m] and Euler parameters; CM velocities [m/s] in
+ground axes and angular velocities [rad/s] in body axes); the predictions use the six-slot increment of
+`fastdyn.increment_into` (translation [m] in ground axes, rotation vector [rad] in body axes). Each
+time is reached from the previous solved state by sub-steps: q + h qdot + h^2/2 qddot + h^3/6 qdddot
+predicted (the third derivative from the accelerations at the start and end of the previous sub-step),
+Newton on the positions, `fastdyn.project` for the velocities, `fastdyn.accelerations` for vd and the
+multipliers. A sub-step is retried at half length when the Newton iteration fails, when it turns any
+body by more than MAX_TURN, or when its correction is large against the predicted motion (a guard
+against converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned
+(lock-up: no configuration satisfies the constraints, or a singular one).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .fastdyn import (NONFINITE, OK, PROJECTION, _constraints, _factor, _solve, _to6, accelerations,
+                      increment_into, normalize_into, project)
+
+MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-step
+MAX_NEWTON = 12       # Newton iterations per sub-step
+CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted increment (+ CORR_ABS) ...
+CORR_ABS = 1e-6       # ... [m or rad, largest slot] halves the sub-step (branch guard)
+HMIN_REL = 1e-12      # smallest sub-step [s] relative to max(1, |t|)
+# stats (int64): 0 outputs solved, 1 sub-steps accepted, 2 sub-steps retried, 3 projections,
+# 4 factorisations, 5 solved configurations where the factorisation dropped dependent loop rows
+# (`kkt_tree.pivoted_chol`: a change point or a lock-up, where the constraints do not determine the
+# rates; those come from the prediction)
+
+
+@njit(cache=True, _nrt=False)
+def _newton(cm, wk, t, q, v, tol, stats):
+    """Newton on phi(q, t) = 0 from q (in place; steps as in `fastdyn.project`); returns (status,
+    sum over the steps of the largest six-slot component [m or rad])."""
+    active = cm[32]
+    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
+    normalize_into(cm, q)
+    for f in range(zero6.shape[0]):
+        for k in range(6):
+            zero6[f, k] = 0.0
+    size = 0.0
+    for it in range(MAX_NEWTON):
+        _constraints(cm, wk, t, q, v)
+        res = 0.0
+        for i in range(active.shape[0]):
+            r = abs(wk[4][active[i]])
+            if not np.isfinite(r):
+                return NONFINITE, size
+            res = max(res, r)
+        if res <= tol:
+            return OK, size
+        if not _factor(cm, wk):
+            return PROJECTION, size
+        stats[4] += 1
+        for i in range(c.shape[0]):
+            c[i] = -wk[4][i]
+        _solve(cm, wk, zero6, c, x6, lam)
+        step = 0.0
+        for f in range(1, x6.shape[0]):
+            for k in range(6):
+                step = max(step, abs(x6[f, k]))
+        size += step
+        increment_into(cm, q, x6)
+    return PROJECTION, size
+
+
+@njit(cache=True, _nrt=False)
+def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
+    """Carry the solved state (q, v, vd, lam) at time st[0] [s] to t1 [s] in place; st = [t, h, hp] with
+    h the sub-step [s] to try first (np.inf: the whole span) and hp > 0 the length [s] of the previous
+    sub-step, whose starting accelerations p6 (nf, 6; six slots) hold (hp = 0: none); all updated.
+    Returns a status of `fastdyn` (OK, or the last failure when the sub-step fell below HMIN_REL); on
+    failure (q, v, vd) are the last solved state, at st[0]. S (3, max(nq, nv)), dx6, a6 (nf, 6): scratch."""
+    nq, nv = q.shape[0], v.shape[0]
+    rigid = cm[6]
+    t, h, hp = st[0], st[1], st[2]
+    status = OK
+    while t1 - t > 1e-14 * max(1.0, abs(t1)):
+        hmin = HMIN_REL * max(1.0, abs(t))
+        h = min(h, t1 - t)
+        if t1 - t - h <= 1e-14 * max(1.0, abs(t1)):
+            h = t1 - t
+        _to6(cm, v, dx6)
+        _to6(cm, vd, a6)
+        turn, inc = 0.0, 0.0
+        c3 = h * h * h / (6.0 * hp) if hp > 0.0 else 0.0   # h^3/6 x (a - a_prev) / hp
+        for f in range(1, dx6.shape[0]):
+            for k in range(6):
+                dx6[f, k] = h * dx6[f, k] + 0.5 * h * h * a6[f, k]
+                if hp > 0.0:
+                    dx6[f, k] += c3 * (a6[f, k] - p6[f, k])
+                inc = max(inc, abs(dx6[f, k]))
+            if rigid[f]:
+                turn = max(turn, np.sqrt(dx6[f, 3] ** 2 + dx6[f, 4] ** 2 + dx6[f, 5] ** 2))
+        if turn > MAX_TURN and h > hmin:
+            h = max(h * 0.9 * MAX_TURN / turn, hmin)
+            continue
+        for i in range(nq):
+            S[0, i] = q[i]
+        for i in range(nv):
+            S[1, i] = v[i]
+            S[2, i] = vd[i]
+            v[i] += h * vd[i]   # (the projection makes v exact: a prediction only)
+        increment_into(cm, q, dx6)
+        status, size = _newton(cm, wk, t + h, q, v, tol, stats)
+        if status == OK:
+            status = project(cm, wk, t + h, q, v, tol, True)
+            stats[3] += 1
+            stats[4] += 1
+        if status == OK and cm[31][4] == 0 and wk[41][0] < cm[30][8].shape[0]:
+            stats[5] += 1
+        if status == OK:
+            status = accelerations(cm, wk, t + h, q, v, vd, lam, False)
+        if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):
+            t += h
+            stats[1] += 1
+            for f in range(a6.shape[0]):
+                for k in range(6):
+                    p6[f, k] = a6[f, k]
+            hp = h
+            h = 2.0 * h
+            continue
+        for i in range(nq):   # retry at half length from the last solved state
+            q[i] = S[0, i]
+        for i in range(nv):
+            v[i] = S[1, i]
+            vd[i] = S[2, i]
+        stats[2] += 1
+        if h <= hmin:
+            st[0], st[1], st[2] = t, h, hp
+            return status if status != OK else PROJECTION
+        h = max(0.5 * h, hmin)
+    st[0], st[1], st[2] = t1, h, hp
+    return OK
+
+
+@njit(cache=True, _nrt=False)
+def sweep(cm, wk, st, tout, iout, Y, VD, LAM, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
+    """Solve the outputs tout[iout:] [s] in turn from the solved state (q, v, vd, lam) at st[0], writing
+    [q, v] rows into Y, vd into VD and the multipliers (zero at inactive rows) into LAM; stops after
+    `chunk` outputs; st and p6 as in `advance`. Returns (status, next iout); on failure st[0] and (q, v)
+    are the last solved state."""
+    nq = q.shape[0]
+    written = 0
+    while iout < tout.shape[0]:
+        status = advance(cm, wk, st, tout[iout], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
+        if status != OK:
+            return status, iout
+        for i in range(nq):
+            Y[iout, i] = q[i]
+        for i in range(v.shape[0]):
+            Y[iout, nq + i] = v[i]
+            VD[iout, i] = vd[i]
+        for i in range(lam.shape[0]):
+            LAM[iout, i] = lam[i]
+        iout += 1
+        written += 1
+        stats[0] += 1
+        if written >= chunk and iout < tout.shape[0]:
+            break
+    return OK, iout
+
+
+@njit(cache=True, _nrt=False)
+def states_at(cm, wk, times, Y, VD, LAM, ts, Yo, VDo, LAMo, tol, stats, S, dx6, a6, p6, q, v, vd, lam, st):
+    """States, accelerations and multipliers at the times ts [s] (inside the run) into Yo, VDo, LAMo: the
+    same solve as `sweep`, from the output at or before each t (times, Y, VD, LAM: the run's outputs;
+    an output time gives its row as stored). Returns the number of times done (< len(ts) on failure)."""
+    nq, n = q.shape[0], times.shape[0]
+    for j in range(ts.shape[0]):
+        lo, hi = 0, n   # k: the last output with times[k] <= ts[j] (0 before the first)
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            if times[mid] <= ts[j]:
+                lo = mid
+            else:
+                hi = mid
+        k = lo
+        for i in range(nq):
+            q[i] = Y[k, i]
+        for i in range(v.shape[0]):
+            v[i] = Y[k, nq + i]
+            vd[i] = VD[k, i]
+        for i in range(lam.shape[0]):
+            lam[i] = LAM[k, i]
+        st[0], st[1], st[2] = times[k], np.inf, 0.0
+        if k > 0:   # the third derivative from the accelerations at the two outputs before t
+            _to6(cm, VD[k - 1], p6)
+            st[2] = times[k] - times[k - 1]
+        if ts[j] > times[k] and advance(cm, wk, st, ts[j], q, v, vd, lam, tol, stats, S, dx6, a6, p6) != OK:
+            return j
+        for i in range(nq):
+            Yo[j, i] = q[i]
+        for i in range(v.shape[0]):
+            Yo[j, nq + i] = v[i]
+            VDo[j, i] = vd[i]
+        for i in range(lam.shape[0]):
+            LAMo[j, i] = lam[i]
+    return ts.shape[0]

@@ -1,0 +1,157 @@
+"""Zero-DOF models under the automatic method: a kinematic sweep instead of an integration.
+
+When the joints and motion drivers leave no degree of freedom (assembly's `dof == 0`: nv minus the
+rank of the independent constraint rows, drivers included), the motion is fixed by the constraints:
+each output time is solved from phi(q, t) = 0, phi_q v = nu and the equations of motion
+M vd + phi_q^T lambda_ = Q, phi_q vd = gamma (as MSC Adams does for a dynamic simulation of a
+zero-DOF model). The result is exact to the Newton tolerance PROJ_TOL (no integration error, no
+rtol): `fastkin.sweep` does the whole grid in compiled code, Python is re-entered once per chunk
+of outputs (progress, Ctrl-C). A failure (a driver moving the mechanism into lock-up) ends the run
+with success=False, every output before it kept, and a SolverError naming the time and the joints,
+as the compiled integrator does (`compiled_run.integrate_compiled`). docs/theory.md section 6a.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import AnalysisInterrupted, MbdsimError, SolverError
+from ..results.result import Result
+from ..results.stream import notify
+from ..system.compiled import Work, compile_system
+from . import fastdyn, fastkin
+from .compiled_run import CHUNK, _MESSAGES, _full_multipliers
+from .fastdyn import INTERRUPTED, OK
+
+PROJ_TOL = 1e-12   # Newton tolerance on max |phi| [m or rad], as the compiled integrator's projection
+METHOD = "kinematic (0 DOF)"
+
+
+class KinematicRun:
+    """A compiled zero-DOF model, its work arrays and counters for one kinematic sweep."""
+
+    def __init__(self, sys, rep):
+        self.sys, self.rows = sys, rep.rows
+        self.cm = compile_system(sys, rep.rows, (rep.q, rep.v))
+        self.work = Work.for_model(self.cm)
+        self.stats = np.zeros(6, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
+
+    @property
+    def joint_space(self) -> bool:
+        """True when the compiled model is a joint-coordinate tree (integrated by DOP853 instead)."""
+        return int(self.cm.dims[5]) == 1
+
+    def _scratch(self):
+        sys, nf = self.sys, int(self.cm.dims[3])
+        return (np.zeros((3, max(sys.nq, sys.nv, 1))), np.zeros((nf, 6)), np.zeros((nf, 6)), np.zeros((nf, 6)))
+
+    def sweep(self, t0, y0, tout, progress=None, partial=None):
+        """(Y, VD, LAM, n, status, t_last, y_last): output rows [q, v], accelerations vd and multipliers of
+        the independent rows (zero elsewhere) at tout [s] from the consistent state y0 = [q, v] at t0 [s]
+        (tout[0] == t0); n outputs written; on failure t_last [s] and y_last are the last solved state.
+        After each chunk of outputs, `notify(progress, t, build)` (build: partial(Y, VD, LAM, n))."""
+        sys = self.sys
+        a, w = self.cm.arrays(), self.work.arrays()
+        nout, nq = len(tout), sys.nq
+        Y, VD, LAM = np.zeros((nout, nq + sys.nv)), np.zeros((nout, sys.nv)), np.zeros((nout, sys.nc))
+        q, v = np.array(y0[:nq], dtype=float), np.array(y0[nq:], dtype=float)
+        vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
+        st = np.array([float(t0), np.inf, 0.0])
+        status = fastdyn.accelerations(a, w, float(t0), q, v, vd, lam, True)
+        self.stats[4] += 1
+        iout = 0
+        if status == OK:
+            Y[0], VD[0], LAM[0] = y0, vd, lam
+            iout = 1
+        S, dx6, a6, p6 = self._scratch()
+        try:
+            while status == OK and iout < nout:
+                status, iout = fastkin.sweep(a, w, st, tout, iout, Y, VD, LAM, q, v, vd, lam, PROJ_TOL, CHUNK,
+                                             self.stats, S, dx6, a6, p6)
+                notify(progress, st[0], None if partial is None else
+                       (lambda n=iout: partial(Y, VD, LAM, n)))
+        except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
+            status = INTERRUPTED
+        return Y, VD, LAM, iout, status, float(st[0]), np.concatenate([q, v])
+
+    def outputs(self, times, Y):
+        """(VD, LAM): accelerations and multipliers of the independent rows recomputed at the output rows
+        Y = [q, v] (times [s]), as `CompiledRun.outputs`; SolverError naming the time if singular."""
+        sys, a, w = self.sys, self.cm.arrays(), self.work.arrays()
+        VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
+        for k, t in enumerate(np.asarray(times, float)):
+            y = np.array(Y[k], dtype=float)
+            if fastdyn.accelerations(a, w, float(t), y[:sys.nq], y[sys.nq:], VD[k], LAM[k], True) != OK:
+                raise SolverError(_MESSAGES[fastdyn.SINGULAR] + " at an output time", time=float(t))
+        return VD, LAM
+
+    def states_at(self, times, Y, VD, LAM, ts):
+        """(q, v, vd, lambda_) at the times ts [s]: the same kinematic solve from the output at or before
+        each t (all of ts in one compiled call); an output time gives its stored sample."""
+        sys = self.sys
+        ts = np.atleast_1d(np.asarray(ts, dtype=float))
+        n = len(ts)
+        Yo, VDo, LAMo = np.zeros((n, Y.shape[1])), np.zeros((n, sys.nv)), np.zeros((n, sys.nc))
+        S, dx6, a6, p6 = self._scratch()
+        done = fastkin.states_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM, ts,
+                                 Yo, VDo, LAMo, PROJ_TOL, np.zeros(6, np.int64), S, dx6, a6, p6, np.zeros(sys.nq),
+                                 np.zeros(sys.nv), np.zeros(sys.nv), np.zeros(sys.nc), np.zeros(3))
+        if done < n:
+            raise SolverError(_MESSAGES[fastdyn.PROJECTION] + " (kinematic solve)", time=float(ts[done]))
+        nq = sys.nq
+        return Yo[:, :nq], Yo[:, nq:], VDo, _full_multipliers(sys, self.rows, ts, Yo, VDo, LAMo)
+
+
+def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
+    """Kinematic analysis of the zero-DOF System `sys` (rep: its assembled state, rep.dof == 0) over the
+    output grid `times` [s]; None when the compiled model is a joint-coordinate tree or a successful
+    sweep met a change point (loop rows dependent at a solved configuration, e.g. a driven parallelogram
+    with its links collinear: the rates there are decided by continuity, not by the constraints): the
+    caller integrates the model instead. A sweep that fails (lock-up) is reported as it is. Raises NotCompiled when the model needs the reference path. res.stats: "method"
+    METHOD, "steps" the outputs solved (the first is the assembled state), "substeps" and "rejected" the
+    sub-steps taken and retried between outputs, "nfev" and "njev" 0 (no right-hand side, no Jacobian
+    by differences), "factorizations" and "projections" counted, "order" None (no integration formula:
+    every output is exact to the Newton tolerance PROJ_TOL)."""
+    run = KinematicRun(sys, rep)
+    if run.joint_space:
+        return None
+    times = np.asarray(times, float)
+    y0 = np.concatenate([rep.q, rep.v])
+    partial = lambda Y, VD, LAM, n: _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n],  # noqa: E731
+                                            stats={"assembly": rep})
+    Y, VD, LAM, n, status, t_fail, y_fail = run.sweep(times[0], y0, times, progress, partial)
+    if status == OK and run.stats[5]:   # rates left to continuity somewhere: integrate instead
+        return None
+    success, message, error = True, "ok", None
+    if status != OK:
+        from .dynamic import _weak_joints
+        try:
+            joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
+                                                                   rep.rows)
+        except (MbdsimError, np.linalg.LinAlgError, ValueError):
+            joints = []
+        cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
+        error = cls(_MESSAGES.get(status, "kinematic solve failed"), time=t_fail, joints=joints,
+                    state=y_fail[:sys.nq])
+        last = f"{times[n - 1]:.9g}" if n else "none"
+        success, message = False, f"{error}; last good output at t = {last} s"
+    s = run.stats
+    stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,
+             "factorizations": int(s[4]), "projections": int(s[3]), "order": None, "method": METHOD,
+             "formulation": "absolute coordinates (tree elimination)", "assembly": rep}
+    res = _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n], success, message, stats)
+    res.error = error
+    return res
+
+
+def _result(sys, rep, run, t_out, Y, VD, LAM, success=True, message="ok", stats=None) -> Result:
+    """The Result of the solved outputs: positions and velocities at t_out [s], accelerations and the
+    multipliers of every row (minimum norm where redundant) from the stored VD, LAM on first use; dense
+    output (`Result.at`) by the same kinematic solve; res.steps: the outputs themselves (no steps)."""
+    nq = sys.nq
+    res = Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None,
+                 evaluate=lambda ts: run.states_at(t_out, Y, VD, LAM, ts), success=success,
+                 status=0 if success else -1, message=message, stats=stats,
+                 accelerations=lambda: (VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)))
+    if len(t_out):
+        res.steps = lambda: (t_out.copy(), Y[:, :nq].copy(), Y[:, nq:].copy())
+    return res
