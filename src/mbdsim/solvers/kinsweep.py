@@ -8,7 +8,7 @@ zero-DOF model). The result is exact to the Newton tolerance PROJ_TOL (no integr
 rtol): `fastkin.sweep` does the whole grid in compiled code, Python is re-entered once per chunk
 of outputs (progress, Ctrl-C). A failure (a driver moving the mechanism into lock-up) ends the run
 with success=False, every output before it kept, and a SolverError naming the time and the joints,
-as the compiled integrator does (`compiled_run.integrate_compiled`). docs/theory.md section 6a.
+as the compiled integrator does (`compiled_run.integrate_compiled`). docs/theory.md section 6b.
 """
 from __future__ import annotations
 
@@ -123,7 +123,7 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
         return None
     success, message, error = True, "ok", None
     if status != OK:
-        from .dynamic import _weak_joints
+        from .common import _weak_joints
         try:
             joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
                                                                    rep.rows)
