@@ -46,7 +46,10 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
     and inertias, rows normalised) is monitored: samples where it falls below SINGULAR_TOL are recorded
     in res.stats["singular"] (time [s], conditioning, joints involved) and each passage is warned
     (SingularConfigurationWarning); the branch is kept by continuity, every prediction coming from
-    the last non-singular sample and the rates at a singular sample from that sample's extrapolation."""
+    the last non-singular sample and the rates at a singular sample from that sample's extrapolation.
+    A model the compiled core carries that passes no singular configuration is solved by the compiled
+    kinematic sweep (mbdsim.solvers.kinsweep, the same equations; res.stats["method"] "kinematic
+    (compiled sweep)"), with progress told each sample's time once the sweep is done."""
     from ..results.stream import run_writing
     return run_writing(lambda p: _kinematics(model, end_time, output_step, start_time, p), progress, out,
                        "kinematics")
@@ -65,6 +68,11 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
         raise ModelError(f"model '{model.name}'", "motions", f"kinematic analysis needs every degree of freedom "
                          f"driven; {rep.dof} DOF remain free (add motions or use mb.simulate)")
     times = time_grid(start_time, end_time, output_step)
+    fast = _compiled_sweep(sys, rep, times)
+    if fast is not None:
+        for t in fast.time:
+            notify(progress, t)
+        return fast
     sf = state_factory(sys)
     mon = Monitor(sys, rep.rows)
     out, flags, records = [], [], []
@@ -96,6 +104,36 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
     res = _result(sys, out, ev, success, message)
     res.stats["singular"] = records
     res.error = error
+    return res
+
+
+def _compiled_sweep(sys, rep, times):
+    """The Result of the compiled kinematic sweep (solvers.kinsweep: the same equations, every sample in
+    compiled code) when the model is carried by the compiled core, has no joint angles to continue
+    (torsion springs, rotational stops), solves completely and passes no singular configuration
+    (conditioning of every sample, from one batched SVD, at least SINGULAR_TOL); else None, and the
+    analysis below (which treats singular passages and reports failures) runs instead."""
+    from ..model.element_specs import Stop, TorsionSpring
+    from ..system.compiled import NotCompiled
+    from .kinsweep import integrate_kinematic
+    if any(isinstance(e, (TorsionSpring, Stop)) for e in sys.model.forces.values()):
+        return None
+    try:
+        res = integrate_kinematic(sys, rep, times)
+    except NotCompiled:
+        return None
+    if res is None or not res.success or len(res.time) != len(times):
+        return None
+    if len(rep.rows) and sys.nv <= DENSE_LIMIT:
+        from ..system.equations import jacobians
+        from ..system.metrics import position_metric
+        J = jacobians(sys, res.q)[:, rep.rows, :] / np.sqrt(position_metric(sys))
+        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        sv = np.linalg.svd(J, compute_uv=False)
+        if np.any(sv.min(axis=1) < SINGULAR_TOL * np.maximum(sv.max(axis=1), 1e-300)):
+            return None
+    res.stats = {"method": "kinematic (compiled sweep)", "singular": [],
+                 **{k: res.stats[k] for k in ("steps", "substeps", "factorizations", "projections", "assembly")}}
     return res
 
 
