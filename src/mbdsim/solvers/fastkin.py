@@ -1,7 +1,7 @@
 """Compiled kinematic sweep of a zero-degree-of-freedom model (numba): no integration.
 
 When the joints and motion drivers fix every degree of freedom, the state at each time t is solved
-from the constraints alone (docs/theory.md section 6a, "Zero-DOF models"):
+from the constraints alone (docs/theory.md section 6b, "Zero-DOF models"):
 
     phi(q, t) = 0                       positions (Newton, from a Taylor prediction)
     phi_q v = nu                        velocities

@@ -202,10 +202,12 @@ def aba(tree, y, nj, r, A, rd, w, P, F, mass, inertia, tw, ydot):
                 return False
             D[c] = dd
             u[c] = uu
+            inv = 1.0 / dd   # one division per body (36 of them cost a quarter of the sweep)
             for i in range(6):
+                ui = U[c, i] * inv
                 for j in range(6):
-                    Ia[i, j] -= U[c, i] * U[c, j] / dd
-                pa[i] += U[c, i] * uu / dd
+                    Ia[i, j] -= ui * U[c, j]
+                pa[i] += ui * uu
         for i in range(6):   # pa += Ia zeta
             s = 0.0
             for j in range(6):
