@@ -30,6 +30,8 @@ def scaling_table(quick, log):
         reps = 3 if n <= 32 else 1
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
+            E.run_mbdsim(p, "auto", RTOL)   # untimed: the model's first call assembles and compiles it, as
+            # for every problem of run.py (the chains up to 128 ran there already, N = 512 did not)
             t_mb, _, info = _best(lambda: E.run_mbdsim(p, "auto", RTOL), reps)
             t_mj, why = None, None
             if E.mujoco:
