@@ -127,11 +127,14 @@ def _compiled_sweep(sys, rep, times):
     if len(rep.rows) and sys.nv <= DENSE_LIMIT:
         from ..system.equations import jacobians
         from ..system.metrics import position_metric
-        J = jacobians(sys, res.q)[:, rep.rows, :] / np.sqrt(position_metric(sys))
-        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
-        sv = np.linalg.svd(J, compute_uv=False)
-        if np.any(sv.min(axis=1) < SINGULAR_TOL * np.maximum(sv.max(axis=1), 1e-300)):
-            return None
+        scale = 1.0 / np.sqrt(position_metric(sys))
+        block = max(1, 2**22 // max(1, sys.nc * sys.nv))   # samples per batch: Jacobians of <= 32 MB at a time
+        for k in range(0, len(res.time), block):
+            J = jacobians(sys, res.q[k:k + block])[:, rep.rows, :] * scale
+            J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+            sv = np.linalg.svd(J, compute_uv=False)
+            if np.any(sv.min(axis=1) < SINGULAR_TOL * np.maximum(sv.max(axis=1), 1e-300)):
+                return None
     res.stats = {"method": "kinematic (compiled sweep)", "singular": [],
                  **{k: res.stats[k] for k in ("steps", "substeps", "factorizations", "projections", "assembly")}}
     return res
