@@ -230,21 +230,29 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
     if status != 0:
-        from .common import _weak_joints
-        try:
-            joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
-                                                                   rep.rows)
-        except (MbdsimError, np.linalg.LinAlgError, ValueError):
-            joints = []
-        cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-        error = cls(_MESSAGES.get(status, "integration failed"), time=float(t_fail), joints=joints,
-                    state=y_fail[:sys.nq])
-        last = f"{times[n - 1]:.9g}" if n else "none"
-        success, message = False, f"{error}; last good output at t = {last} s"
+        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed")
+        success = False
     stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
     res.error = error
     return res
+
+
+def failure(sys, rep, status, t_fail, y_fail, t_done, fallback):
+    """(error, message) of a compiled run that ended with kernel status `status` at t_fail [s] in state
+    y_fail = [q, v]: a SolverError naming the time and the joints nearest to dependent rows (or
+    AnalysisInterrupted for Ctrl-C), and the Result's message with the last output time of t_done [s];
+    `fallback`: the text for a status without a message of its own."""
+    from .common import _weak_joints
+    try:
+        joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
+                                                               rep.rows)
+    except (MbdsimError, np.linalg.LinAlgError, ValueError):
+        joints = []
+    cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
+    error = cls(_MESSAGES.get(status, fallback), time=float(t_fail), joints=joints, state=y_fail[:sys.nq])
+    last = f"{t_done[-1]:.9g}" if len(t_done) else "none"
+    return error, f"{error}; last good output at t = {last} s"
 
 
 def _stats(run, rep) -> dict:

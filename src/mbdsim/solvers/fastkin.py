@@ -145,24 +145,30 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
 
 
 @njit(cache=True, _nrt=False)
+def _store(q, v, vd, lam, Y, VD, LAM, row):
+    """Row `row` of the outputs: [q, v] into Y, vd into VD, the multipliers into LAM."""
+    nq = q.shape[0]
+    for i in range(nq):
+        Y[row, i] = q[i]
+    for i in range(v.shape[0]):
+        Y[row, nq + i] = v[i]
+        VD[row, i] = vd[i]
+    for i in range(lam.shape[0]):
+        LAM[row, i] = lam[i]
+
+
+@njit(cache=True, _nrt=False)
 def sweep(cm, wk, st, tout, iout, Y, VD, LAM, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
     """Solve the outputs tout[iout:] [s] in turn from the solved state (q, v, vd, lam) at st[0], writing
     [q, v] rows into Y, vd into VD and the multipliers (zero at inactive rows) into LAM; stops after
     `chunk` outputs; st and p6 as in `advance`. Returns (status, next iout); on failure st[0] and (q, v)
     are the last solved state."""
-    nq = q.shape[0]
     written = 0
     while iout < tout.shape[0]:
         status = advance(cm, wk, st, tout[iout], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
         if status != OK:
             return status, iout
-        for i in range(nq):
-            Y[iout, i] = q[i]
-        for i in range(v.shape[0]):
-            Y[iout, nq + i] = v[i]
-            VD[iout, i] = vd[i]
-        for i in range(lam.shape[0]):
-            LAM[iout, i] = lam[i]
+        _store(q, v, vd, lam, Y, VD, LAM, iout)
         iout += 1
         written += 1
         stats[0] += 1
@@ -199,11 +205,5 @@ def states_at(cm, wk, times, Y, VD, LAM, ts, Yo, VDo, LAMo, tol, stats, S, dx6, 
             st[2] = times[k] - times[k - 1]
         if ts[j] > times[k] and advance(cm, wk, st, ts[j], q, v, vd, lam, tol, stats, S, dx6, a6, p6) != OK:
             return j
-        for i in range(nq):
-            Yo[j, i] = q[i]
-        for i in range(v.shape[0]):
-            Yo[j, nq + i] = v[i]
-            VDo[j, i] = vd[i]
-        for i in range(lam.shape[0]):
-            LAMo[j, i] = lam[i]
+        _store(q, v, vd, lam, Yo, VDo, LAMo, j)
     return ts.shape[0]

@@ -14,12 +14,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import AnalysisInterrupted, MbdsimError, SolverError
+from ..errors import SolverError
 from ..results.result import Result
 from ..results.stream import notify
 from ..system.compiled import Work, compile_system
 from . import fastdyn, fastkin
-from .compiled_run import CHUNK, _MESSAGES, _full_multipliers
+from .compiled_run import CHUNK, _MESSAGES, _full_multipliers, failure
 from .fastdyn import INTERRUPTED, OK
 
 PROJ_TOL = 1e-12   # Newton tolerance on max |phi| [m or rad], as the compiled integrator's projection
@@ -123,17 +123,8 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
         return None
     success, message, error = True, "ok", None
     if status != OK:
-        from .common import _weak_joints
-        try:
-            joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
-                                                                   rep.rows)
-        except (MbdsimError, np.linalg.LinAlgError, ValueError):
-            joints = []
-        cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-        error = cls(_MESSAGES.get(status, "kinematic solve failed"), time=t_fail, joints=joints,
-                    state=y_fail[:sys.nq])
-        last = f"{times[n - 1]:.9g}" if n else "none"
-        success, message = False, f"{error}; last good output at t = {last} s"
+        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "kinematic solve failed")
+        success = False
     s = run.stats
     stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,
              "factorizations": int(s[4]), "projections": int(s[3]), "order": None, "method": METHOD,
