@@ -253,7 +253,7 @@ def _solve(cm, wk, F, c_rows, x6, lam):
         return
     t = cm[30]
     kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
-              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[31], F, c_rows, x6, lam, wk[38], wk[41])
+              wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[21], F, c_rows, x6, lam, wk[38], wk[41])
 
 
 @njit(cache=True, _nrt=False)
@@ -451,9 +451,22 @@ def project(cm, wk, t, q, v, tol, exact_factor=True):
         increment_into(cm, q, x6)
     if not ok:
         return PROJECTION
-    # velocities: v <- v + dv with M dv + J^T mu = 0, J dv = nu - J v, at the rows just evaluated
-    if (exact_factor or not factored) and not _factor(cm, wk):
+    return project_velocities(cm, wk, v, exact_factor or not factored)
+
+
+@njit(cache=True, _nrt=False)
+def project_velocities(cm, wk, v, refactor=True):
+    """v onto phi_q v = nu (mass-weighted minimum-norm correction dv: M dv + J^T mu = 0, J dv = nu - J v)
+    in place, with wk holding the constraint rows at the current positions (`_constraints`, after a
+    converged position Newton); refactor=False reuses the factorisation in wk. Leaves in wk the
+    factorisation used (at these positions when refactor). Returns OK or SINGULAR."""
+    if refactor and not _factor(cm, wk):
         return SINGULAR
+    active = cm[32]
+    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
+    for f in range(zero6.shape[0]):
+        for k in range(6):
+            zero6[f, k] = 0.0
     v6 = wk[30]
     _to6(cm, v, v6)
     Jc, bi, bj, nu = wk[5], cm[12], cm[13], wk[6]

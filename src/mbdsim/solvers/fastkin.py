@@ -12,7 +12,7 @@ ground axes and angular velocities [rad/s] in body axes); the predictions use th
 `fastdyn.increment_into` (translation [m] in ground axes, rotation vector [rad] in body axes). Each
 time is reached from the previous solved state by sub-steps: q + h qdot + h^2/2 qddot + h^3/6 qdddot
 predicted (the third derivative from the accelerations at the start and end of the previous sub-step),
-Newton on the positions, `fastdyn.project` for the velocities, `fastdyn.accelerations` for vd and the
+Newton on the positions, `fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the
 multipliers. A sub-step is retried at half length when the Newton iteration fails, when it turns any
 body by more than MAX_TURN, or when its correction is large against the predicted motion (a guard
 against converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned
@@ -25,7 +25,7 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .fastdyn import (NONFINITE, OK, PROJECTION, _constraints, _factor, _solve, _to6, accelerations,
-                      increment_into, normalize_into, project)
+                      increment_into, normalize_into, project_velocities)
 
 MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-step
 MAX_NEWTON = 12       # Newton iterations per sub-step
@@ -113,8 +113,8 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
             v[i] += h * vd[i]   # (the projection makes v exact: a prediction only)
         increment_into(cm, q, dx6)
         status, size = _newton(cm, wk, t + h, q, v, tol, stats)
-        if status == OK:
-            status = project(cm, wk, t + h, q, v, tol, True)
+        if status == OK:   # the rows in wk are at the converged q: the velocities directly
+            status = project_velocities(cm, wk, v, True)
             stats[3] += 1
             stats[4] += 1
         if status == OK and cm[31][4] == 0 and wk[41][0] < cm[30][8].shape[0]:

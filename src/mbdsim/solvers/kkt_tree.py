@@ -11,7 +11,9 @@ child body c to its parent p,
 both formed from triangular solves with the Cholesky factors (D = L L^T: S_j = Z Z^T, Z = L_D^-1 JC^T;
 JP^T S^-1 JP = Y^T Y, Y = L_S^-1 JP),
 and the solve is one backward and one forward sweep. The loop rows K enter through the Schur complement
-(K W) lambda_L = K vd0 - c_L with W = tree solve of K^T, so the cost is O(N (1 + n_loop)). Every body has
+(K W) lambda_L = K vd0 - c_L with W = tree solve of K^T, so the cost is O(N (1 + n_loop)); the tree
+rows' multipliers of those solves (LT) are kept with W, so that a solve is one tree solve and the loop
+correction vd = vd0 - W lambda_L, lambda_T = lambda_T0 - LT lambda_L (linearity). Every body has
 six velocity slots here (CM velocity [m/s], body-axes angular velocity [rad/s]); a particle's rotational
 slots carry a unit dummy inertia and no load. Rows are global row indices into the compact Jacobian
 Jc (nc, 2, 6) of `system.kernels.rows_kernel`. Kernels return False when a pivot is not positive
@@ -206,9 +208,10 @@ def _row_dot(Jc, bi, bj, row, x):
 
 @njit(cache=True, _nrt=False)
 def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
-               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, lam_tmp, F, D, Z, perm):
+               loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, LT, F, D, Z, perm):
     """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular.
-    F (nf, 6), D (6, 6) and Z (6, 6) are scratch."""
+    W (nl, nf, 6) and LT (nl, nc): the tree solve of each loop row's K^T (velocity slots, and the tree
+    rows' multipliers). F (nf, 6), D (6, 6) and Z (6, 6) are scratch."""
     if not tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
                        LD, G, LS, JC, JP, D, Z):
         return False
@@ -227,7 +230,7 @@ def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_
             if f != 0:
                 for k in range(6):
                     F[f, k] = Jc[row, side, k]
-        tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c0, W[i], lam_tmp, Qt, u, D)
+        tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c0, W[i], LT[i], Qt, u, D)
         for side in range(2):
             f = bi[row] if side == 0 else bj[row]
             if f != 0:
@@ -285,9 +288,11 @@ def pivoted_chol(A, n, L3, perm):
 
 @njit(cache=True, _nrt=False)
 def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows, LD, G, LS, JC, JP, Qt, u,
-              W, LK, lamL, F2, F, c_rows, vd, lam, X, perm):
+              W, LK, lamL, LT, F, c_rows, vd, lam, X, perm):
     """Solve the factored system for loads F (nf, 6) and row right-hand sides c_rows (nc,);
-    writes vd (nf, 6) and lam (nc,) at every tree and loop row. X (>= 2, 6) is scratch."""
+    writes vd (nf, 6) and lam (nc,) at every tree and loop row: one tree solve, then the loop rows'
+    multipliers from the Schur complement and their correction through W and LT of `kkt_factor`.
+    X (>= 2, 6) is scratch."""
     tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X)
     nl = loop_rows.shape[0]
     if nl == 0:
@@ -297,18 +302,18 @@ def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows,
         row = loop_rows[perm[1 + a]]
         lamL[0, a] = _row_dot(Jc, bi, bj, row, vd) - c_rows[row] if a < rank else 0.0
     chol_solve(LK, 0, rank, lamL, 0)
-    for f in range(F.shape[0]):
-        for k in range(6):
-            F2[f, k] = F[f, k]
     for a in range(nl):
-        row = loop_rows[perm[1 + a]]
-        lam[row] = lamL[0, a]
-        for side in range(2):
-            f = bi[row] if side == 0 else bj[row]
-            if f != 0:
-                for k in range(6):
-                    F2[f, k] -= Jc[row, side, k] * lamL[0, a]
-    tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, G, LS, JC, JP, F2, c_rows, vd, lam, Qt, u, X)
+        i = perm[1 + a]
+        la = lamL[0, a]
+        lam[loop_rows[i]] = la
+        if la == 0.0:
+            continue
+        for f in range(vd.shape[0]):
+            for k in range(6):
+                vd[f, k] -= W[i, f, k] * la
+        for r in range(blk_rows.shape[0]):
+            row = blk_rows[r]
+            lam[row] -= LT[i, row] * la
 
 
 @njit(cache=True, _nrt=False)

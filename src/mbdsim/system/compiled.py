@@ -99,7 +99,7 @@ class Work:
         z = np.zeros
         a = (z((nf, 3)), z((nf, 3, 3)), z((nf, 3)), z((nf, 3)), z(nc), z((nc, 2, 6)), z(nc), z(nc), z((nf, 6)),
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
-             z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z(nc), z((3, nd)), z(4),
+             z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z((nl, nc)), z((3, nd)), z(4),
              z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
              z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
              # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
