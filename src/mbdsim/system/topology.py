@@ -87,15 +87,37 @@ def spanning_tree(nf: int, edges: list[tuple[str, int, int]], rows_of: dict[str,
 
 
 def system_topology(sys, rows) -> Topology:
-    """Topology of a System for its independent rows `rows` (joints as edges; motions join their joint)."""
-    model = sys.model
-    joint_of = {m.name: m.joint.name for m in model.motions.values()}
+    """Topology of a System for its independent rows `rows` (joints as edges; motions join their joint).
+    The joint graph and each row's joint are kept in sys.derived, and so are the topologies of the last
+    few row sets asked for (functions of the System alone)."""
+    rows = np.asarray(rows, dtype=int)
+    kept = sys.derived.setdefault("topologies", {})
+    key = rows.tobytes()
+    topo = kept.get(key)
+    if topo is None:
+        if len(kept) >= 4:
+            kept.clear()
+        topo = kept[key] = _system_topology(sys, rows)
+    return topo
+
+
+def _joint_graph(sys):
+    """(edges (name, frame_i, frame_j) of the joints between two frames, each row's joint or owner name)."""
+    graph = sys.derived.get("joint_graph")
+    if graph is None:
+        model = sys.model
+        joint_of = {m.name: m.joint.name for m in model.motions.values()}
+        edges = [(j.name, sys.fid[j.body_i], sys.fid[j.body_j]) for j in model.joints.values()
+                 if sys.fid[j.body_i] != sys.fid[j.body_j]]
+        graph = sys.derived["joint_graph"] = (edges, [joint_of.get(o, o) for o in sys.row_owner])
+    return graph
+
+
+def _system_topology(sys, rows) -> Topology:
+    edges, row_joint = _joint_graph(sys)
     rows_of: dict[str, list[int]] = {}
-    for r in np.asarray(rows, dtype=int):
-        owner = sys.row_owner[r]
-        rows_of.setdefault(joint_of.get(owner, owner), []).append(int(r))
-    edges = [(j.name, sys.fid[j.body_i], sys.fid[j.body_j]) for j in model.joints.values()
-             if sys.fid[j.body_i] != sys.fid[j.body_j]]
+    for r in rows.tolist():
+        rows_of.setdefault(row_joint[r], []).append(r)
     known = {e[0] for e in edges}
     rows_of_edges = {k: v for k, v in rows_of.items() if k in known}
     topo = spanning_tree(sys.nbody + 1, edges, rows_of_edges)
