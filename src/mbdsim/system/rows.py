@@ -35,7 +35,7 @@ def _tree_plan(sys, nc):
     if plan is not None and plan[0] == nc:
         return plan[1]
     from .topology import system_topology
-    topo = system_topology(sys, np.arange(nc))
+    topo = system_topology(sys, np.arange(nc))   # (the topology of all rows is kept in sys.derived)
     vadr, rigid = sys.frame_v_adr, sys.frame_rigid
     shapes: dict = {}
     ok = True

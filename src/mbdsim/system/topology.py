@@ -88,8 +88,10 @@ def spanning_tree(nf: int, edges: list[tuple[str, int, int]], rows_of: dict[str,
 
 def system_topology(sys, rows) -> Topology:
     """Topology of a System for its independent rows `rows` (joints as edges; motions join their joint).
-    The joint graph and each row's joint are kept in sys.derived, and so are the topologies of the last
-    few row sets asked for (functions of the System alone)."""
+    The joint graph, each row's joint and the topology of all rows are kept in sys.derived, and so are
+    the topologies of the last few row sets asked for (functions of the System alone).  When no joint
+    has more than 6 rows the tree does not depend on the rows (spanning_tree), so the topology of a
+    strictly increasing subset of the rows is that of all rows with the other rows left out."""
     rows = np.asarray(rows, dtype=int)
     kept = sys.derived.setdefault("topologies", {})
     key = rows.tobytes()
@@ -97,8 +99,47 @@ def system_topology(sys, rows) -> Topology:
     if topo is None:
         if len(kept) >= 4:
             kept.clear()
-        topo = kept[key] = _system_topology(sys, rows)
+        full = _full_topology(sys)
+        if full is not None and _increasing_subset(rows, sys.nc):
+            topo = _restricted(full, rows, sys.nc)
+        else:
+            topo = _system_topology(sys, rows)
+        kept[key] = topo
     return topo
+
+
+def _full_topology(sys) -> Topology | None:
+    """Topology of all sys.nc rows when no joint has more than 6 of them, else None (kept)."""
+    kept = sys.derived.get("topology_all")
+    if kept is None:
+        edges, row_joint = _joint_graph(sys)
+        known = {e[0] for e in edges}
+        count: dict = {}
+        for name in row_joint:
+            count[name] = count.get(name, 0) + 1
+        small = all(n <= 6 for name, n in count.items() if name in known)
+        kept = sys.derived["topology_all"] = (_system_topology(sys, np.arange(sys.nc)) if small else None,)
+    return kept[0]
+
+
+def _increasing_subset(rows, nc) -> bool:
+    return len(rows) == 0 or (rows[0] >= 0 and rows[-1] < nc and bool(np.all(rows[1:] > rows[:-1])))
+
+
+def _restricted(full: Topology, rows, nc) -> Topology:
+    """The topology of all rows with those not in `rows` removed from the blocks and the loop rows."""
+    if len(rows) == nc:
+        return full
+    keep = np.zeros(nc, dtype=bool)
+    keep[rows] = True
+    inblk = keep[full.blk_rows]
+    counts = np.add.reduceat(inblk.astype(np.int64), full.blk_ptr[:-1]) if len(full.blk_rows) else \
+        np.zeros(len(full.blk_child), dtype=np.int64)
+    counts[full.blk_ptr[:-1] == full.blk_ptr[1:]] = 0   # reduceat of an empty block reads the next entry
+    ptr = np.zeros(len(full.blk_child) + 1, dtype=np.int64)
+    ptr[1:] = np.cumsum(counts)
+    return Topology(full.order, full.pblk, full.blk_child, full.blk_parent, ptr, full.blk_rows[inblk],
+                    full.ch_ptr, full.ch_blk, full.loop_rows[keep[full.loop_rows]])
 
 
 def _joint_graph(sys):
