@@ -165,7 +165,7 @@ def _assemble_system(model) -> System:
     M = np.zeros((nv, nv))
     for k, b in enumerate(bodies):
         a = v_adr[k + 1]
-        M[a:a + 3, a:a + 3] = b.mass * np.eye(3)
+        M[range(a, a + 3), range(a, a + 3)] = b.mass
         if not b.is_particle:
             J[k + 1] = b.inertia
             M[a + 3:a + 6, a + 3:a + 6] = b.inertia
@@ -182,7 +182,7 @@ def _assemble_system(model) -> System:
     not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
                     for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
     not_compiled += [f"sensor '{n}'" for n in getattr(model, "sensors", {})]
-    as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
+    as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
     return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                   as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
                   np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,

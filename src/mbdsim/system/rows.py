@@ -36,20 +36,20 @@ def _tree_plan(sys, nc):
         return plan[1]
     from .topology import system_topology
     topo = system_topology(sys, np.arange(nc))   # (the topology of all rows is kept in sys.derived)
-    vadr, rigid = sys.frame_v_adr, sys.frame_rigid
+    vadr, rigid = sys.frame_v_adr.tolist(), sys.frame_rigid.tolist()
+    ptr, flat = topo.blk_ptr.tolist(), topo.blk_rows.tolist()
     shapes: dict = {}
-    ok = True
-    for b, c in enumerate(topo.blk_child):
-        rows = topo.blk_rows[topo.blk_ptr[b]:topo.blk_ptr[b + 1]]
+    blocks: list | None = []
+    for b, c in enumerate(topo.blk_child.tolist()):
+        rows = flat[ptr[b]:ptr[b + 1]]
         width = 6 if rigid[c] else 3
-        if len(rows) == 0:
-            continue
         if len(rows) > width:
-            ok = False
+            blocks = None
             break
-        shapes.setdefault((len(rows), width), []).append((rows, vadr[c]))
-    blocks = None if not ok else [(np.array([r for r, _ in v]), np.array([a for _, a in v]), w)
-                                  for (_, w), v in shapes.items()]
+        if rows:
+            shapes.setdefault((len(rows), width), []).append((rows, vadr[c]))
+    if blocks is not None:
+        blocks = [(np.array([r for r, _ in v]), np.array([a for _, a in v]), w) for (_, w), v in shapes.items()]
     out = (topo, np.sort(topo.blk_rows), np.asarray(topo.loop_rows), blocks)
     sys.derived["tree_plan"] = (nc, out)
     return out

@@ -9,6 +9,7 @@ See docs/theory.md section "O(N) equations of motion".
 from __future__ import annotations
 
 from collections import deque
+from itertools import accumulate
 from dataclasses import dataclass
 
 import numpy as np
@@ -35,8 +36,7 @@ class Topology:
 
 
 def _csr(lists):
-    ptr = np.zeros(len(lists) + 1, dtype=np.int64)
-    ptr[1:] = np.cumsum([len(x) for x in lists])
+    ptr = np.fromiter(accumulate((len(x) for x in lists), initial=0), dtype=np.int64, count=len(lists) + 1)
     flat = np.array([i for x in lists for i in x], dtype=np.int64)
     return ptr, flat
 
