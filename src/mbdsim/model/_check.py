@@ -59,7 +59,7 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError(entity, field, f"expected a number, got {value!r}") from None
-    if not np.isfinite(x):
+    if not math.isfinite(x):
         raise ModelError(entity, field, f"must be finite, got {value!r}")
     if minimum is not None and (x < minimum or (strict and x == minimum)):
         rel = ">" if strict else ">="
