@@ -106,7 +106,8 @@ def perpendicular_frame(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarr
     """Right-handed orthonormal (f, g, h) with h the given unit axis (deterministic choice of f)."""
     h = np.asarray(h, dtype=float)
     h = h / math.sqrt(h.dot(h))          # as np.linalg.norm
-    trial = _UNIT[int(np.argmin(np.abs(h)))]
+    a0, a1, a2 = (abs(x) for x in h.tolist())
+    trial = _UNIT[0 if a0 <= a1 and a0 <= a2 else (1 if a1 <= a2 else 2)]   # np.argmin: the first least
     f = cross3(trial, h)
     f /= math.sqrt(f.dot(f))
     g = cross3(h, f)

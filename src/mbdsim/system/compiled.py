@@ -162,7 +162,7 @@ def _loads(sys):
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
         else:
             raise NotCompiled(f"force element '{e.name}' ({type(e).__name__}) is not compiled yet")
-    arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape)  # noqa: E731
+    arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape) if x else np.zeros(shape, dt)  # noqa: E731
     n, m, nb = len(pf), len(sp), len(bu)
     bushings = (arr([b[0] for b in bu], (nb, 2), np.int64), arr([b[1] for b in bu], (nb, 2, 3)),
                 arr([b[2] for b in bu], (nb, 2, 3, 3)), arr([b[3] for b in bu], (nb, 6)),

@@ -26,16 +26,18 @@ def independent_rows(J, tol=1e-9, sys=None):
     return np.sort(piv[:rank])
 
 
-def _tree_plan(sys, nc):
-    """What the tree-first selection needs of the System's structure alone (kept in sys.derived): the
-    topology of all nc rows, its sorted tree rows, its loop rows, and the blocks as (rows (nb, k),
-    first velocity column (nb,), width) stacks of equal shape, or None when a block has more rows than
-    its body has velocities."""
-    plan = sys.derived.get("tree_plan")
-    if plan is not None and plan[0] == nc:
-        return plan[1]
-    from .topology import system_topology
-    topo = system_topology(sys, np.arange(nc))   # (the topology of all rows is kept in sys.derived)
+def _tree_plan(sys):
+    """What the tree-first selection needs of the System's structure alone (kept in sys.derived and
+    shared by Systems of the same structure, topology.shared): the topology of all rows, its sorted
+    tree rows, its loop rows, and the blocks as (rows (nb, k), first velocity column (nb,), width)
+    stacks of equal shape, or None when a block has more rows than its body has velocities."""
+    from .topology import shared
+    return shared(sys, "tree_plan", _make_tree_plan)
+
+
+def _make_tree_plan(sys):
+    from .topology import _system_topology
+    topo = _system_topology(sys, np.arange(sys.nc))
     vadr, rigid = sys.frame_v_adr.tolist(), sys.frame_rigid.tolist()
     ptr, flat = topo.blk_ptr.tolist(), topo.blk_rows.tolist()
     shapes: dict = {}
@@ -50,9 +52,7 @@ def _tree_plan(sys, nc):
             shapes.setdefault((len(rows), width), []).append((rows, vadr[c]))
     if blocks is not None:
         blocks = [(np.array([r for r, _ in v]), np.array([a for _, a in v]), w) for (_, w), v in shapes.items()]
-    out = (topo, np.sort(topo.blk_rows), np.asarray(topo.loop_rows), blocks)
-    sys.derived["tree_plan"] = (nc, out)
-    return out
+    return topo, np.sort(topo.blk_rows), np.asarray(topo.loop_rows), blocks
 
 
 def _tree_first_rows(sys, J, tol):
@@ -60,7 +60,7 @@ def _tree_first_rows(sys, J, tol):
     rows whose projection on the tree rows' null space is independent (pivoted QR of that small block);
     None when the tree rows are dependent (the caller's pivoted QR decides). Dense factorisations for
     small systems, sparse (O(N) for chains and trees) beyond DENSE_LIMIT velocity variables."""
-    _, tree, loop, blocks = _tree_plan(sys, J.shape[0])
+    _, tree, loop, blocks = _tree_plan(sys)
     if len(tree) == 0:
         return None
     scale = max(1.0, float(np.abs(J).max()))
@@ -77,7 +77,7 @@ def _tree_first_rows(sys, J, tol):
     if P is None:
         return None
     if len(loop) == 0:
-        return tree
+        return tree.copy()   # (the plan is shared)
     dd, piv = pivoted_qr(P.T)
     rank = int(np.sum(dd > tol * scale))
     return np.sort(np.concatenate([tree, loop[piv[:rank]]]))
