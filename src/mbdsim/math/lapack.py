@@ -65,3 +65,22 @@ def null_space(a) -> np.ndarray:
         raise ValueError(f"illegal value in {-info}th argument of internal gesdd")
     tol = np.amax(s, initial=0.0) * (np.finfo(float).eps * max(m, n))
     return vh[np.sum(s > tol, dtype=int):, :].T.copy()
+
+
+def cho_solve_spd(a, b) -> np.ndarray:
+    """x with a x = b for a symmetric positive-definite a, as scipy.linalg.cho_solve(cho_factor(a), b)
+    (LAPACK dpotrf, dpotrs, upper factor); np.linalg.LinAlgError when a is not positive definite,
+    ValueError for an inf or a NaN."""
+    a, b = _finite(a), _finite(b)
+    if a.size == 0 or b.size == 0 or a.ndim != 2 or a.shape[0] != a.shape[1] or a.shape[0] != b.shape[0]:
+        import scipy.linalg as sla
+        return sla.cho_solve(sla.cho_factor(a), b)   # edge cases and errors exactly as scipy's
+    c, info = lapack.dpotrf(a, lower=0, clean=0)
+    if info > 0:
+        raise np.linalg.LinAlgError(f"{info}-th leading minor of the array is not positive definite")
+    if info < 0:
+        raise ValueError(f'LAPACK reported an illegal value in {-info}-th argument on entry to "POTRF".')
+    x, info = lapack.dpotrs(c, b, lower=0)
+    if info != 0:
+        raise ValueError(f"illegal value in {-info}th argument of internal potrs")
+    return x
