@@ -28,6 +28,7 @@ from .constraints.driver import driver_rows
 from .constraints.path import path_specs
 from .constraints.registry import JOINT_TYPES
 from .force_elements.friction import lock_specs
+from .packing import pack_rows
 
 KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide")   # row kinds of system.kernels
 
@@ -183,12 +184,14 @@ def _assemble_system(model) -> System:
                     for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
     not_compiled += [f"sensor '{n}'" for n in getattr(model, "sensors", {})]
     as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
-    return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
-                  as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
-                  np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
-                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
-                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
-                  not_compiled)
+    sys = System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
+                 as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
+                 np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
+                 owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
+                 np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
+                 not_compiled)
+    sys.derived["packed"] = pack_rows(sys)   # the rows for the compiled kernels (system.packing)
+    return sys
 
 
 def joint_geometry(joint, fid) -> JointGeom:
