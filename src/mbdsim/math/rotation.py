@@ -104,9 +104,14 @@ def as_matrix(orientation) -> np.ndarray:
 
 def perpendicular_frame(h: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Right-handed orthonormal (f, g, h) with h the given unit axis (deterministic choice of f)."""
-    h = np.asarray(h, dtype=float) / np.linalg.norm(h)
-    trial = np.eye(3)[int(np.argmin(np.abs(h)))]
+    h = np.asarray(h, dtype=float)
+    h = h / math.sqrt(h.dot(h))          # as np.linalg.norm
+    a0, a1, a2 = (abs(x) for x in h.tolist())
+    trial = _UNIT[0 if a0 <= a1 and a0 <= a2 else (1 if a1 <= a2 else 2)]   # np.argmin: the first least
     f = cross3(trial, h)
-    f /= np.linalg.norm(f)
+    f /= math.sqrt(f.dot(f))
     g = cross3(h, f)
     return f, g, h
+
+
+_UNIT = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))

@@ -2,14 +2,22 @@
 from __future__ import annotations
 
 import inspect
+import math
 
 import numpy as np
 
 from ..errors import ModelError
 
 
+_NUMBERS = (float, int, np.float64)   # exact types, never booleans (bool is a subclass of int)
+
+
 def _has_bool(value) -> bool:
     """True when value is a boolean or a (nested) sequence holding one: True is not the number 1 here."""
+    if type(value) in _NUMBERS:
+        return False
+    if isinstance(value, (list, tuple)) and all(type(x) in _NUMBERS for x in value):
+        return False   # a flat sequence of numbers (the common case)
     if isinstance(value, (bool, np.bool_)):
         return True
     if isinstance(value, np.ndarray):
@@ -27,7 +35,7 @@ def vector(entity: str, field: str, value, n: int = 3, what: str = "") -> np.nda
         raise ModelError(entity, field, f"expected {n} numbers, got {value!r}") from None
     if v.shape != (n,):
         raise ModelError(entity, field, f"expected {n} numbers{what}, got {value!r}")
-    if not np.all(np.isfinite(v)):
+    if not np.isfinite(v).all():
         raise ModelError(entity, field, f"values must be finite, got {value!r}")
     return v
 
@@ -36,7 +44,7 @@ def vec3(entity: str, field: str, value, unit: bool = False) -> np.ndarray:
     """A finite 3-vector (a unit vector when unit=True), else ModelError."""
     v = vector(entity, field, value, 3)
     if unit:
-        n = np.linalg.norm(v)
+        n = math.sqrt(v.dot(v))   # as np.linalg.norm of a vector
         if n < 1e-12:
             raise ModelError(entity, field, "direction vector must be non-zero")
         v = v / n
@@ -51,7 +59,7 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError(entity, field, f"expected a number, got {value!r}") from None
-    if not np.isfinite(x):
+    if not math.isfinite(x):
         raise ModelError(entity, field, f"must be finite, got {value!r}")
     if minimum is not None and (x < minimum or (strict and x == minimum)):
         rel = ">" if strict else ">="
@@ -77,11 +85,15 @@ def inertia_matrix(entity: str, value, strict: bool = True) -> np.ndarray:
     except (TypeError, ValueError):
         raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got {value!r}") from None
     J = np.diag(a) if a.shape == (3,) else a
-    if J.shape != (3, 3) or not np.all(np.isfinite(J)):
+    if J.shape != (3, 3) or not np.isfinite(J).all():
         raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got {value!r}")
-    if not np.allclose(J, J.T, atol=1e-12 * max(1.0, np.abs(J).max())):
-        raise ModelError(entity, "inertia", "matrix must be symmetric")
-    ev = np.linalg.eigvalsh(J)
+    big = float(np.abs(J).max())
+    if a.shape == (3,) and (big == 0.0 or 1e-100 < big < 1e100):
+        ev = np.sort(a)   # a diagonal matrix: symmetric, and LAPACK's eigenvalues are its entries exactly
+    else:   # np.allclose(J, J.T, atol=1e-12 * max(1, |J|max)) written out (J is finite)
+        if not (np.abs(J - J.T) <= 1e-12 * max(1.0, big) + 1e-5 * np.abs(J.T)).all():
+            raise ModelError(entity, "inertia", "matrix must be symmetric")
+        ev = np.linalg.eigvalsh(J)
     if ev.min() < -1e-12 * max(1.0, ev.max()):
         raise ModelError(entity, "inertia", f"must be positive semi-definite, eigenvalues {ev}")
     if ev[0] + ev[1] < ev[2] - 1e-6 * ev[2]:

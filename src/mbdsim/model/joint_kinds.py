@@ -89,14 +89,15 @@ def coupled_dofs(kind: str) -> tuple:
     return k.axis_dofs if k.coupled is None else k.coupled
 
 
-def pick_axis_dof(entity: str, joint, dof, loads: bool, no_axis: str) -> str:
+def pick_axis_dof(entity: str, joint, dof, loads: bool, no_axis) -> str:
     """The axis freedom of `joint` that `entity` acts on: `dof` ("rotation"/"translation") or, when None,
     the kind's first; ModelError(entity, "joint", no_axis) when the kind has none for a motion or coupler
-    (loads=False) or a load (loads=True), ModelError(entity, "dof") when `dof` is not one of them."""
+    (loads=False) or a load (loads=True), ModelError(entity, "dof") when `dof` is not one of them.
+    no_axis: the message, or a function giving it (called only then)."""
     from ..errors import ModelError
     allowed = axis_dofs(joint.kind, loads)
     if not allowed:
-        raise ModelError(entity, "joint", no_axis)
+        raise ModelError(entity, "joint", no_axis() if callable(no_axis) else no_axis)
     if dof is None:
         return allowed[0]
     if dof not in allowed:

@@ -243,7 +243,7 @@ class ExprLoadsMixin:
         try:
             jt = self._lookup(joint, self.joints, entity, "joint")
             from .joint_kinds import kinds_with_axis, pick_axis_dof
-            dof = pick_axis_dof(entity, jt, dof, True, f"a {jt.kind} joint has no single axis; use a "
+            dof = pick_axis_dof(entity, jt, dof, True, lambda: f"a {jt.kind} joint has no single axis; use a "
                                 f"{', '.join(kinds_with_axis(loads=True))} joint")
             if jt.body_j.is_particle and dof == "rotation":
                 raise ModelError(entity, "joint", f"body_j of joint {jt.name!r} is a particle: no torque")

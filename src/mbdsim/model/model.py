@@ -378,7 +378,7 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
     def _motion_dof(entity, joint, dof):
         from .joint_kinds import kinds_with_axis, pick_axis_dof
         return pick_axis_dof(entity, joint, dof, False,
-                             f"cannot drive a {joint.kind} joint; use {', '.join(kinds_with_axis())}")
+                             lambda: f"cannot drive a {joint.kind} joint; use {', '.join(kinds_with_axis())}")
 
     def _repr_html_(self) -> str:  # Jupyter summary
         from ..viewer.notebook import model_html; return model_html(self)  # noqa: E702

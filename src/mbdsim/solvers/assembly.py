@@ -130,11 +130,12 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:
-        q, changed = positions(sys, q0, t, rows_all, tol, held=own_q)
+        q, changed, terms = _positions(sys, q0, t, rows_all, tol, held=own_q)
     except AssemblyError:
         _overdriven_failure(sys, q0, t, rows_all, tol)
         raise
-    terms = constraint_terms(sys, q, np.zeros(sys.nv), t)   # phi, phi_q and nu do not depend on v
+    if terms is None:   # phi, phi_q and nu do not depend on v
+        terms = constraint_terms(sys, q, np.zeros(sys.nv), t)
     J = terms[1][rows_all]
     rows = independent_rows(J, sys=sys)
     _check_overdriven(sys, J, rows, t, q)
@@ -171,13 +172,19 @@ def positions(sys, q0, t, rows, tol, held=True):
     """Newton onto phi(q, t) = 0 with steps least in the position metric (system.metrics.position_metric); with
     `held`, the joints' initial displacements are reached by continuation from as drawn (so the branch
     is kept) and held exactly when consistent.  Returns (q, changed items)."""
+    return _positions(sys, q0, t, rows, tol, held)[:2]
+
+
+def _positions(sys, q0, t, rows, tol, held=True):
+    """positions, and constraint_terms(sys, q, 0, t) of all rows at the q returned when Newton
+    evaluated them there last (else None)."""
     D = position_metric(sys)
     items = joint_position_items(sys, q0) if held else []
     q = q0
     if not items:
-        q, res = _newton(sys, q0, t, rows, tol, D)
+        q, res, terms = _newton(sys, q0, t, rows, tol, D)
         _check_residual(sys, q, t, rows, res)
-        return q, []
+        return q, [], terms
     L = length_scale(sys)
     span = max(max(float(np.max(np.abs(np.where(it.angle, it.g, it.g / L)))) for it in items), 1e-300)
     n = int(min(400, max(1, np.ceil(span / 0.2))))
@@ -185,7 +192,7 @@ def positions(sys, q0, t, rows, tol, held=True):
     for k in range(1, n + 1):
         q, consistent, items = _held_newton(sys, q, t, rows, tol, M, k / n)
     _check_residual(sys, q, t, rows, _residual(sys, q, t, rows))
-    return q, ([] if consistent else changed_items(items, None))
+    return q, ([] if consistent else changed_items(items, None)), None
 
 
 def _held_newton(sys, q, t, rows, tol, M, scale, maxit=50):
@@ -208,9 +215,10 @@ def _held_newton(sys, q, t, rows, tol, M, scale, maxit=50):
 
 def _newton(sys, q0, t, rows, tol, D, maxit=50):
     """Newton with steps least in the diagonal metric D: dx = D^-1/2 (J D^-1/2)^+ (-phi); when full steps
-    do not converge (a body drawn far off), again with backtracking on |phi|."""
-    q, res = _newton_run(sys, q0, t, rows, tol, D, maxit, False)
-    return (q, res) if res <= 1e-9 else _newton_run(sys, q0, t, rows, tol, D, 4 * maxit, True)
+    do not converge (a body drawn far off), again with backtracking on |phi|.  Returns (q, max |phi|,
+    the constraint terms at q when the last evaluation was there, else None)."""
+    q, res, terms = _newton_run(sys, q0, t, rows, tol, D, maxit, False)
+    return (q, res, terms) if res <= 1e-9 else _newton_run(sys, q0, t, rows, tol, D, 4 * maxit, True)
 
 
 def _newton_run(sys, q, t, rows, tol, D, maxit, backtrack):
@@ -219,10 +227,11 @@ def _newton_run(sys, q, t, rows, tol, D, maxit, backtrack):
     res = np.inf
     norm = lambda x: float(np.linalg.norm(constraint_terms(sys, x, np.zeros(sys.nv), t, False)[0][rows]))  # noqa: E731
     for _ in range(maxit):
-        phi, J = (x[rows] for x in constraint_terms(sys, q, np.zeros(sys.nv), t)[:2])
+        terms = constraint_terms(sys, q, np.zeros(sys.nv), t)
+        phi, J = terms[0][rows], terms[1][rows]
         res = float(np.max(np.abs(phi), initial=0.0))
         if res <= tol:
-            break
+            return q, res, terms
         dx = s * min_norm_solve(J * s, -phi)
         step, n0 = 1.0, float(np.linalg.norm(phi))
         while backtrack and step > 1e-3 and res > 1e-6 and norm(increment(sys, q, step * dx)) >= n0:
@@ -230,7 +239,7 @@ def _newton_run(sys, q, t, rows, tol, D, maxit, backtrack):
         q = increment(sys, q, step * dx)
         if float(np.max(np.abs(dx))) < 1e-15 * max(1.0, float(np.max(np.abs(q)))):
             break
-    return q, res
+    return q, res, None
 
 
 def _residual(sys, q, t, rows):
@@ -268,7 +277,8 @@ def _check_overdriven(sys, J, rows, t, q):
     motions = [m for m in sys.model.motions if m in sys.owner_rows]
     bad = []
     for m in motions:
-        keep = np.setdiff1d(np.arange(J.shape[0]), sys.owner_rows[m])
+        keep = np.ones(J.shape[0], dtype=bool)
+        keep[sys.owner_rows[m]] = False
         if len(independent_rows(J[keep])) == len(rows):   # m adds nothing: it is implied by the rest
             bad.append(m)
     if bad:

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as sla
 
+from ..math.lapack import cho_solve_spd
 from ..system import measures as ms
 from ..system.frames import body_frames
 
@@ -97,7 +98,7 @@ def velocity_items(sys, q):
         x, _, rows, _, _ = joint_values(sys, jt, q)
         out.append(Held(f"joint '{jt.name}'", "initial_velocity", jt.initial_velocity[:len(x)], rows,
                         np.zeros(len(x)), np.zeros(len(x), dtype=bool)))
-    fr = body_frames(sys, q)
+    fr = body_frames(sys, q) if any(b.angular_velocity_given for b in sys.bodies) else None
     for k, b in enumerate(sys.bodies):
         a = sys.frame_v_adr[k + 1]
         if b.velocity_given:
@@ -123,8 +124,9 @@ def lexi_solve(J, b, items, M, rel_tol=1e-9):
     if not items and J.shape[0]:   # nothing held: x = M^-1 J^T (J M^-1 J^T)^-1 b when J has full row rank
         MiJt = np.linalg.solve(M, J.T)
         try:
-            x = MiJt @ sla.cho_solve(sla.cho_factor(J @ MiJt), b)
-            if np.allclose(J @ x, b, rtol=1e-10, atol=1e-12 * max(1.0, float(np.abs(b).max()))):
+            x = MiJt @ cho_solve_spd(J @ MiJt, b)   # scipy's cho_solve(cho_factor(.)) without its checks
+            atol = 1e-12 * max(1.0, float(np.abs(b).max()))
+            if (np.abs(J @ x - b) <= atol + 1e-10 * np.abs(b)).all():   # np.allclose(J x, b, 1e-10, atol)
                 return x, True
         except (np.linalg.LinAlgError, ValueError):
             pass   # dependent rows or an inconsistent b: the general path below

@@ -28,6 +28,7 @@ from .constraints.driver import driver_rows
 from .constraints.path import path_specs
 from .constraints.registry import JOINT_TYPES
 from .force_elements.friction import lock_specs
+from .packing import pack_rows
 
 KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide")   # row kinds of system.kernels
 
@@ -165,7 +166,7 @@ def _assemble_system(model) -> System:
     M = np.zeros((nv, nv))
     for k, b in enumerate(bodies):
         a = v_adr[k + 1]
-        M[a:a + 3, a:a + 3] = b.mass * np.eye(3)
+        M[range(a, a + 3), range(a, a + 3)] = b.mass
         if not b.is_particle:
             J[k + 1] = b.inertia
             M[a + 3:a + 6, a + 3:a + 6] = b.inertia
@@ -182,13 +183,15 @@ def _assemble_system(model) -> System:
     not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
                     for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
     not_compiled += [f"sensor '{n}'" for n in getattr(model, "sensors", {})]
-    as_idx = lambda x, n: np.array([list(r) for r in x], dtype=int).reshape(-1, n)  # noqa: E731
-    return System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
-                  as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
-                  np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
-                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
-                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
-                  not_compiled)
+    as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
+    sys = System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
+                 as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
+                 np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
+                 owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
+                 np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
+                 not_compiled)
+    sys.derived["packed"] = pack_rows(sys)   # the rows for the compiled kernels (system.packing)
+    return sys
 
 
 def joint_geometry(joint, fid) -> JointGeom:

@@ -112,6 +112,15 @@ class Work:
         return self.arrays_
 
 
+def _singular_masses(M6) -> bool:
+    """True when a body's 6x6 mass matrix (stack (n, 6, 6)) has an eigenvalue <= 1e-12 of its largest
+    entry (one batched eigvalsh)."""
+    if not len(M6):
+        return False
+    ev = np.linalg.eigvalsh(M6)
+    return bool(np.any(ev.min(axis=1) <= 1e-12 * np.maximum(np.abs(M6).max(axis=(1, 2)), 1e-300)))
+
+
 def _driver_programs(fns):
     """Packed value/d1/d2 programs of every driver function, or NotCompiled."""
     if not fns:
@@ -153,7 +162,7 @@ def _loads(sys):
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
         else:
             raise NotCompiled(f"force element '{e.name}' ({type(e).__name__}) is not compiled yet")
-    arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape)  # noqa: E731
+    arr = lambda x, shape, dt=float: np.array(x, dtype=dt).reshape(shape) if x else np.zeros(shape, dt)  # noqa: E731
     n, m, nb = len(pf), len(sp), len(bu)
     bushings = (arr([b[0] for b in bu], (nb, 2), np.int64), arr([b[1] for b in bu], (nb, 2, 3)),
                 arr([b[2] for b in bu], (nb, 2, 3, 3)), arr([b[3] for b in bu], (nb, 6)),
@@ -189,17 +198,19 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         raise NotCompiled("joint friction (stick/slip) is not compiled yet")
     nf = sys.nbody + 1
     M6 = np.zeros((nf, 6, 6))
-    for f in range(nf):
-        M6[f] = np.eye(6)
-        if f:
-            M6[f, :3, :3] = sys.mass[f] * np.eye(3)
-            if sys.frame_rigid[f]:
-                M6[f, 3:, 3:] = sys.inertia_B[f]
-    kind, bi, bj, v1, v2, v3, drv, fns = kernels.pack_rows(sys)
+    M6[:, range(6), range(6)] = 1.0
+    M6[1:, range(3), range(3)] = sys.mass[1:, None]
+    rig = np.flatnonzero(sys.frame_rigid)
+    M6[rig, 3:, 3:] = sys.inertia_B[rig]
+    packed = sys.derived.get("packed")   # the rows as system.equations packed them, else packed here
+    if packed is None:
+        packed = sys.derived["packed"] = kernels.pack_rows(sys)
+    kind, bi, bj, v1, v2, v3, drv, fns = packed
+    kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     code, consts, tables, start, end, stack = _driver_programs(fns)
     bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
-    dense = any(np.linalg.eigvalsh(M6[f]).min() <= 1e-12 * max(np.abs(M6[f]).max(), 1e-300) for f in range(1, nf))
+    dense = _singular_masses(M6[1:])
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
         jointtree.tree_arrays(sys, rows, *state)
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES)]

@@ -4,7 +4,8 @@ part in a dependency, and the switched rows in force at a time.  Rows are those 
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
+
+from ..math.lapack import null_space, pivoted_qr, rank_of
 
 DENSE_LIMIT = 600   # velocity variables; larger systems use sparse factorisations (O(N) for chains, trees)
 
@@ -21,10 +22,37 @@ def independent_rows(J, tol=1e-9, sys=None):
         rows = _tree_first_rows(sys, J, tol)
         if rows is not None:
             return rows
-    _, R, piv = sla.qr(J.T, mode="economic", pivoting=True)
-    d = np.abs(np.diag(R))
-    rank = int(np.sum(d > tol * max(1.0, d[0] if len(d) else 1.0)))
+    rank, piv = rank_of(J.T, tol)
     return np.sort(piv[:rank])
+
+
+def _tree_plan(sys):
+    """What the tree-first selection needs of the System's structure alone (kept in sys.derived and
+    shared by Systems of the same structure, topology.shared): the topology of all rows, its sorted
+    tree rows, its loop rows, and the blocks as (rows (nb, k), first velocity column (nb,), width)
+    stacks of equal shape, or None when a block has more rows than its body has velocities."""
+    from .topology import shared
+    return shared(sys, "tree_plan", _make_tree_plan)
+
+
+def _make_tree_plan(sys):
+    from .topology import _system_topology
+    topo = _system_topology(sys, np.arange(sys.nc))
+    vadr, rigid = sys.frame_v_adr.tolist(), sys.frame_rigid.tolist()
+    ptr, flat = topo.blk_ptr.tolist(), topo.blk_rows.tolist()
+    shapes: dict = {}
+    blocks: list | None = []
+    for b, c in enumerate(topo.blk_child.tolist()):
+        rows = flat[ptr[b]:ptr[b + 1]]
+        width = 6 if rigid[c] else 3
+        if len(rows) > width:
+            blocks = None
+            break
+        if rows:
+            shapes.setdefault((len(rows), width), []).append((rows, vadr[c]))
+    if blocks is not None:
+        blocks = [(np.array([r for r, _ in v]), np.array([a for _, a in v]), w) for (_, w), v in shapes.items()]
+    return topo, np.sort(topo.blk_rows), np.asarray(topo.loop_rows), blocks
 
 
 def _tree_first_rows(sys, J, tol):
@@ -32,14 +60,11 @@ def _tree_first_rows(sys, J, tol):
     rows whose projection on the tree rows' null space is independent (pivoted QR of that small block);
     None when the tree rows are dependent (the caller's pivoted QR decides). Dense factorisations for
     small systems, sparse (O(N) for chains and trees) beyond DENSE_LIMIT velocity variables."""
-    from .topology import system_topology
-    topo = system_topology(sys, np.arange(J.shape[0]))
-    tree = np.sort(topo.blk_rows)
-    loop = np.asarray(topo.loop_rows)
+    _, tree, loop, blocks = _tree_plan(sys)
     if len(tree) == 0:
         return None
     scale = max(1.0, float(np.abs(J).max()))
-    if not _blocks_independent(sys, J, topo, tol * scale):
+    if not _blocks_independent(J, blocks, tol * scale):
         return None
     if J.shape[1] > DENSE_LIMIT:
         P = _projected_loop_sparse(J, tree, loop)
@@ -52,26 +77,21 @@ def _tree_first_rows(sys, J, tol):
     if P is None:
         return None
     if len(loop) == 0:
-        return tree
-    _, R, piv = sla.qr(P.T, mode="economic", pivoting=True)
-    dd = np.abs(np.diag(R))
+        return tree.copy()   # (the plan is shared)
+    dd, piv = pivoted_qr(P.T)
     rank = int(np.sum(dd > tol * scale))
     return np.sort(np.concatenate([tree, loop[piv[:rank]]]))
 
 
-def _blocks_independent(sys, J, topo, thr):
+def _blocks_independent(J, blocks, thr):
     """Every tree block's rows independent on its child body's velocity variables (what the O(N) solve
-    needs: S_j = JC_j D^-1 JC_j^T positive definite)."""
-    vadr, rigid = sys.frame_v_adr, sys.frame_rigid
-    for b, c in enumerate(topo.blk_child):
-        rows = topo.blk_rows[topo.blk_ptr[b]:topo.blk_ptr[b + 1]]
-        if len(rows) == 0:
-            continue
-        cols = J[np.ix_(rows, np.arange(vadr[c], vadr[c] + (6 if rigid[c] else 3)))]
-        if len(rows) > cols.shape[1]:
-            return False
-        s = np.linalg.svd(cols, compute_uv=False)
-        if s.min() <= thr:
+    needs: S_j = JC_j D^-1 JC_j^T positive definite); blocks: see _tree_plan (None: a block has more
+    rows than velocities).  One batched SVD per block shape."""
+    if blocks is None:
+        return False
+    for rows, adr, width in blocks:
+        cols = J[rows[:, :, None], adr[:, None, None] + np.arange(width)]   # (nb, k, width)
+        if np.linalg.svd(cols, compute_uv=False).min() <= thr:
             return False
     return True
 
@@ -111,10 +131,12 @@ def min_norm_solve(J, r):
 
 def dependent_owners(sys, J, rows):
     """Names of the joints/motions whose rows take part in the dependencies of J."""
-    removed = np.setdiff1d(np.arange(J.shape[0]), rows)
-    if len(removed) == 0:
+    if len(rows) == J.shape[0]:
         return []
-    ns = sla.null_space(J.T)
+    keep = np.ones(J.shape[0], dtype=bool)
+    keep[rows] = False
+    removed = np.flatnonzero(keep)
+    ns = null_space(J.T)
     involved = np.where(np.any(np.abs(ns) > 1e-8, axis=1))[0]
     names = []
     for r in np.concatenate([involved, removed]):

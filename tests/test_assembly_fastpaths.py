@@ -1,0 +1,79 @@
+"""The fast paths of assembly and compilation give exactly what the general routines give: LAPACK called
+directly (math.lapack) as scipy's wrappers, the vectorised row packing (system.packing) as the kernels'
+reference packing, the topology of a row subset restricted from that of all rows as computed afresh,
+and Systems of the same structure sharing their topologies."""
+from __future__ import annotations
+
+import glob
+import os
+import warnings
+
+import numpy as np
+import pytest
+import scipy.linalg as sla
+
+from mbdsim.io import load_model
+from mbdsim.math import lapack
+from mbdsim.studies.models import slider_crank
+from mbdsim.system import kernels, topology
+from mbdsim.system.assemble import assemble_system, single_use
+
+EXAMPLES = sorted(glob.glob(os.path.join(os.path.dirname(__file__), "..", "examples", "*.yaml")))
+
+
+def _systems():
+    out = []
+    for path in EXAMPLES:
+        try:
+            model = load_model(path)
+        except Exception:   # not a model file (a study description)
+            continue
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            out.append(assemble_system(model))
+    return out + [assemble_system(slider_crank())]
+
+
+@pytest.mark.parametrize("shape", [(18, 21), (21, 18), (6, 5), (3, 7), (0, 4), (4, 0)])
+def test_lapack_as_scipy(shape):
+    rng = np.random.default_rng(1)
+    A = rng.standard_normal(shape)
+    if A.size:
+        A[:, -1] = A[:, 0] + A[:, 1]   # rank deficient
+    _, R, piv = sla.qr(A, mode="economic", pivoting=True)
+    d, piv2 = lapack.pivoted_qr(A)
+    assert np.array_equal(np.abs(np.diag(R)), d) and np.array_equal(piv, piv2)
+    assert np.array_equal(sla.null_space(A), lapack.null_space(A))
+    assert np.array_equal(sla.null_space(A.T), lapack.null_space(A.T))
+    S = A @ A.T + np.eye(shape[0])
+    b = rng.standard_normal(shape[0])
+    if shape[0]:
+        assert np.array_equal(lapack.cho_solve_spd(S, b), sla.cho_solve(sla.cho_factor(S), b))
+    with pytest.raises(ValueError):
+        lapack.pivoted_qr(np.full((2, 2), np.nan))
+
+
+def test_packing_and_topology_as_reference():
+    rng = np.random.default_rng(0)
+    for s in _systems():
+        fast, ref = s.derived["packed"], kernels.pack_rows(s)
+        for x, y in zip(fast[:7], ref[:7]):
+            assert x.dtype == y.dtype and np.array_equal(x, y)
+        assert all(f is g for f, g in zip(fast[7], ref[7])) and len(fast[7]) == len(ref[7])
+        for _ in range(50):
+            rows = np.sort(rng.choice(s.nc, rng.integers(0, s.nc + 1), replace=False))
+            s.derived.pop("topologies", None)
+            a, b = topology.system_topology(s, rows), topology._system_topology(s, rows)
+            for k in a.__dict__:
+                assert getattr(a, k).dtype == getattr(b, k).dtype and np.array_equal(getattr(a, k), getattr(b, k))
+
+
+def test_structure_shared_between_variants():
+    with single_use():
+        s1 = assemble_system(slider_crank(crank=0.2, rod=0.5))
+        s2 = assemble_system(slider_crank(crank=0.25, rod=0.45, speed=3.0))
+        s3 = assemble_system(slider_crank(crank=0.2, rod=0.5).__class__("other"))   # an empty model
+    assert topology.structure_key(s1) == topology.structure_key(s2) != topology.structure_key(s3)
+    assert topology._full_topology(s1) is topology._full_topology(s2)
+    t1 = topology.system_topology(s1, np.arange(s1.nc))
+    assert t1.blk_rows is not topology._full_topology(s1).blk_rows   # handed out as copies
