@@ -113,14 +113,14 @@ _SHARED_MAX = 16
 
 
 def structure_key(sys) -> tuple:
-    """What the joint graph, the rows' owners and the velocity layout of a System are made of (kept in
-    sys.derived): Systems with equal keys have the same topologies and tree plans."""
+    """What the joint graph (joint kinds included), the rows' owners and the velocity layout of a System
+    are made of (kept in sys.derived): Systems with equal keys have the same topologies and tree plans."""
     key = sys.derived.get("structure_key")
     if key is None:
         model = sys.model
         key = sys.derived["structure_key"] = (
             sys.nbody, sys.nc, tuple(sys.row_owner), tuple((m.name, m.joint.name) for m in model.motions.values()),
-            tuple((j.name, sys.fid[j.body_i], sys.fid[j.body_j]) for j in model.joints.values()),
+            tuple((j.name, j.kind, sys.fid[j.body_i], sys.fid[j.body_j]) for j in model.joints.values()),
             sys.frame_v_adr.tobytes(), sys.frame_rigid.tobytes())
     return key
 
