@@ -15,7 +15,7 @@ from ..system import measures as ms
 from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
-from ..system.frames import Frames, body_frames
+from ..system.frames import Frames, acceleration_terms, body_frames
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -85,13 +85,14 @@ class Result:
 
     @property
     def frames(self):
+        """Body frames of the samples (mbdsim.system.frames.Frames); the acceleration terms (rdd, alpha)
+        and the multipliers are computed on first use (most measures need positions and velocities only)."""
         if self._fr is None:
-            if self._vd is None and self._accelerations is not None:   # positions need no accelerations
-                self._fr = _LazyFrames(body_frames(self.system, self.q, self.v), self)
-            else:
-                self._fr = body_frames(self.system, self.q, self.v, self.vd)
-                self._fr.lambda_ = self.lambda_   # multipliers, for friction measures (force_elements.friction)
-            self._fr.t = self.time   # sample times, for time-dependent element measures
+            fr = body_frames(self.system, self.q, self.v)
+            if self._vd is not None or self._accelerations is not None:
+                fr = _LazyFrames(fr, self)
+            self._fr = fr
+            fr.t = self.time   # sample times, for time-dependent element measures
         return self._fr
 
     def at(self, t: float | ArrayLike) -> "Result":
@@ -463,22 +464,22 @@ def _spring(res, el):
 
 
 class _LazyFrames(Frames):
-    """Body frames of a Result whose accelerations (rdd, alpha) and multipliers are computed on first use."""
+    """Body frames of a Result whose accelerations (rdd, alpha) and multipliers (lambda_, for friction
+    measures: force_elements.friction) are computed on first use."""
 
     def __init__(self, fr: Frames, res: Result):
         self.r, self.A, self.rd, self.w = fr.r, fr.A, fr.rd, fr.w
         self._res = res
 
     def _full(self, key):
-        if key not in self.__dict__:   # body_frames' acceleration terms, on the rotations already computed
+        d = self.__dict__
+        if key not in d:
             res = self._res
-            sys, vd, rig = res.system, np.asarray(res.vd, dtype=float), res.system.rigid_fid
-            rdd, alpha = np.zeros(self.r.shape), np.zeros(self.r.shape)
-            rdd[..., 1:, :] = vd[..., sys.rd_idx]
-            if len(rig):
-                alpha[..., rig, :] = np.einsum("...ij,...j->...i", self.A[..., rig, :, :], vd[..., sys.w_idx])
-            self.__dict__.update(_rdd=rdd, _alpha=alpha, _lam=res.lambda_)
-        return self.__dict__[key]
+            if key == "_lam":
+                d["_lam"] = res.lambda_
+            else:   # body_frames' acceleration terms, on the rotations already computed
+                d["_rdd"], d["_alpha"] = acceleration_terms(res.system, self.A, res.vd)
+        return d[key]
 
     rdd = property(lambda self: self._full("_rdd"), lambda self, x: self.__dict__.__setitem__("_rdd", x))
     alpha = property(lambda self: self._full("_alpha"), lambda self, x: self.__dict__.__setitem__("_alpha", x))
