@@ -120,14 +120,26 @@ def _rotate(R, x):
     return np.einsum("...ij,...j->...i", R, x)
 
 
+def cross(a, b):
+    """Cross products a x b of stacks of 3-vectors (..., 3) (np.cross's arithmetic, without its axis
+    handling: several times faster on the short stacks of a Result)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out = np.empty(a.shape if a.shape == b.shape else np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
+
+
 def point_state(fr: Frames, fid, s_B):
     """Ground position, velocity and (if available) acceleration of points s_B [m] fixed on frames fid."""
     A = fr.A[..., fid, :, :]
     s = np.einsum("...ij,...j->...i", A, s_B)
     w = fr.w[..., fid, :]
     pos = fr.r[..., fid, :] + s
-    vel = fr.rd[..., fid, :] + np.cross(w, s)
+    vel = fr.rd[..., fid, :] + cross(w, s)
     acc = None
     if fr.rdd is not None:
-        acc = fr.rdd[..., fid, :] + np.cross(fr.alpha[..., fid, :], s) + np.cross(w, np.cross(w, s))
+        acc = fr.rdd[..., fid, :] + cross(fr.alpha[..., fid, :], s) + cross(w, cross(w, s))
     return pos, vel, acc
