@@ -5,6 +5,7 @@ positions then measured from its origin).  SI units: m, m/s, m/s^2, rad, rad/s, 
 """
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -16,6 +17,7 @@ from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
 from ..system.frames import Frames, acceleration_terms, body_frames
+from ..system.reactions import joint_reaction
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -99,9 +101,11 @@ class Result:
         """The same Result API at time(s) t [s], evaluated from the solver's dense output."""
         ts = np.atleast_1d(np.asarray(t, dtype=float))
         lo, hi = self.time[0], self.time[-1]
-        if not np.all(np.isfinite(ts)) or np.any(ts < lo - 1e-12 * max(1, abs(lo))) or \
-                np.any(ts > hi + 1e-12 * max(1, abs(hi))):
-            raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
+        if ts.size:   # the earliest and latest times checked (NaN and infinities fail isfinite)
+            first, last = float(ts.min()), float(ts.max())
+            if not (math.isfinite(first) and math.isfinite(last)) or first < lo - 1e-12 * max(1, abs(lo)) or \
+                    last > hi + 1e-12 * max(1, abs(hi)):
+                raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
         if self._evaluate is None:
             return self._bracketed(ts)
         q, v, vd, lam = self._evaluate(np.clip(ts, lo, hi))
@@ -277,7 +281,6 @@ class Result:
         return out
 
     def _reaction(self, joint, on, frame):
-        from ..system.reactions import joint_reaction
         if self.lambda_ is None:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
