@@ -129,3 +129,28 @@ def test_lazy_frames_accelerations_equal_body_frames(name):
     for key in ("r", "A", "rd", "w", "rdd", "alpha"):
         assert np.array_equal(getattr(fr, key), getattr(full, key)), key
     assert np.abs(full.alpha).max() > 0 and np.abs(full.rdd).max() > 0
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_sparse_min_norm_equals_dense(name):
+    """minnorm_sparse (the products over each column's nonzero rows, as _full_multipliers calls it) gives
+    the dense kernel's multipliers and the same flags, a change point included (sample 1: two rows coincide)."""
+    from mbdsim.solvers import minnorm_sparse
+    res = _run(name)
+    rows, LAM = _solved(res)
+    nc = res.system.nc
+    J = np.ascontiguousarray(jacobians(res.system, res.q))
+    J[1, rows[1]] = J[1, rows[0]]
+    dep = np.setdiff1d(np.arange(nc), rows).astype(np.int64)
+    LAM = np.ascontiguousarray(LAM)
+    outs = []
+    for kernel in (min_norm_multipliers, minnorm_sparse.min_norm_multipliers):
+        out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
+        kernel(J, LAM, rows.astype(np.int64), dep, out, bad)
+        outs.append((out, bad))
+    (o1, b1), (o2, b2) = outs
+    assert b1.tolist() == b2.tolist() and not b1[0]
+    ok = ~b1
+    ok[1] = False                                          # (ill-conditioned where not flagged)
+    scale = np.abs(o1[ok]).max()
+    assert np.abs(o1[ok] - o2[ok]).max() <= 1e-13 * scale

@@ -46,16 +46,47 @@ def _values(signal, res, ts) -> np.ndarray:
 
 def _fit(ts, vals, idx, deg):
     """Polynomial of degree `deg` through the points idx, in the local coordinate x = (t - ts[i0]) / dt;
-    returns (coefficients, t0, dt) or None when the values are not finite."""
+    returns (coefficients, highest power first, t0, dt) or None when the values are not finite.  With
+    deg + 1 points the fit is the interpolating polynomial: one Vandermonde solve (np.polyfit's least
+    squares otherwise)."""
     x0, dt = ts[idx[0]], ts[idx[1]] - ts[idx[0]]
     y = vals[idx]
     if dt <= 0 or not np.all(np.isfinite(y)):
         return None
-    return np.polyfit((ts[idx] - x0) / dt, y, deg), x0, dt
+    x = (ts[idx] - x0) / dt
+    if len(idx) == deg + 1:
+        try:
+            return np.linalg.solve(np.vander(x, deg + 1), y), x0, dt
+        except np.linalg.LinAlgError:
+            pass
+    return np.polyfit(x, y, deg), x0, dt
+
+
+def _horner(coef, x: float) -> float:
+    """Value of the polynomial coef (highest power first) at the scalar x (np.polyval's recurrence)."""
+    y = 0.0
+    for c in coef:
+        y = y * x + c
+    return y
+
+
+def _roots(coef):
+    """Roots of the polynomial coef (highest power first, the leading one nonzero): eigenvalues of the
+    companion matrix, as np.roots computes them."""
+    n = len(coef) - 1
+    if n < 1:
+        return np.array([])
+    if n == 1:
+        return np.array([-coef[1] / coef[0]])
+    A = np.diag(np.ones(n - 1), -1)
+    A[0, :] = -coef[1:] / coef[0]
+    return np.linalg.eigvals(A)
 
 
 def _real_roots_in(coef, lo, hi):
-    r = np.roots(coef) if np.any(coef[:-1]) else np.array([])
+    if not np.any(coef[:-1]):
+        return np.array([])
+    r = _roots(coef) if coef[0] != 0 and coef[-1] != 0 else np.roots(coef)
     r = r[np.abs(r.imag) <= 1e-9 * np.maximum(1.0, np.abs(r.real))].real
     return r[(r >= lo) & (r <= hi)]
 
@@ -75,8 +106,11 @@ def _peak_estimate(ts, vals, j):
     cand = _real_roots_in(np.polyder(coef), xj - 1, xj + 1)
     if not len(cand):
         return None
-    x = cand[np.argmax(np.polyval(coef, cand))]
-    return float(x0 + x * dt), float(np.polyval(coef, x)), float(np.ptp(vals[idx]))
+    values = [_horner(coef, c) for c in cand.tolist()]
+    k = int(np.argmax(values))
+    x, top = float(cand[k]), values[k]
+    y = vals[idx]
+    return float(x0 + x * dt), float(top), float(y.max() - y.min())
 
 
 def extremum(res, signal, sign: int) -> tuple[float, float]:

@@ -5,6 +5,7 @@ positions then measured from its origin).  SI units: m, m/s, m/s^2, rad, rad/s, 
 """
 from __future__ import annotations
 
+import math
 from typing import Callable
 
 import numpy as np
@@ -15,7 +16,8 @@ from ..system import measures as ms
 from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
-from ..system.frames import Frames, body_frames
+from ..system.frames import Frames, acceleration_terms, body_frames
+from ..system.reactions import joint_reaction
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -85,22 +87,25 @@ class Result:
 
     @property
     def frames(self):
+        """Body frames of the samples (mbdsim.system.frames.Frames); the acceleration terms (rdd, alpha)
+        and the multipliers are computed on first use (most measures need positions and velocities only)."""
         if self._fr is None:
-            if self._vd is None and self._accelerations is not None:   # positions need no accelerations
-                self._fr = _LazyFrames(body_frames(self.system, self.q, self.v), self)
-            else:
-                self._fr = body_frames(self.system, self.q, self.v, self.vd)
-                self._fr.lambda_ = self.lambda_   # multipliers, for friction measures (force_elements.friction)
-            self._fr.t = self.time   # sample times, for time-dependent element measures
+            fr = body_frames(self.system, self.q, self.v)
+            if self._vd is not None or self._accelerations is not None:
+                fr = _LazyFrames(fr, self)
+            self._fr = fr
+            fr.t = self.time   # sample times, for time-dependent element measures
         return self._fr
 
     def at(self, t: float | ArrayLike) -> "Result":
         """The same Result API at time(s) t [s], evaluated from the solver's dense output."""
         ts = np.atleast_1d(np.asarray(t, dtype=float))
         lo, hi = self.time[0], self.time[-1]
-        if not np.all(np.isfinite(ts)) or np.any(ts < lo - 1e-12 * max(1, abs(lo))) or \
-                np.any(ts > hi + 1e-12 * max(1, abs(hi))):
-            raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
+        if ts.size:   # the earliest and latest times checked (NaN and infinities fail isfinite)
+            first, last = float(ts.min()), float(ts.max())
+            if not (math.isfinite(first) and math.isfinite(last)) or first < lo - 1e-12 * max(1, abs(lo)) or \
+                    last > hi + 1e-12 * max(1, abs(hi)):
+                raise ValueError(f"time(s) {ts} outside the result's range [{lo}, {hi}] s")
         if self._evaluate is None:
             return self._bracketed(ts)
         q, v, vd, lam = self._evaluate(np.clip(ts, lo, hi))
@@ -276,7 +281,6 @@ class Result:
         return out
 
     def _reaction(self, joint, on, frame):
-        from ..system.reactions import joint_reaction
         if self.lambda_ is None:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
@@ -463,22 +467,22 @@ def _spring(res, el):
 
 
 class _LazyFrames(Frames):
-    """Body frames of a Result whose accelerations (rdd, alpha) and multipliers are computed on first use."""
+    """Body frames of a Result whose accelerations (rdd, alpha) and multipliers (lambda_, for friction
+    measures: force_elements.friction) are computed on first use."""
 
     def __init__(self, fr: Frames, res: Result):
         self.r, self.A, self.rd, self.w = fr.r, fr.A, fr.rd, fr.w
         self._res = res
 
     def _full(self, key):
-        if key not in self.__dict__:   # body_frames' acceleration terms, on the rotations already computed
+        d = self.__dict__
+        if key not in d:
             res = self._res
-            sys, vd, rig = res.system, np.asarray(res.vd, dtype=float), res.system.rigid_fid
-            rdd, alpha = np.zeros(self.r.shape), np.zeros(self.r.shape)
-            rdd[..., 1:, :] = vd[..., sys.rd_idx]
-            if len(rig):
-                alpha[..., rig, :] = np.einsum("...ij,...j->...i", self.A[..., rig, :, :], vd[..., sys.w_idx])
-            self.__dict__.update(_rdd=rdd, _alpha=alpha, _lam=res.lambda_)
-        return self.__dict__[key]
+            if key == "_lam":
+                d["_lam"] = res.lambda_
+            else:   # body_frames' acceleration terms, on the rotations already computed
+                d["_rdd"], d["_alpha"] = acceleration_terms(res.system, self.A, res.vd)
+        return d[key]
 
     rdd = property(lambda self: self._full("_rdd"), lambda self, x: self.__dict__.__setitem__("_rdd", x))
     alpha = property(lambda self: self._full("_alpha"), lambda self, x: self.__dict__.__setitem__("_alpha", x))

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..math.rotation import quat_to_matrix
 from . import kernels
 
 
@@ -43,29 +42,94 @@ def body_frames(sys, q, v=None, vd=None) -> Frames:
     lead = q.shape[:-1]
     n = sys.nbody + 1
     r = np.zeros(lead + (n, 3))
-    A = np.broadcast_to(np.eye(3), lead + (n, 3, 3)).copy()
     rd = np.zeros(lead + (n, 3))
     w = np.zeros(lead + (n, 3))
     r[..., 1:, :] = q[..., sys.r_idx]
     rig = sys.rigid_fid
+    all_rigid = _all_rigid(sys)
+    A = np.zeros(lead + (n, 3, 3))
+    A[..., 0, 0], A[..., 1, 1], A[..., 2, 2] = 1.0, 1.0, 1.0
+    R = None
     if len(rig):
-        p = q[..., sys.p_idx]
-        p = p / np.linalg.norm(p, axis=-1, keepdims=True)
-        A[..., rig, :, :] = quat_to_matrix(p)
+        R = _rotations(q[..., sys.p_idx])
+        if all_rigid:
+            A[..., 1:, :, :] = R
+        else:
+            A[..., rig, :, :] = R
+    fr = Frames(r, A, rd, w)
     if v is not None:
         v = np.asarray(v, dtype=float)
         rd[..., 1:, :] = v[..., sys.rd_idx]
-        if len(rig):
-            w[..., rig, :] = np.einsum("...ij,...j->...i", A[..., rig, :, :], v[..., sys.w_idx])
-    fr = Frames(r, A, rd, w)
+        if R is not None:
+            if all_rigid:
+                w[..., 1:, :] = _rotate(R, v[..., sys.w_idx])
+            else:
+                w[..., rig, :] = _rotate(R, v[..., sys.w_idx])
     if vd is not None:
-        vd = np.asarray(vd, dtype=float)
-        fr.rdd = np.zeros(lead + (n, 3))
-        fr.alpha = np.zeros(lead + (n, 3))
-        fr.rdd[..., 1:, :] = vd[..., sys.rd_idx]
-        if len(rig):
-            fr.alpha[..., rig, :] = np.einsum("...ij,...j->...i", A[..., rig, :, :], vd[..., sys.w_idx])
+        fr.rdd, fr.alpha = acceleration_terms(sys, A, vd)
     return fr
+
+
+def acceleration_terms(sys, A, vd):
+    """(rdd, alpha) (..., nbody + 1, 3) [m/s^2, rad/s^2], ground axes, of every frame from the rotations
+    A (..., nbody + 1, 3, 3) and the accelerations of the velocity variables vd (..., nv)."""
+    vd = np.asarray(vd, dtype=float)
+    lead, n = A.shape[:-3], A.shape[-3]
+    rdd, alpha = np.zeros(lead + (n, 3)), np.zeros(lead + (n, 3))
+    rdd[..., 1:, :] = vd[..., sys.rd_idx]
+    rig = sys.rigid_fid
+    if len(rig) and _all_rigid(sys):
+        alpha[..., 1:, :] = _rotate(A[..., 1:, :, :], vd[..., sys.w_idx])
+    elif len(rig):
+        alpha[..., rig, :] = _rotate(A[..., rig, :, :], vd[..., sys.w_idx])
+    return rdd, alpha
+
+
+def _all_rigid(sys) -> bool:
+    """Whether every body is rigid, in frame order (rigid_fid = 1..nbody): slices instead of fancy
+    indexing (cached in sys.derived)."""
+    flag = sys.derived.get("all rigid")
+    if flag is None:
+        rig = np.asarray(sys.rigid_fid)
+        flag = sys.derived["all rigid"] = bool(np.array_equal(rig, np.arange(1, sys.nbody + 1)))
+    return flag
+
+
+def _rotations(p):
+    """Rotation matrices (..., 3, 3), body -> ground, of the Euler parameters p (..., 4) normalised first
+    (the arithmetic of math.rotation.quat_to_matrix, written into one array)."""
+    p = p / np.sqrt(np.add.reduce(p * p, axis=-1, keepdims=True))   # = np.linalg.norm(p, axis=-1)
+    e0, e1, e2, e3 = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
+    s0, s1, s2, s3 = e0 * e0, e1 * e1, e2 * e2, e3 * e3
+    e12, e03, e13, e02, e23, e01 = e1 * e2, e0 * e3, e1 * e3, e0 * e2, e2 * e3, e0 * e1
+    R = np.empty(p.shape[:-1] + (3, 3))
+    R[..., 0, 0] = s0 + s1 - s2 - s3
+    R[..., 0, 1] = 2 * (e12 - e03)
+    R[..., 0, 2] = 2 * (e13 + e02)
+    R[..., 1, 0] = 2 * (e12 + e03)
+    R[..., 1, 1] = s0 - s1 + s2 - s3
+    R[..., 1, 2] = 2 * (e23 - e01)
+    R[..., 2, 0] = 2 * (e13 - e02)
+    R[..., 2, 1] = 2 * (e23 + e01)
+    R[..., 2, 2] = s0 - s1 - s2 + s3
+    return R
+
+
+def _rotate(R, x):
+    """R x for stacks of matrices R (..., 3, 3) and vectors x (..., 3)."""
+    return np.einsum("...ij,...j->...i", R, x)
+
+
+def cross(a, b):
+    """Cross products a x b of stacks of 3-vectors (..., 3) (np.cross's arithmetic, without its axis
+    handling: several times faster on the short stacks of a Result)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    out = np.empty(a.shape if a.shape == b.shape else np.broadcast_shapes(a.shape, b.shape))
+    out[..., 0] = a1 * b2 - a2 * b1
+    out[..., 1] = a2 * b0 - a0 * b2
+    out[..., 2] = a0 * b1 - a1 * b0
+    return out
 
 
 def point_state(fr: Frames, fid, s_B):
@@ -74,8 +138,8 @@ def point_state(fr: Frames, fid, s_B):
     s = np.einsum("...ij,...j->...i", A, s_B)
     w = fr.w[..., fid, :]
     pos = fr.r[..., fid, :] + s
-    vel = fr.rd[..., fid, :] + np.cross(w, s)
+    vel = fr.rd[..., fid, :] + cross(w, s)
     acc = None
     if fr.rdd is not None:
-        acc = fr.rdd[..., fid, :] + np.cross(fr.alpha[..., fid, :], s) + np.cross(w, np.cross(w, s))
+        acc = fr.rdd[..., fid, :] + cross(fr.alpha[..., fid, :], s) + cross(w, cross(w, s))
     return pos, vel, acc

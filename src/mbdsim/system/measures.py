@@ -11,7 +11,7 @@ import numpy as np
 from ..errors import ModelError
 from ..model.body import Body, Marker
 from .constraints import primitives as pr
-from .frames import Frames
+from .frames import Frames, cross
 from ..model.joint_kinds import has_slide, is_angle
 
 
@@ -75,10 +75,10 @@ def point_kinematics(sys, fr, target, with_acc=True):
     s = A @ s_B
     w = fr.w[:, fid]
     pos = fr.r[:, fid] + s
-    vel = fr.rd[:, fid] + np.cross(w, s)
+    vel = fr.rd[:, fid] + cross(w, s)
     acc = None
     if with_acc and fr.rdd is not None:
-        acc = fr.rdd[:, fid] + np.cross(fr.alpha[:, fid], s) + np.cross(w, np.cross(w, s))
+        acc = fr.rdd[:, fid] + cross(fr.alpha[:, fid], s) + cross(w, cross(w, s))
     return pos, vel, acc
 
 

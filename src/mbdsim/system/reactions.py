@@ -19,14 +19,7 @@ def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None):
     Optional precomputed geometry of the samples q (N, nq): A (N, nbody + 1, 3, 3) body rotation
     matrices (Frames.A), J (N, nc, nv) constraint Jacobians; computed here when not given."""
     name = joint if isinstance(joint, str) else joint.name
-    rows = sys.owner_rows.get(name)
-    if rows is None:
-        raise ModelError(f"joint '{name}'", "joint", "has no constraint rows in the analysed model")
-    # a motion acting on the joint is part of the joint's load (as in Adams)
-    for m in sys.model.motions.values():
-        if m.joint.name == name and m.name in sys.owner_rows:
-            rows = np.concatenate([rows, sys.owner_rows[m.name]])
-    geom = sys.geoms.get(name) or sys.geoms[sys.model.motions[name].joint.name]
+    rows, geom = _rows_and_geometry(sys, name)
     body = on if on is not None else (joint.body_j if not isinstance(joint, str) else None)
     fid = geom.bj if body is None else sys.fid.get(body, -1)
     if fid not in (geom.bi, geom.bj):
@@ -38,18 +31,44 @@ def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None):
     return _load_on(sys, q, lambda_, rows, fid, geom, A, J)
 
 
+def _rows_and_geometry(sys, name):
+    """(constraint rows, joint geometry) of the joint or motion `name`: the joint's rows followed by those
+    of the motions acting on it (a motion is part of the joint's load, as in Adams); cached in
+    sys.derived (they depend on the model only)."""
+    key = ("reaction rows", name)
+    found = sys.derived.get(key)
+    if found is None:
+        rows = sys.owner_rows.get(name)
+        if rows is None:
+            raise ModelError(f"joint '{name}'", "joint", "has no constraint rows in the analysed model")
+        for m in sys.model.motions.values():
+            if m.joint.name == name and m.name in sys.owner_rows:
+                rows = np.concatenate([rows, sys.owner_rows[m.name]])
+        geom = sys.geoms.get(name) or sys.geoms[sys.model.motions[name].joint.name]
+        found = sys.derived[key] = (np.asarray(rows, dtype=np.int64), geom)
+    return found
+
+
 def _load_on(sys, q, lambda_, rows, fid, geom, A=None, J=None):
     """Constraint force [N] and torque about the joint point [N m] (N, 3), ground axes, of `rows` on frame
     fid, for all samples at once."""
     s_B = geom.s_j if fid == geom.bj else geom.s_i
-    a = sys.frame_v_adr[fid]
+    a = int(sys.frame_v_adr[fid])
     q = np.atleast_2d(q)
-    J = (jacobians(sys, q) if J is None else J)[:, rows]   # (N, nr, nv)
-    lam = np.asarray(lambda_)[:, rows]
-    F = -np.einsum("nri,nr->ni", J[:, :, a:a + 3], lam)
-    T = np.zeros_like(F)
-    if sys.frame_rigid[fid]:
-        A = (body_frames(sys, q).A if A is None else A)[:, fid]
-        T_cm = np.einsum("nij,nj->ni", A, -np.einsum("nri,nr->ni", J[:, :, a + 3:a + 6], lam))
-        T = T_cm + np.cross(-(A @ s_B), F)
-    return F, T
+    rigid = bool(sys.frame_rigid[fid])
+    J = jacobians(sys, q) if J is None else J
+    lam = np.asarray(lambda_)[:, rows]                        # (N, nr)
+    Jb = J[:, rows, a:a + (6 if rigid else 3)]                 # (N, nr, 3 or 6): the body's columns
+    Q = -np.einsum("nri,nr->ni", Jb, lam)                      # force (ground), torque about CM (body axes)
+    F = Q[:, :3]
+    if not rigid:
+        return F, np.zeros_like(F)
+    A = (body_frames(sys, q).A if A is None else A)[:, fid]
+    T_cm = np.einsum("nij,nj->ni", A, Q[:, 3:])
+    s = A @ -np.asarray(s_B, dtype=float)                      # r_CM - r_P (N, 3), ground axes
+    s0, s1, s2, F0, F1, F2 = s[:, 0], s[:, 1], s[:, 2], F[:, 0], F[:, 1], F[:, 2]
+    T = np.empty_like(F)                                       # T_cm + s x F
+    T[:, 0] = T_cm[:, 0] + (s1 * F2 - s2 * F1)
+    T[:, 1] = T_cm[:, 1] + (s2 * F0 - s0 * F2)
+    T[:, 2] = T_cm[:, 2] + (s0 * F1 - s1 * F0)
+    return np.ascontiguousarray(F), T
