@@ -17,7 +17,7 @@ from ..results.result import Result
 from ..results.stream import notify
 from ..system.compiled import Work, compile_system
 from ..system.equations import jacobians
-from . import fastdop, fastdyn, minnorm_sparse
+from . import fastdop, fastdyn, minnorm
 from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
@@ -288,7 +288,7 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
     rows, so that the determinate components are exact. All samples in one compiled call with r x r and
-    d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm_sparse), the SVD pseudo-inverse where
+    d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm), the SVD pseudo-inverse where
     the rows are dependent at the sample's configuration too (a change point)."""
     if len(rows) == sys.nc or not len(times):
         return LAM
@@ -302,7 +302,7 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
         dep = sys.derived[key] = np.flatnonzero(free).astype(np.int64)
     LAM = np.ascontiguousarray(LAM, dtype=float)
     out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
-    minnorm_sparse.min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
+    minnorm.min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
     if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
         load = np.einsum("nri,nr->ni", J[bad][:, rows], LAM[bad][:, rows])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
