@@ -25,13 +25,20 @@ def _has_bool(value) -> bool:
     return isinstance(value, (list, tuple)) and any(_has_bool(x) for x in value)
 
 
+def _plain(x) -> bool:
+    """A finite float, or an int that a float holds exactly (no booleans, no overflow)."""
+    return (type(x) is float and math.isfinite(x)) or (type(x) is int and -2**53 <= x <= 2**53)
+
+
 def vector(entity: str, field: str, value, n: int = 3, what: str = "") -> np.ndarray:
     """A finite n-vector, else ModelError (`what` names the components in the message)."""
+    if type(value) in (tuple, list) and len(value) == n and all(_plain(x) for x in value):
+        return np.array(value, dtype=float)   # the common case: n plain finite numbers
     if _has_bool(value):
         raise ModelError(entity, field, f"expected {n} numbers, got a boolean in {value!r}")
     try:
         v = np.asarray(value, dtype=float).reshape(-1)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ModelError(entity, field, f"expected {n} numbers, got {value!r}") from None
     if v.shape != (n,):
         raise ModelError(entity, field, f"expected {n} numbers{what}, got {value!r}")
@@ -57,7 +64,7 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
         raise ModelError(entity, field, f"expected a number, got the boolean {value!r}")
     try:
         x = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ModelError(entity, field, f"expected a number, got {value!r}") from None
     if not math.isfinite(x):
         raise ModelError(entity, field, f"must be finite, got {value!r}")
