@@ -1,5 +1,5 @@
 """The fast paths of assembly and compilation give exactly what the general routines give: LAPACK called
-directly (math.lapack) as scipy's wrappers, the vectorised row packing (system.packing) as the kernels'
+directly (math.lapack) as scipy's wrappers, the vectorised row packing (system.packing) as the row-by-row
 reference packing, the topology of a row subset restricted from that of all rows as computed afresh,
 and Systems of the same structure sharing their topologies."""
 from __future__ import annotations
@@ -53,10 +53,43 @@ def test_lapack_as_scipy(shape):
         lapack.pivoted_qr(np.full((2, 2), np.nan))
 
 
+def _pack_rows_loop(sys):
+    """Reference for system.packing.pack_rows: the rows packed one by one (the former kernels.pack_rows).
+
+    A point-on-curve group packs as spherical rows with v2 = the marker point s_j (body-j axes) and
+    v1 = 0: the caller writes the curve point c(s) (body-i axes) into v1 at each evaluation.  Rows of
+    the groups the kernel does not evaluate (couplers, screw, constant-velocity) stay ground-ground
+    spherical rows (all zero) for the caller to overwrite."""
+    nc = sys.nc
+    kind = np.zeros(nc, np.int64)
+    bi = np.zeros(nc, np.int64)
+    bj = np.zeros(nc, np.int64)
+    v = np.zeros((3, nc, 3))
+    drv = -np.ones(nc, np.int64)
+    fns = []
+    for g in sys.groups:
+        if g.kind not in kernels.KIND and g.kind not in ("sph", "curve"):
+            continue
+        three = g.kind in ("sph", "curve")
+        first = 1 if g.kind == "curve" else 0      # curve: vecs[0] is the marker point s_j
+        for k in range(len(g.bi)):
+            r0 = g.row_adr[k]
+            rows = [r0, r0 + 1, r0 + 2] if three else [r0]
+            for c, r in enumerate(rows):
+                kind[r] = c if three else kernels.KIND[g.kind]
+                bi[r], bj[r] = g.bi[k], g.bj[k]
+                for m, vec in enumerate(g.vecs):
+                    v[first + m, r] = vec[k]
+                if g.kind in ("angle", "slide"):
+                    drv[r] = len(fns)
+                    fns.append(g.fns[k])
+    return kind, bi, bj, v[0], v[1], v[2], drv, fns
+
+
 def test_packing_and_topology_as_reference():
     rng = np.random.default_rng(0)
     for s in _systems():
-        fast, ref = s.derived["packed"], kernels.pack_rows(s)
+        fast, ref = s.derived["packed"], _pack_rows_loop(s)
         for x, y in zip(fast[:7], ref[:7]):
             assert x.dtype == y.dtype and np.array_equal(x, y)
         assert all(f is g for f, g in zip(fast[7], ref[7])) and len(fast[7]) == len(ref[7])

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..model.element_specs import Bushing
 from ..model.forces import Force, SpringDamper, Torque
-from . import exprloads_pack, jointtree, kernels
+from . import exprloads_pack, jointtree, packing
 from .measures import locate
 from .topology import Topology, system_topology
 
@@ -41,7 +41,7 @@ class CompiledModel:
     gravity: np.ndarray       # (3,) [m/s^2] ground axes
     mass: np.ndarray          # (nf,) [kg]
     inertia: np.ndarray       # (nf, 3, 3) [kg m^2] about the CM, body axes
-    kind: np.ndarray          # constraint rows (system.kernels.pack_rows)
+    kind: np.ndarray          # constraint rows (system.packing.pack_rows)
     bi: np.ndarray
     bj: np.ndarray
     vecs: np.ndarray          # (3, nc, 3) body-axes vectors of each row
@@ -204,7 +204,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     M6[rig, 3:, 3:] = sys.inertia_B[rig]
     packed = sys.derived.get("packed")   # the rows as system.equations packed them, else packed here
     if packed is None:
-        packed = sys.derived["packed"] = kernels.pack_rows(sys)
+        packed = sys.derived["packed"] = packing.pack_rows(sys)
     kind, bi, bj, v1, v2, v3, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     code, consts, tables, start, end, stack = _driver_programs(fns)

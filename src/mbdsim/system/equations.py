@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import kernels
+from . import kernels, packing
 from .constraints import primitives as pr
 from .constraints.registry import PAIR_ROW_KINDS
 from .frames import Frames, body_frames
@@ -85,7 +85,7 @@ def _packed(sys):
     """The System's constraint rows packed for the kernels (cached in sys.derived)."""
     packed = sys.derived.get("packed")
     if packed is None:
-        packed = sys.derived["packed"] = kernels.pack_rows(sys)
+        packed = sys.derived["packed"] = packing.pack_rows(sys)
     return packed
 
 

@@ -3,7 +3,7 @@ evaluated row by row in one pass with scalar arithmetic, scattered straight into
 
 `primitives` (numpy) evaluates the same rows batched over time samples (Result measures, path
 constraints); the tests check that both agree to round-off.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
-(driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `pack_rows`).
+(driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `system.packing.pack_rows`).
 """
 from __future__ import annotations
 
@@ -14,39 +14,6 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 
 KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6}
-
-
-def pack_rows(sys):
-    """Flat per-row arrays (kind, bi, bj, v1, v2, v3, driver index) from the system's groups.
-
-    A point-on-curve group packs as spherical rows with v2 = the marker point s_j (body-j axes) and
-    v1 = 0: the caller writes the curve point c(s) (body-i axes) into v1 at each evaluation.  Rows of
-    the groups the kernel does not evaluate (couplers, screw, constant-velocity) stay ground-ground
-    spherical rows (all zero) for the caller to overwrite."""
-    nc = sys.nc
-    kind = np.zeros(nc, np.int64)
-    bi = np.zeros(nc, np.int64)
-    bj = np.zeros(nc, np.int64)
-    v = np.zeros((3, nc, 3))
-    drv = -np.ones(nc, np.int64)
-    fns = []
-    for g in sys.groups:
-        if g.kind not in KIND and g.kind not in ("sph", "curve"):
-            continue
-        three = g.kind in ("sph", "curve")
-        first = 1 if g.kind == "curve" else 0      # curve: vecs[0] is the marker point s_j
-        for k in range(len(g.bi)):
-            r0 = g.row_adr[k]
-            rows = [r0, r0 + 1, r0 + 2] if three else [r0]
-            for c, r in enumerate(rows):
-                kind[r] = c if three else KIND[g.kind]
-                bi[r], bj[r] = g.bi[k], g.bj[k]
-                for m, vec in enumerate(g.vecs):
-                    v[first + m, r] = vec[k]
-                if g.kind in ("angle", "slide"):
-                    drv[r] = len(fns)
-                    fns.append(g.fns[k])
-    return kind, bi, bj, v[0], v[1], v[2], drv, fns
 
 
 @njit(cache=True, _nrt=False)

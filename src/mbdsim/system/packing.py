@@ -1,9 +1,6 @@
-"""Constraint rows packed for the compiled kernels, vectorised per row group.
-
-The same arrays as `system.kernels.pack_rows` (the reference, which lives in a numba kernel file where
-any edit forces a recompilation), a few times faster: one numpy assignment per group instead of one per
-row.  `assemble_system` keeps the result in sys.derived["packed"], where system.equations and
-compile_system look for it.
+"""Constraint rows packed for the compiled kernels (system.kernels), vectorised per row group: one numpy
+assignment per group instead of one per row.  `assemble_system` keeps the result in
+sys.derived["packed"], where system.equations and compile_system look for it.
 """
 from __future__ import annotations
 
@@ -11,8 +8,7 @@ import numpy as np
 
 
 def pack_rows(sys):
-    """(kind, bi, bj, v1, v2, v3, driver index, driver functions) of every row, as
-    system.kernels.pack_rows: kinds 0-2 spherical x/y/z (point-on-curve rows too, v1 = 0 for the
+    """(kind, bi, bj, v1, v2, v3, driver index, driver functions) of every row: kinds 0-2 spherical x/y/z (point-on-curve rows too, v1 = 0 for the
     caller's curve point), 3 dot1, 4 dot2, 5 angle, 6 slide; vectors in body axes; rows of kinds the
     kernel does not evaluate stay ground-ground spherical rows of zeros, driver index -1."""
     from .kernels import KIND
