@@ -110,3 +110,22 @@ def test_structure_shared_between_variants():
     assert topology._full_topology(s1) is topology._full_topology(s2)
     t1 = topology.system_topology(s1, np.arange(s1.nc))
     assert t1.blk_rows is not topology._full_topology(s1).blk_rows   # handed out as copies
+
+
+def test_joint_kinds_in_the_structure_key():
+    """Joints of different kinds with as many rows (cylindrical and universal: 4 each) between the same
+    bodies, under the same names, are different structures: nothing is shared between them."""
+    import mbdsim as mb
+
+    def model(kind):
+        m = mb.Model("k", gravity=(0, -9.81, 0))
+        b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(0.0, -0.5, 0.0))
+        if kind == "cylindrical":
+            m.add_cylindrical("j", m.ground, b, point=(0, 0, 0), axis=(0, 0, 1))
+        else:
+            m.add_universal("j", m.ground, b, point=(0, 0, 0), axis_i=(0, 0, 1), axis_j=(1, 0, 0))
+        return m
+    with single_use():
+        a, b = assemble_system(model("cylindrical")), assemble_system(model("universal"))
+    assert a.nc == b.nc and list(a.row_owner) == list(b.row_owner)
+    assert topology.structure_key(a) != topology.structure_key(b)
