@@ -97,10 +97,12 @@ class Work:
         nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
         nd = len(cm.start) // 3
         z = np.zeros
+        # 31: unused (the second tree solve's loads before kkt_solve's loop correction), kept empty so
+        # that the later slots keep their numbers
         a = (z((nf, 3)), z((nf, 3, 3)), z((nf, 3)), z((nf, 3)), z(nc), z((nc, 2, 6)), z(nc), z(nc), z((nf, 6)),
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
              z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z((nl, nc)), z((3, nd)), z(4),
-             z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((nf, 6)),
+             z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((0, 6)),
              z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
              # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
              (z((nf, 6, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z(nf), z(nf), z((6, 6)),

@@ -36,8 +36,10 @@ def _tree_plan(sys):
 
 
 def _make_tree_plan(sys):
-    from .topology import _system_topology
-    topo = _system_topology(sys, np.arange(sys.nc))
+    from .topology import _full_topology, _system_topology
+    topo = _full_topology(sys)   # the shared topology of all rows (None when a joint has > 6 rows)
+    if topo is None:
+        topo = _system_topology(sys, np.arange(sys.nc))
     vadr, rigid = sys.frame_v_adr.tolist(), sys.frame_rigid.tolist()
     ptr, flat = topo.blk_ptr.tolist(), topo.blk_rows.tolist()
     shapes: dict = {}
