@@ -125,3 +125,19 @@ def test_cli_streams_and_resumes(tmp_path, small_chunks):
     assert pd.read_parquet(out).equals(df)
     r = CliRunner().invoke(app, ["run", str(model), "--end", "2", "--resume"])
     assert r.exit_code == 2
+
+
+def test_resume_after_a_kill_inside_an_atomic_write(tmp_path, small_chunks):
+    """A run killed while writing its checkpoint or run file leaves their temporary files behind
+    (`_atomic`'s names): a resume accepts them as the run's own and finishes as an uninterrupted run."""
+    m = double_pendulum()
+    out = tmp_path / "run.parquet"
+    full = mb.simulate(m, 0.5, 0.001, out=tmp_path / "full.parquet")
+    mb.simulate(m, 0.5, 0.001, out=out)
+    for name in (stream.CHECKPOINT, stream.META):
+        (out / stream._tmp_name(name)).write_bytes(b"partial write")
+    resumed = mb.simulate(m, 0.5, 0.001, out=out, resume=True)
+    assert resumed.success and np.array_equal(resumed.q[-1], full.q[-1])
+    (out / "notes.txt").write_text("a user's file")
+    with pytest.raises(mb.ModelError, match="not written by mbdsim"):
+        mb.simulate(m, 0.5, 0.001, out=out, resume=True)

@@ -73,11 +73,18 @@ def prepare(out, resume: bool) -> Path:
 
 
 def _ours(name: str) -> bool:
-    return name in (CHECKPOINT, META) or name.startswith(("part-", ".part-", ".ckpt-", "._run"))
+    """A file a run writes, or the temporary file of one (left behind by a run killed while writing it)."""
+    return name in (CHECKPOINT, META, _tmp_name(CHECKPOINT), _tmp_name(META)) or \
+        name.startswith(("part-", ".part-", ".ckpt-", "._run"))
+
+
+def _tmp_name(name: str) -> str:
+    """The temporary file `_atomic` writes before renaming it to `name`."""
+    return f".{name.lstrip('_')}.tmp"
 
 
 def _atomic(path: Path, write) -> None:
-    tmp = path.parent / f".{path.name.lstrip('_')}.tmp"
+    tmp = path.parent / _tmp_name(path.name)
     write(tmp)
     with open(tmp, "rb") as fh:
         os.fsync(fh.fileno())
