@@ -48,7 +48,13 @@ def test_lapack_as_scipy(shape):
     S = A @ A.T + np.eye(shape[0])
     b = rng.standard_normal(shape[0])
     if shape[0]:
-        assert np.array_equal(lapack.cho_solve_spd(S, b), sla.cho_solve(sla.cho_factor(S), b))
+        x = lapack.cho_solve_spd(S, b)
+        assert np.allclose(x, sla.cho_solve(sla.cho_factor(S), b), rtol=1e-12, atol=0)
+        assert np.allclose(S @ x, b, rtol=0, atol=1e-12 * np.abs(S).max() * np.abs(x).max())
+        X = lapack.cho_solve_spd(S, np.column_stack([b, 2 * b]))
+        assert np.allclose(X[:, 1], 2 * x, rtol=1e-12, atol=0)
+        with pytest.raises(np.linalg.LinAlgError):
+            lapack.cho_solve_spd(-S, b)
     with pytest.raises(ValueError):
         lapack.pivoted_qr(np.full((2, 2), np.nan))
 

@@ -5,6 +5,15 @@ other modules, so after an edit or an upgrade a cached kernel could keep a stale
 Keying the cache directory on a hash of every kernel module makes any change start a fresh cache.
 Imported (by `mbdsim.system`) before any kernel module is compiled or loaded. A user-set
 NUMBA_CACHE_DIR is respected (the hash is appended below it).
+
+Loading a cached kernel: numba's `FunctionCache.load_overload` first refreshes the whole CPU target
+context (imports and installs every typing and lowering registry, numba.np.linalg's check for scipy's
+BLAS included: 0.3-0.8 s in a fresh process), which only a compilation needs: rebuilding a cached
+kernel needs the code generator and numba's runtime (NRT), nothing else.  `_fast_cached_loads` makes
+the loads of mbdsim's own kernels (functions of mbdsim's modules; any other numba function is loaded
+by numba's own method) initialise the runtime only.  A cache miss still compiles through
+numba's compiler, which refreshes the context itself; any failure of the short path falls back to
+numba's method.
 """
 from __future__ import annotations
 
@@ -38,4 +47,35 @@ def configure() -> str:
     return path
 
 
+def _fast_cached_loads() -> bool:
+    """Install the short load path for the cached kernels of mbdsim's modules (see the module
+    docstring); False (numba's own method kept) when this numba lacks the internals it relies on."""
+    try:
+        from numba.core import caching
+        from numba.core.runtime import nrt
+        original = caching.FunctionCache.load_overload
+        caching.FunctionCache._load_overload   # noqa: B018 - the internals used below exist
+    except (ImportError, AttributeError):
+        return False
+    if getattr(original, "mbdsim", False):
+        return True
+
+    def load_overload(self, sig, target_context):
+        module = getattr(getattr(self, "_py_func", None), "__module__", None) or ""
+        if not module.startswith("mbdsim."):
+            return original(self, sig, target_context)
+        try:
+            nrt.rtsys.initialize(target_context)
+            with self._guard_against_spurious_io_errors():
+                return self._load_overload(sig, target_context)
+        except Exception:  # noqa: BLE001 - numba's own method decides (and reports) instead
+            return original(self, sig, target_context)
+
+    load_overload.mbdsim = True
+    load_overload.__doc__ = original.__doc__
+    caching.FunctionCache.load_overload = load_overload
+    return True
+
+
 CACHE_DIR = configure()
+FAST_LOADS = _fast_cached_loads()

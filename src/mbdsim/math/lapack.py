@@ -3,14 +3,22 @@
 The same LAPACK routines, with the same workspace sizes, as scipy.linalg.qr(pivoting=True) and
 scipy.linalg.null_space, so the results are bit for bit theirs, without their argument handling (tens of
 microseconds a call, which dominate for the constraint Jacobians of small models).  Inputs are finite
-float64 matrices; a matrix with an inf or a NaN raises ValueError as scipy's functions do.
+float64 matrices; a matrix with an inf or a NaN raises ValueError as scipy's functions do.  scipy.linalg
+is imported on first use only; `cho_solve_spd` uses numpy's LAPACK (a simple model's first run then
+needs no scipy.linalg at all).
 """
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import lapack
 
 _LWORK: dict = {}   # (routine, m, n) -> optimal workspace size from LAPACK's query
+
+
+def _lapack():
+    """scipy.linalg.lapack, imported on first use (scipy.linalg costs ~0.3 s at start-up, and a model
+    whose rows need no rank decision never needs it)."""
+    from scipy.linalg import lapack
+    return lapack
 
 
 def _finite(a: np.ndarray) -> np.ndarray:
@@ -30,8 +38,8 @@ def pivoted_qr(a) -> tuple[np.ndarray, np.ndarray]:
     key = ("geqp3", m, n)
     lwork = _LWORK.get(key)
     if lwork is None:
-        lwork = _LWORK[key] = int(lapack.dgeqp3(a, lwork=-1)[3][0].real)
-    qr, jpvt, _, _, info = lapack.dgeqp3(a, lwork=lwork)
+        lwork = _LWORK[key] = int(_lapack().dgeqp3(a, lwork=-1)[3][0].real)
+    qr, jpvt, _, _, info = _lapack().dgeqp3(a, lwork=lwork)
     if info < 0:
         raise ValueError(f"illegal value in {-info}th argument of internal geqp3")
     return np.abs(np.diagonal(qr)).copy(), jpvt - 1
@@ -54,11 +62,11 @@ def null_space(a) -> np.ndarray:
     key = ("gesdd", m, n)
     lwork = _LWORK.get(key)
     if lwork is None:
-        work, info = lapack.dgesdd_lwork(m, n, compute_uv=1, full_matrices=1)
+        work, info = _lapack().dgesdd_lwork(m, n, compute_uv=1, full_matrices=1)
         if info != 0:
             raise ValueError(f"Internal work array size computation failed: {info}")
         lwork = _LWORK[key] = int(work.real)
-    _, s, vh, info = lapack.dgesdd(a, compute_uv=1, full_matrices=1, lwork=lwork)
+    _, s, vh, info = _lapack().dgesdd(a, compute_uv=1, full_matrices=1, lwork=lwork)
     if info > 0:
         raise np.linalg.LinAlgError("SVD did not converge")
     if info < 0:
@@ -68,19 +76,15 @@ def null_space(a) -> np.ndarray:
 
 
 def cho_solve_spd(a, b) -> np.ndarray:
-    """x with a x = b for a symmetric positive-definite a, as scipy.linalg.cho_solve(cho_factor(a), b)
-    (LAPACK dpotrf, dpotrs, upper factor); np.linalg.LinAlgError when a is not positive definite,
-    ValueError for an inf or a NaN."""
+    """x with a x = b for a symmetric positive-definite a (r, r), b (r,) or (r, k): numpy's Cholesky
+    factor L (a = L L^T), then L y = b and L^T x = y (to round-off as scipy.linalg.cho_solve(cho_factor(a),
+    b); numpy's LAPACK, so that the velocity assembly of a simple model needs no scipy.linalg, ~0.3 s
+    at start-up).  np.linalg.LinAlgError when a is not positive definite, ValueError for an inf or a NaN
+    or mismatched shapes."""
     a, b = _finite(a), _finite(b)
-    if a.size == 0 or b.size == 0 or a.ndim != 2 or a.shape[0] != a.shape[1] or a.shape[0] != b.shape[0]:
-        import scipy.linalg as sla
-        return sla.cho_solve(sla.cho_factor(a), b)   # edge cases and errors exactly as scipy's
-    c, info = lapack.dpotrf(a, lower=0, clean=0)
-    if info > 0:
-        raise np.linalg.LinAlgError(f"{info}-th leading minor of the array is not positive definite")
-    if info < 0:
-        raise ValueError(f'LAPACK reported an illegal value in {-info}-th argument on entry to "POTRF".')
-    x, info = lapack.dpotrs(c, b, lower=0)
-    if info != 0:
-        raise ValueError(f"illegal value in {-info}th argument of internal potrs")
-    return x
+    if a.ndim != 2 or a.shape[0] != a.shape[1] or b.ndim not in (1, 2) or a.shape[0] != b.shape[0]:
+        raise ValueError(f"cho_solve_spd: shapes {a.shape} and {b.shape} do not match")
+    if a.size == 0:
+        return np.zeros(b.shape)
+    L = np.linalg.cholesky(a)
+    return np.linalg.solve(L.T, np.linalg.solve(L, b))

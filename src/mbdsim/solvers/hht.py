@@ -16,7 +16,6 @@ interpolation of (q, v) in the tangent space followed by projection and an index
 from __future__ import annotations
 
 import numpy as np
-import scipy.linalg as sla
 
 from ..errors import SolverError
 from ..results.result import Result
@@ -212,6 +211,7 @@ class _Tangent:
 
 def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
     """One HHT step of size h from `cur`; returns (new _Step or None, converged)."""
+    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
     t1 = cur.t + h
     a, lam = cur.a.copy(), cur.lam.copy()
     nv = sys.nv
@@ -258,6 +258,7 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
 
 
 def _iteration_matrix(sys, tan, J, h, alpha, beta, gamma):
+    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
     nv, nr = sys.nv, J.shape[0]
     A = np.zeros((nv + nr, nv + nr))
     A[:nv, :nv] = sys.M + (1 + alpha) * (gamma * h * tan.C + beta * h * h * tan.K)

@@ -12,7 +12,6 @@ from __future__ import annotations
 import warnings
 
 import numpy as np
-import scipy.linalg as sla
 
 from ...math.rotation import skew
 
@@ -63,6 +62,7 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
     """vd and full lambda_ (lock entries = friction multipliers) with slip friction loads coupled to lambda_.
 
     rows: the active rows (independent joint rows + active lock rows)."""
+    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up, needed only with friction
     nv, nr = sys.nv, len(rows)
     K = np.zeros((nv + nr, nv + nr))
     K[:nv, :nv] = sys.M
