@@ -14,11 +14,16 @@ import numpy as np
 _LWORK: dict = {}   # (routine, m, n) -> optimal workspace size from LAPACK's query
 
 
+_LAPACK = []   # scipy.linalg.lapack once imported
+
+
 def _lapack():
     """scipy.linalg.lapack, imported on first use (scipy.linalg costs ~0.3 s at start-up, and a model
     whose rows need no rank decision never needs it)."""
-    from scipy.linalg import lapack
-    return lapack
+    if not _LAPACK:
+        from .._blas import scipy_linalg
+        _LAPACK.append(scipy_linalg().lapack)
+    return _LAPACK[0]
 
 
 def _finite(a: np.ndarray) -> np.ndarray:

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._threads import blas_single_thread
+from .._blas import blas_single_thread
 from ..errors import AssemblyError
 from ..system.assemble import System, assemble_system
 from ..system.equations import constraint_terms

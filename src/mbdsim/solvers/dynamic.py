@@ -13,7 +13,7 @@ import os
 
 import numpy as np
 
-from ._threads import blas_single_thread
+from .._blas import blas_single_thread, lazy_import
 from ..errors import ModelError
 from ..results.result import Result
 from ..system.assemble import assemble_system
@@ -230,9 +230,8 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
             return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)
         except NotCompiled:
             pass   # an element the compiled kernels do not carry yet: the reference (scipy) path
-    from scipy import integrate
-
     from .index1 import integrate_index1
+    integrate = lazy_import("scipy.integrate")
     return integrate_index1(sys, rep, times, getattr(integrate, SCIPY_METHODS[method]), rtol, atol, max_step,
                             progress)
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._blas import scipy_linalg
 from ..math.lapack import cho_solve_spd
 from ..system import measures as ms
 from ..system.frames import body_frames
@@ -129,7 +130,7 @@ def lexi_solve(J, b, items, M, rel_tol=1e-9):
                 return x, True
         except (np.linalg.LinAlgError, ValueError):
             pass   # dependent rows or an inconsistent b: the general path below
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up, the fast path needs none
+    sla = scipy_linalg()   # imported here: ~0.3 s at start-up, the fast path needs none
     if J.shape[0]:
         xp = np.linalg.lstsq(J, b, rcond=None)[0]
         N = sla.null_space(J, rcond=1e-10)

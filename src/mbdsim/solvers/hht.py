@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._blas import scipy_linalg
 from ..errors import SolverError
 from ..results.result import Result
 from ..system.dynamics import applied_forces
@@ -211,7 +212,7 @@ class _Tangent:
 
 def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
     """One HHT step of size h from `cur`; returns (new _Step or None, converged)."""
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up
     t1 = cur.t + h
     a, lam = cur.a.copy(), cur.lam.copy()
     nv = sys.nv
@@ -258,7 +259,7 @@ def _try_step(sys, cur, h, alpha, beta, gamma, rows, sf, tan):
 
 
 def _iteration_matrix(sys, tan, J, h, alpha, beta, gamma):
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up
     nv, nr = sys.nv, J.shape[0]
     A = np.zeros((nv + nr, nv + nr))
     A[:nv, :nv] = sys.M + (1 + alpha) * (gamma * h * tan.C + beta * h * h * tan.K)

@@ -9,7 +9,7 @@ import warnings
 
 import numpy as np
 
-from ._threads import blas_single_thread
+from .._blas import blas_single_thread
 from ..errors import AssemblyError, ModelError
 from ..results.result import Result
 from ..system.dynamics import applied_forces

@@ -30,12 +30,15 @@ _FAST = {"reassoc", "contract", "nsz", "arcp"}
 
 @njit(cache=True, fastmath=_FAST)
 def _cholesky(A, n):
-    """Lower Cholesky factor of A[:n, :n] in place (upper part untouched); False if not positive definite."""
+    """Lower Cholesky factor of A[:n, :n] in place (upper part untouched); False if not positive definite
+    to 1e-12 of the pivot's diagonal (for G = J_r J_r^T: rows dependent to about 1e-6 in the relative
+    singular values of J_r, which the SVD decides better)."""
     for j in range(n):
         s = A[j, j]
+        floor = 1e-12 * abs(s)
         for k in range(j):
             s -= A[j, k] * A[j, k]
-        if not s > 0.0:
+        if not s > floor:
             return False
         d = np.sqrt(s)
         A[j, j] = d

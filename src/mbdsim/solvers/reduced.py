@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .._blas import scipy_linalg
 from ..errors import SolverError
 from ..system.equations import constraint_terms
 from .common import increment
@@ -87,7 +88,7 @@ def _project_offset(sys, q, t, rows, offset, tol, maxit=30):
 
 def min_norm(J, r):
     """Minimum-norm x with J x = r for independent rows J (Cholesky of J J^T; least squares if that fails)."""
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up
     if J.shape[0] == 0:
         return np.zeros(J.shape[1])
     try:
@@ -99,7 +100,7 @@ def min_norm(J, r):
 def tangent_residual(sys, q, t, rows, Q):
     """(r, lambda_): r = Q - phi_q^T lambda_ with lambda_ the least-squares multipliers of the rows, i.e. the
     part of the generalized load Q (nv) that no constraint reaction can balance (zero at equilibrium)."""
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up
     if not len(rows):
         return Q.copy(), np.zeros(0)
     J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][rows]

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ._threads import blas_single_thread
+from .._blas import blas_single_thread
 from ..errors import SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system

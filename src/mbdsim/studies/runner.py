@@ -11,6 +11,7 @@ from contextlib import contextmanager
 
 import pandas as pd
 
+from .._blas import _limit
 from ..errors import ModelError
 from .store import STUDY_COLUMN, RowStore, load_rows
 from .variant import run_chunk
@@ -146,9 +147,10 @@ def execute(study, client=None, workers=None, out=None, chunk_size=None, progres
             if len(pending) == 0:
                 pass
             elif serial:
-                for chunk in chunks_of(pending, chunk_size or 1):     # every run journaled as it finishes
-                    sink.add(run_chunk(study.plan, chunk))
-                    bar.advance(task, len(chunk))
+                with _limit():   # one BLAS limit for the whole loop (run_chunk's own is then a no-op)
+                    for chunk in chunks_of(pending, chunk_size or 1):     # every run journaled as it finishes
+                        sink.add(run_chunk(study.plan, chunk))
+                        bar.advance(task, len(chunk))
             else:
                 _run_dask(study, pending, client, workers, chunk_size, sink, lambda n: bar.advance(task, n))
     finally:

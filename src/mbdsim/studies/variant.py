@@ -142,7 +142,7 @@ def run_chunk(plan: Plan, runs: list) -> list[dict]:
     """The Dask task: rows for `runs`, a list of (run number, {parameter: value}).  The whole chunk (the
     outputs' linear algebra included, not only the analyses) runs with one BLAS thread: the workers
     already share the cores."""
-    from ..solvers._threads import _limit
+    from .._blas import _limit
     worker = f"{socket.gethostname()}:{os.getpid()}"
     with _limit():
         return [{"run": run, **params, **run_variant(plan, params), "worker": worker} for run, params in runs]

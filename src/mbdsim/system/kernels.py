@@ -278,7 +278,9 @@ def inertial_forces_kernel(A, w, mass, inertia_B, rd_idx, w_idx, rigid_fid, g, n
         wb = np.zeros(3)
         for i in range(3):
             wb[i] = A[f, 0, i] * w[f, 0] + A[f, 1, i] * w[f, 1] + A[f, 2, i] * w[f, 2]
-        h = inertia_B[f] @ wb
+        h = np.zeros(3)   # J_B w_B by hand: numba's `@` calls scipy's BLAS (loading scipy.linalg mid-run)
+        for i in range(3):
+            h[i] = inertia_B[f, i, 0] * wb[0] + inertia_B[f, i, 1] * wb[1] + inertia_B[f, i, 2] * wb[2]
         Q[w_idx[k, 0]] -= wb[1] * h[2] - wb[2] * h[1]
         Q[w_idx[k, 1]] -= wb[2] * h[0] - wb[0] * h[2]
         Q[w_idx[k, 2]] -= wb[0] * h[1] - wb[1] * h[0]

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._blas import lazy_import
 from ..math.lapack import null_space, pivoted_qr, rank_of
 
 DENSE_LIMIT = 600   # velocity variables; larger systems use sparse factorisations (O(N) for chains, trees)
@@ -101,8 +102,7 @@ def _blocks_independent(J, blocks, thr):
 def _projected_loop_sparse(J, tree, loop):
     """Loop rows projected onto the null space of the tree rows (sparse normal equations, O(N) for
     chains and trees); None when the tree rows are dependent."""
-    from scipy import sparse
-    from scipy.sparse.linalg import splu
+    sparse, splu = lazy_import("scipy.sparse"), lazy_import("scipy.sparse.linalg").splu
     JT = sparse.csr_matrix(J[tree])
     try:
         lu = splu((JT @ JT.T).tocsc())
@@ -123,8 +123,7 @@ def min_norm_solve(J, r):
     else the sparse normal equations (J J^T + eps I) y = r, x = J^T y (eps: 1e-14 of the largest diagonal)."""
     if J.shape[1] <= DENSE_LIMIT or J.shape[0] == 0:
         return np.linalg.lstsq(J, r, rcond=None)[0]
-    from scipy import sparse
-    from scipy.sparse.linalg import splu
+    sparse, splu = lazy_import("scipy.sparse"), lazy_import("scipy.sparse.linalg").splu
     Js = sparse.csr_matrix(J)
     S = (Js @ Js.T).tocsc()
     S = S + 1e-14 * max(float(S.diagonal().max()), 1e-300) * sparse.identity(S.shape[0], format="csc")

@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 
+from ..._blas import scipy_linalg
 from ...math.rotation import skew
 
 MAXIT = 50          # iterations of the coupled friction KKT solve
@@ -62,7 +63,7 @@ def friction_kkt(sys, fr, J, gamma, Q, rows, t):
     """vd and full lambda_ (lock entries = friction multipliers) with slip friction loads coupled to lambda_.
 
     rows: the active rows (independent joint rows + active lock rows)."""
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up, needed only with friction
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up, needed only with friction
     nv, nr = sys.nv, len(rows)
     K = np.zeros((nv + nr, nv + nr))
     K[:nv, :nv] = sys.M

@@ -31,13 +31,14 @@ import itertools
 
 import numpy as np
 
+from ..._blas import scipy_linalg
 RHO_TOL = 1e-10     # constrained mobility below which a lock row counts as dependent on the others
 MAX_JOINT = 7       # joints decided by enumeration together (3^7 assignments); beyond: one by one
 
 
 def null_basis(J, nv):
     """Orthonormal basis of the null space of J (nv, k)."""
-    import scipy.linalg as sla   # here: scipy.linalg costs ~0.3 s at start-up, needed only with friction
+    sla = scipy_linalg()   # imported on first use: ~0.3 s at start-up, needed only with friction
     return sla.null_space(J, rcond=1e-11) if J.shape[0] else np.eye(nv)
 
 
