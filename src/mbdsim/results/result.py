@@ -17,7 +17,7 @@ from . import joints as jm
 from . import kinematics as kin
 from ..system.force_elements import evaluator
 from ..system.frames import Frames, acceleration_terms, body_frames
-from ..system.reactions import joint_reaction
+from ..system.reactions import jacobians_of, joint_reaction
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -120,7 +120,7 @@ class Result:
         Euler parameters renormalised."""
         if len(self.time) < 2:
             return self._subset([0] * len(ts))
-        from ..solvers.common import normalize, qdot
+        from ..system.coordinates import normalize, qdot
         k = np.clip(np.searchsorted(self.time, ts), 1, len(self.time) - 1)
         a, b = k - 1, k
         h = (self.time[b] - self.time[a])[:, None]
@@ -285,7 +285,6 @@ class Result:
             raise ValueError("reaction forces are not available: this result holds no multipliers")
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
         body = None if on is None else ms.resolve_body(self.system, on, "on")
-        from ..solvers.compiled_run import jacobians_of
         lam = self.lambda_
         F, T = joint_reaction(self.system, self.q, lam, jt, body, A=self.frames.A, J=jacobians_of(self.system, lam))
         return self._express(F, frame), self._express(T, frame)

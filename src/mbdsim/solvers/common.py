@@ -5,6 +5,7 @@ import numpy as np
 
 from ..errors import SolverError
 from ..system import kernels
+from ..system.coordinates import normalize, qdot  # noqa: F401  (the solvers' names)
 from ..system.dynamics import _worst_joints, accelerations, applied_forces, solve_kkt  # noqa: F401  (the solvers' names)
 from ..system.equations import constraint_terms
 from ..system.rows import (DENSE_LIMIT, active_rows, dependent_owners, independent_rows,  # noqa: F401
@@ -17,25 +18,6 @@ def increment(sys, q, dx):
                                  sys.rd_idx, sys.p_idx, sys.w_idx)
     q[sys.aux_q_idx] += dx[sys.aux_v_idx]   # auxiliary coordinates (curve parameters): plain sums
     return q
-
-
-def normalize(sys, q):
-    """Unit-normalise the Euler parameters of q (copy)."""
-    q = q.copy()
-    if len(sys.p_idx):
-        p = q[sys.p_idx]
-        q[sys.p_idx] = p / np.linalg.norm(p, axis=-1, keepdims=True)
-    return q
-
-
-def qdot(sys, q, v):
-    """dq/dt from velocity variables: rd for positions, 1/2 p (x) (0, w_B) for Euler parameters."""
-    qd = kernels.qdot_kernel(np.asarray(q, dtype=float), np.asarray(v, dtype=float), sys.r_idx,
-                             sys.rd_idx, sys.p_idx, sys.w_idx, sys.nq)
-    qd[sys.aux_q_idx] = v[sys.aux_v_idx]
-    return qd
-
-
 
 
 def project_positions(sys, q, t, rows, tol=1e-12, maxit=25):

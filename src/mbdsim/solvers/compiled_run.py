@@ -17,6 +17,7 @@ from ..results.result import Result
 from ..results.stream import notify
 from ..system.compiled import Work, compile_system
 from ..system.equations import jacobians
+from ..system.reactions import keep_jacobians
 from . import fastdop, fastdyn, minnorm
 from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
@@ -307,19 +308,8 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
         load = np.einsum("nri,nr->ni", J[bad][:, rows], LAM[bad][:, rows])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
         out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
-    if J.nbytes <= JACOBIAN_KEEP:   # the reactions read from these multipliers reuse their Jacobians
-        sys.run_state["jacobians of multipliers"] = (out, J)   # this run's samples: run state
+    keep_jacobians(sys, out, J)   # the reactions read from these multipliers reuse their Jacobians
     return out
-
-
-JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed are kept up to this size
-
-
-def jacobians_of(sys, lambda_):
-    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array the last
-    `_full_multipliers` call returned (the object itself, not equal values), else None."""
-    kept = sys.run_state.get("jacobians of multipliers")
-    return kept[1] if kept is not None and kept[0] is lambda_ else None
 
 
 def _rms(x, scale) -> float:

@@ -13,6 +13,24 @@ from .equations import jacobians
 from .frames import body_frames
 
 
+JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed are kept up to this size
+
+
+def keep_jacobians(sys, lambda_, J) -> None:
+    """Keep the constraint Jacobians J (N, nc, nv) at the samples of the multipliers `lambda_` (N, nc) just
+    computed from them, for the reactions read from those multipliers (this run's samples: run state;
+    up to JACOBIAN_KEEP bytes)."""
+    if J.nbytes <= JACOBIAN_KEEP:
+        sys.run_state["jacobians of multipliers"] = (lambda_, J)
+
+
+def jacobians_of(sys, lambda_):
+    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array last given
+    to `keep_jacobians` (the object itself, not equal values), else None."""
+    kept = sys.run_state.get("jacobians of multipliers")
+    return kept[1] if kept is not None and kept[0] is lambda_ else None
+
+
 def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None):
     """Force [N] and torque [N m] (N, 3), ground axes, that `joint` (a Joint or motion name) exerts on `on`.
 
