@@ -90,6 +90,17 @@ def test_fingerprint_is_deterministic_and_sees_deep_changes():
     assert model_fingerprint(m) != first
 
 
+def test_fingerprint_tells_arrays_apart_by_dtype_shape_and_bytes():
+    """Arrays with the same bytes but another dtype or shape, or another byte order, give other digests
+    (the dtype names are cached per dtype)."""
+    from mbdsim.system.fingerprint import fingerprint
+    arrays = [np.zeros(1, np.int64), np.zeros(1, np.float64), np.zeros(2, np.float32), np.zeros((1, 2), np.float32),
+              np.zeros(1, ">f8"), np.array([1.0]), np.array([1.0], ">f8")]
+    digests = [fingerprint({"x": a})[0] for a in arrays]
+    assert len(set(digests)) == len(arrays)
+    assert [fingerprint({"x": a.copy()})[0] for a in arrays] == digests   # the same again (cache hits)
+
+
 def test_energies_from_the_state_equal_the_frame_forms():
     """Kinetic and gravity energies straight from (q, v) against the ground-axes forms through the body
     frames (0.5 m |v_cm|^2 + 0.5 w . (A J A^T) w, -m g . r_cm), on a model with rigid bodies and a
