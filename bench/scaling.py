@@ -62,14 +62,14 @@ print(t1 - t0, time.perf_counter() - t1)
 
 
 def startup(log):
-    """`import mbdsim` and the first simulate of a new model in a fresh process (numba cache warm), best of 3;
+    """`import mbdsim` and the first simulate of a new model in a fresh process (numba cache warm), best of 5;
     `mbdsim validate` (all 30 cases) wall time.  The processes may write Python's bytecode cache (a
     PYTHONDONTWRITEBYTECODE of this environment is dropped for them) and a first run writes it, as the
     first import after any install does: the timed runs then read it, as a user's fresh process does."""
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     subprocess.run([sys.executable, "-c", _FIRST], capture_output=True, text=True, check=True, env=env)
     runs = []
-    for _ in range(3):
+    for _ in range(5):
         out = subprocess.run([sys.executable, "-c", _FIRST], capture_output=True, text=True, check=True, env=env)
         runs.append(tuple(float(x) for x in out.stdout.split()))
     imp, first = min(r[0] for r in runs), min(r[1] for r in runs)
