@@ -250,7 +250,7 @@ def test_hand_over_on_a_jointed_model_keeps_constraints_accelerations_and_energy
     ringing decays. After the switch the outputs stay on the constraints, the on-demand accelerations
     equal the index-1 solve at the output states, and the energy balance E + dissipated = E(0) holds."""
     from mbdsim.solvers.common import accelerations
-    from mbdsim.solvers.state import state_factory
+    from mbdsim.results.state import state_factory
     from mbdsim.system.equations import constraint_terms
     m = mb.Model("held rod", gravity=(0, -G, 0))
     rod = m.add_body("rod", 1.0, (1e-4, 1.0 / 12, 1.0 / 12), position=(0.5, 0, 0))

@@ -111,7 +111,7 @@ def _energy_terms(res):
         hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None
     P_w = None
     if applied:
-        from ..solvers.state import state_factory
+        from .state import state_factory
         sf = state_factory(sys)
         P_w = np.zeros(len(res.time))
         from ..system.frames import body_frames

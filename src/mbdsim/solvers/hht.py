@@ -27,7 +27,7 @@ from .common import accelerations, increment, normalize, project_positions, proj
 from .common import consistent_state
 from .driver import Step, drive
 from .events import EventTracker
-from .state import state_factory
+from ..results.state import state_factory
 
 ALPHA = -0.05
 

@@ -19,7 +19,7 @@ from .common import _weak_joints, accelerations, consistent_state, normalize, pr
     project_velocities, qdot
 from .driver import Step, drive
 from .events import EventTracker
-from .state import state_factory
+from ..results.state import state_factory
 
 
 class _Trajectory:

@@ -17,7 +17,7 @@ from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .assembly import assemble_state
 from .common import DENSE_LIMIT, increment, project_positions
-from .state import state_factory
+from ..results.state import state_factory
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:

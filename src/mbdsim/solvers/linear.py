@@ -54,7 +54,7 @@ from .assembly import assemble_state
 from .common import increment, independent_rows, project_positions
 from .linear_modes import mode_shape_table, modes_table
 from .reduced import Chart, length_scale, min_norm, tangent_basis, velocity_scale
-from .state import state_factory
+from ..results.state import state_factory
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:

@@ -25,7 +25,7 @@ class SensorItem:
     """Event-tracker item of one Sensor."""
 
     def __init__(self, sys, sensor):
-        from .state import State
+        from ..results.state import State
         self.sys, self.sensor, self._State = sys, sensor, State
         self.last = None      # sign of g at the last accepted state
 

@@ -38,7 +38,7 @@ from ..system.frames import body_frames
 from .assembly import assemble_state
 from .common import project_positions
 from .reduced import Chart, describe_direction, length_scale, tangent_basis, tangent_residual, velocity_scale
-from .state import state_factory
+from ..results.state import state_factory
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:

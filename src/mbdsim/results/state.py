@@ -11,7 +11,7 @@ class State:
     """Measures of a single instant (t [s]); methods mirror Result but return one sample (no time axis)."""
 
     def __init__(self, system, t, q, v):
-        from ..results.result import Result
+        from .result import Result
         self.t = float(t)
         self._res = Result(system, [t], q[None, :], v[None, :], None, None)
 
