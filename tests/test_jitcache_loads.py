@@ -8,7 +8,9 @@ import sys
 import textwrap
 
 import numpy as np
+import pytest
 
+import mbdsim as mb
 from mbdsim import _jitcache
 
 _PENDULUM = """
@@ -26,6 +28,16 @@ misses = sum(fastdop.run.stats.cache_misses.values())
 print(hits, misses, int("numba.np.linalg" in sys.modules), int("scipy.linalg" in sys.modules))
 print(" ".join(repr(float(x)) for x in r.q[-1]))
 """
+
+
+@pytest.fixture(scope="module", autouse=True)
+def _warm_cache():
+    """The pendulum's kernels compiled (or loaded) in this process first, so that the fresh processes
+    below load them from the disk cache instead of compiling them a second time (cold cache in CI)."""
+    m = mb.Model("p", gravity=(0, -9.81, 0))
+    b = m.add_body("b", 1.0, inertia=(1e-3, 1 / 12, 1 / 12), position=(0.5, 0, 0))
+    m.add_revolute("j", m.ground, b, (0, 0, 0), (0, 0, 1))
+    mb.simulate(m, 0.5)
 
 
 def _run(code: str, cwd=None) -> list[str]:
