@@ -48,20 +48,18 @@ def _get_controller(rescan: bool = False):
 
 @contextlib.contextmanager
 def _counted(limit):
-    """`limit` entered, with this thread's depth counted around it; limits added inside it by
-    `scipy_linalg` are left first."""
-    _held.depth = getattr(_held, "depth", 0) + 1
-    extra = _held.extra = [] if _held.depth == 1 else getattr(_held, "extra", [])
+    """The outermost `limit` of this thread entered (`_limit` makes inner ones no-ops), with the depth
+    counted around it; limits added inside it by `lazy_import` are left first."""
+    _held.depth, _held.extra = 1, []
     try:
         with limit:
             try:
                 yield
             finally:
-                if _held.depth == 1:
-                    while extra:
-                        extra.pop().__exit__(None, None, None)
+                while _held.extra:
+                    _held.extra.pop().__exit__(None, None, None)
     finally:
-        _held.depth -= 1
+        _held.depth = 0
 
 
 def _limit():

@@ -11,19 +11,15 @@ from __future__ import annotations
 
 import numpy as np
 
+from .._blas import scipy_linalg
+
 _LWORK: dict = {}   # (routine, m, n) -> optimal workspace size from LAPACK's query
-
-
-_LAPACK = []   # scipy.linalg.lapack once imported
 
 
 def _lapack():
     """scipy.linalg.lapack, imported on first use (scipy.linalg costs ~0.3 s at start-up, and a model
-    whose rows need no rank decision never needs it)."""
-    if not _LAPACK:
-        from .._blas import scipy_linalg
-        _LAPACK.append(scipy_linalg().lapack)
-    return _LAPACK[0]
+    whose rows need no rank decision never needs it); later calls: a sys.modules look-up."""
+    return scipy_linalg().lapack
 
 
 def _finite(a: np.ndarray) -> np.ndarray:
