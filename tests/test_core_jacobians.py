@@ -17,7 +17,7 @@ import mbdsim as mb
 from mbdsim.solvers.common import increment
 from mbdsim.system import assemble_system, equations
 
-# the dispatching entry point (compiled kernel when numba is present) and the numpy reference
+# the dispatching entry point (packed compiled rows) and the group-by-group rows scattered by numpy
 IMPLS = {"dispatch": equations.constraint_terms,
          "numpy": getattr(equations, "constraint_terms_numpy", equations.constraint_terms)}
 constraint_terms = equations.constraint_terms

@@ -1,7 +1,7 @@
 """Constraint equations of systems with rows the compiled kernel does not know (point-on-curve,
 couplers, screw, constant-velocity): the mixed evaluation (kernel for the rows it knows, the curve
-point and the remaining rows added in numpy) against the all-numpy reference primitives, on random
-states away from the constraint manifold (tests/test_path.py holds the curve rows against finite
+point and the remaining rows added group by group) against the group-by-group evaluation of every
+row, on random states away from the constraint manifold (tests/test_path.py holds the curve rows against finite
 differences through the same entry point)."""
 from __future__ import annotations
 

@@ -417,8 +417,47 @@ def normalize_kernel(p_idx, q):
 
 
 @njit(cache=True, _nrt=False)
+def newton_positions(cm, wk, t, q, v, tol):
+    """Newton on phi(q, t) = 0 from q, in place (Euler parameters normalised first; mass-weighted
+    minimum-norm steps through the KKT factorisation in wk, at most 12), the rows in wk evaluated at the
+    q returned. Returns (status: OK, NONFINITE (a residual not finite), SINGULAR (a factorisation
+    failed) or PROJECTION (no convergence); the sum over the steps of the largest six-slot component
+    [m or rad]; the number of factorisations)."""
+    active = cm[32]
+    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
+    normalize_into(cm, q)
+    for f in range(zero6.shape[0]):
+        for k in range(6):
+            zero6[f, k] = 0.0
+    size, nfactor = 0.0, 0
+    for it in range(12):
+        _constraints(cm, wk, t, q, v)   # phi and the Jacobian do not depend on v; nu, gamma are at (q, v)
+        res = 0.0
+        for i in range(active.shape[0]):
+            r = abs(wk[4][active[i]])
+            if not np.isfinite(r):
+                return NONFINITE, size, nfactor
+            res = max(res, r)
+        if res <= tol:
+            return OK, size, nfactor
+        if not _factor(cm, wk):
+            return SINGULAR, size, nfactor
+        nfactor += 1
+        for i in range(c.shape[0]):
+            c[i] = -wk[4][i]
+        _solve(cm, wk, zero6, c, x6, lam)
+        step = 0.0
+        for f in range(1, x6.shape[0]):
+            for k in range(6):
+                step = max(step, abs(x6[f, k]))
+        size += step
+        increment_into(cm, q, x6)
+    return PROJECTION, size, nfactor
+
+
+@njit(cache=True, _nrt=False)
 def project(cm, wk, t, q, v, tol, exact_factor=True):
-    """Project q onto phi(q, t) = 0 (mass-weighted minimum-norm Newton steps) and v onto phi_q v = nu.
+    """Project q onto phi(q, t) = 0 (`newton_positions`) and v onto phi_q v = nu.
     Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`); with
     exact_factor=False the velocity step reuses the last Newton step's factorisation (positions a
     Newton step apart: the velocity residual is of the order of that step times the correction, far
@@ -426,32 +465,10 @@ def project(cm, wk, t, q, v, tol, exact_factor=True):
     A joint-coordinate tree satisfies its constraints by construction: nothing to do."""
     if cm[31][5] == 1:
         return OK
-    factored = False
-    active = cm[32]
-    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
-    normalize_into(cm, q)
-    for f in range(zero6.shape[0]):
-        for k in range(6):
-            zero6[f, k] = 0.0
-    ok = False
-    for it in range(12):
-        _constraints(cm, wk, t, q, v)   # phi and the Jacobian do not depend on v; nu, gamma are at (q, v)
-        res = 0.0
-        for i in range(active.shape[0]):
-            res = max(res, abs(wk[4][active[i]]))
-        if res <= tol:
-            ok = True
-            break
-        if not _factor(cm, wk):
-            return SINGULAR
-        factored = True
-        for i in range(c.shape[0]):
-            c[i] = -wk[4][i]
-        _solve(cm, wk, zero6, c, x6, lam)
-        increment_into(cm, q, x6)
-    if not ok:
-        return PROJECTION
-    return project_velocities(cm, wk, v, exact_factor or not factored)
+    status, _, nfactor = newton_positions(cm, wk, t, q, v, tol)
+    if status != OK:
+        return status
+    return project_velocities(cm, wk, v, exact_factor or nfactor == 0)
 
 
 @njit(cache=True, _nrt=False)

@@ -12,7 +12,7 @@ ground axes and angular velocities [rad/s] in body axes); the predictions use th
 `fastdyn.increment_into` (translation [m] in ground axes, rotation vector [rad] in body axes). Each
 time is reached from the previous solved state by sub-steps: q + h qdot + h^2/2 qddot + h^3/6 qdddot
 predicted (the third derivative from the accelerations at the start and end of the previous sub-step),
-Newton on the positions, `fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the
+Newton on the positions (`fastdyn.newton_positions`, as the projection of the dynamics), `fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the
 multipliers. A sub-step is retried at half length when the Newton iteration fails, when it turns any
 body by more than MAX_TURN, or when its correction is large against the predicted motion (a guard
 against converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned
@@ -24,11 +24,10 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
-from .fastdyn import (NONFINITE, OK, PROJECTION, _constraints, _factor, _solve, _to6, accelerations,
-                      increment_into, normalize_into, project_velocities)
+from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, increment_into, newton_positions,
+                      project_velocities)
 
 MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-step
-MAX_NEWTON = 12       # Newton iterations per sub-step
 CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted increment (+ CORR_ABS) ...
 CORR_ABS = 1e-6       # ... [m or rad, largest slot] halves the sub-step (branch guard)
 HMIN_REL = 1e-12      # smallest sub-step [s] relative to max(1, |t|)
@@ -36,42 +35,6 @@ HMIN_REL = 1e-12      # smallest sub-step [s] relative to max(1, |t|)
 # 4 factorisations, 5 solved configurations where the factorisation dropped dependent loop rows
 # (`kkt_tree.pivoted_chol`: a change point or a lock-up, where the constraints do not determine the
 # rates; those come from the prediction)
-
-
-@njit(cache=True, _nrt=False)
-def _newton(cm, wk, t, q, v, tol, stats):
-    """Newton on phi(q, t) = 0 from q (in place; steps as in `fastdyn.project`); returns (status,
-    sum over the steps of the largest six-slot component [m or rad])."""
-    active = cm[32]
-    x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
-    normalize_into(cm, q)
-    for f in range(zero6.shape[0]):
-        for k in range(6):
-            zero6[f, k] = 0.0
-    size = 0.0
-    for it in range(MAX_NEWTON):
-        _constraints(cm, wk, t, q, v)
-        res = 0.0
-        for i in range(active.shape[0]):
-            r = abs(wk[4][active[i]])
-            if not np.isfinite(r):
-                return NONFINITE, size
-            res = max(res, r)
-        if res <= tol:
-            return OK, size
-        if not _factor(cm, wk):
-            return PROJECTION, size
-        stats[4] += 1
-        for i in range(c.shape[0]):
-            c[i] = -wk[4][i]
-        _solve(cm, wk, zero6, c, x6, lam)
-        step = 0.0
-        for f in range(1, x6.shape[0]):
-            for k in range(6):
-                step = max(step, abs(x6[f, k]))
-        size += step
-        increment_into(cm, q, x6)
-    return PROJECTION, size
 
 
 @njit(cache=True, _nrt=False)
@@ -112,7 +75,10 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
             S[2, i] = vd[i]
             v[i] += h * vd[i]   # (the projection makes v exact: a prediction only)
         increment_into(cm, q, dx6)
-        status, size = _newton(cm, wk, t + h, q, v, tol, stats)
+        status, size, nfactor = newton_positions(cm, wk, t + h, q, v, tol)
+        stats[4] += nfactor
+        if status == SINGULAR:   # a singular Jacobian on the way: reported as a failed solve
+            status = PROJECTION
         if status == OK:   # the rows in wk are at the converged q: the velocities directly
             status = project_velocities(cm, wk, v, True)
             stats[3] += 1

@@ -142,7 +142,8 @@ def _terms_mixed(sys, q, v, t, jacobian):
 
 
 def _numpy_group(sys, g, fr, q, v, t, phi_, J, nu, gamma):
-    """Evaluate one group with the numpy primitives into the global arrays (J may be None)."""
+    """Evaluate one group through the primitives' Rows (ground-axes rows, scattered here) into the global
+    arrays (J may be None)."""
     if g.kind == "coord":   # couplers, gears, user constraints: rows over several joints
         from .constraints.coupler import coord_terms
         coord_terms(sys, g, fr, q, v, t, phi_, J, nu, gamma)
@@ -173,7 +174,9 @@ def jacobians(sys, q) -> np.ndarray:
 
 
 def constraint_terms_numpy(sys, q, v, t, jacobian=True):
-    """Reference numpy implementation of constraint_terms (vectorised primitives)."""
+    """constraint_terms group by group through the primitives' Rows and `scatter_jacobian` (the same row
+    maths, `kernels.row_terms`, as the compiled path, scattered by numpy: the cross-check of the packed
+    rows and of the body-axes scatter)."""
     fr = body_frames(sys, q, v)
     fr.t = t
     fr.aux_q, fr.aux_v = np.asarray(q)[sys.aux_q_idx], np.asarray(v)[sys.aux_v_idx]

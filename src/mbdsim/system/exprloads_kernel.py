@@ -19,7 +19,7 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .exprvm import eval_program
-from .kernels import _dot1
+from .kernels import row_rate, row_terms
 
 
 @njit(cache=True, _nrt=False)
@@ -88,20 +88,12 @@ def measure(k, fi, fj, fk, si, sj, Ri, Rj, Rk, v, r, A, rd, w):
         else:           # AZ = atan2(xi.yj, xi.xj)
             a, b, c = _axis(A, fi, Ri, 0), _axis(A, fj, Rj, 1), _axis(A, fj, Rj, 0)
         return np.arctan2(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], a[0] * c[0] + a[1] * c[1] + a[2] * c[2])
-    if k == 21:         # joint angle rate (absolute coordinates): N / rho^2 of the angle primitive
-        S, cS, qS, Sd = _dot1(A, w, fi, fj, v[1], v[2])
-        C, cC, qC, Cd = _dot1(A, w, fi, fj, v[0], v[2])
-        return (C * Sd - S * Cd) / (S * S + C * C)
-    # joint slide (22) and its rate (23): h_i . d, d = P_j - P_i (v: h_i, s_i, s_j in body axes)
-    h = _rot(A, fi, v[0, 0], v[0, 1], v[0, 2])
-    pi, vi = _point(r, A, rd, w, fi, v[1])
-    pj, vj = _point(r, A, rd, w, fj, v[2])
-    d0, d1, d2 = pj[0] - pi[0], pj[1] - pi[1], pj[2] - pi[2]
+    # joint angle rate (21; absolute coordinates: the angle row's J v), slide (22) and its rate (23): the
+    # rows of kernels.row_terms (v: f_i, g_i, f_j or h_i, s_i, s_j in body axes)
+    ph, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 21 else 4, r, A, rd, w, fi, fj, v[0], v[1], v[2])
     if k == 22:
-        return h[0] * d0 + h[1] * d1 + h[2] * d2
-    c0, c1, c2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], h[0], h[1], h[2])
-    return (h[0] * (vj[0] - vi[0]) + h[1] * (vj[1] - vi[1]) + h[2] * (vj[2] - vi[2])
-            + c0 * d0 + c1 * d1 + c2 * d2)
+        return ph
+    return row_rate(rd, w, fi, fj, Jri, Jpi, Jrj, Jpj)
 
 
 @njit(cache=True, _nrt=False)
@@ -116,6 +108,19 @@ def _force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
         m0, m1, m2 = _cross(s0, s1, s2, F0, F1, F2)
         for k in range(3):
             F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
+
+
+@njit(cache=True, _nrt=False)
+def _row_load(F, A, f, s, Jr, Jp, rigid):
+    """s times a constraint row's Jacobian rows on frame f (J_r [-], J_p ground axes) into F: the force
+    s J_r [N] and the ground-axes torque s J_p turned into body axes."""
+    if f == 0:
+        return
+    for k in range(3):
+        F[f, k] += s * Jr[k]
+    if rigid[f]:
+        for k in range(3):
+            F[f, 3 + k] += s * (A[f, 0, k] * Jp[0] + A[f, 1, k] * Jp[1] + A[f, 2, k] * Jp[2])
 
 
 @njit(cache=True, _nrt=False)
@@ -181,16 +186,9 @@ def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
             inv = v0 / L if L > 0.0 else 0.0
             _force(F, A, fi, si[0], si[1], si[2], d0 * inv, d1 * inv, d2 * inv, rigid)
             _force(F, A, fj, sj[0], sj[1], sj[2], -d0 * inv, -d1 * inv, -d2 * inv, rigid)
-        elif k == 3:        # joint torque: T times the angle's Jacobian rows (ground-axes rotations)
-            S, cS, qS, Sd = _dot1(A, w, fi, fj, ld_v[e, 1], ld_v[e, 2])
-            C, cC, qC, Cd = _dot1(A, w, fi, fj, ld_v[e, 0], ld_v[e, 2])
-            s = v0 / (S * S + C * C)
-            J0, J1, J2 = s * (C * cS[0] - S * cC[0]), s * (C * cS[1] - S * cC[1]), s * (C * cS[2] - S * cC[2])
-            _torque(F, A, fi, J0, J1, J2, rigid)
-            _torque(F, A, fj, -J0, -J1, -J2, rigid)
-        else:               # joint force: F h_i at P_j on body j, -F h_i at the same ground point on body i
-            h = _rot(A, fi, ld_v[e, 0, 0], ld_v[e, 0, 1], ld_v[e, 0, 2])
-            sj = _rot(A, fj, ld_v[e, 2, 0], ld_v[e, 2, 1], ld_v[e, 2, 2])
-            _force(F, A, fj, sj[0], sj[1], sj[2], v0 * h[0], v0 * h[1], v0 * h[2], rigid)
-            o0, o1, o2 = r[fj, 0] + sj[0] - r[fi, 0], r[fj, 1] + sj[1] - r[fi, 1], r[fj, 2] + sj[2] - r[fi, 2]
-            _force(F, A, fi, o0, o1, o2, -v0 * h[0], -v0 * h[1], -v0 * h[2], rigid)
+        else:               # joint torque (3) or force (4): T or F times the joint angle's or slide's
+            #                   Jacobian rows (kernels.row_terms), the generalized force J^T T
+            _, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 3 else 4, r, A, rd, w, fi, fj, ld_v[e, 0], ld_v[e, 1],
+                                                 ld_v[e, 2])
+            _row_load(F, A, fi, v0, Jri, Jpi, rigid)
+            _row_load(F, A, fj, v0, Jrj, Jpj, rigid)

@@ -1,8 +1,9 @@
-"""Compiled (numba) kernel of the constraint equations: the same maths as `constraints.primitives`,
-evaluated row by row in one pass with scalar arithmetic, scattered straight into phi, phi_q, nu, gamma.
-
-`primitives` (numpy) evaluates the same rows batched over time samples (Result measures, path
-constraints); the tests check that both agree to round-off.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
+"""Compiled (numba) kernels of the constraint equations: `row_terms` is the one implementation of the
+constraint primitives, evaluated row by row with scalar arithmetic, scattered straight into phi,
+phi_q, nu, gamma by `rows_kernel`, or returned with ground-axes Jacobian rows by `ground_rows` (the
+`constraints.primitives` API: measures, force elements, the rows of screw, constant-velocity, couplers
+and path constraints, batched over time samples); tests/test_core_jacobians.py holds every row kind
+against finite differences.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
 (driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `system.packing.pack_rows`).
 """
 from __future__ import annotations
@@ -71,6 +72,8 @@ def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
 
 @njit(cache=True, _nrt=False)
 def _dot1(A, w, bi, bj, ai_B, aj_B):
+    """a_i . a_j of unit vectors fixed on frames bi and bj (body axes ai_B, aj_B): (value, c = a_i x a_j
+    (the ground-axes rotation row of bi; -c that of bj), quad, rate [1/s])."""
     ai = _mv(A, bi, ai_B)
     aj = _mv(A, bj, aj_B)
     wi = (w[bi, 0], w[bi, 1], w[bi, 2])
@@ -81,72 +84,98 @@ def _dot1(A, w, bi, bj, ai_B, aj_B):
     rate = _dt(c, wi) - _dt(c, wj)
     return _dt(ai, aj), c, quad, rate
 
+
+@njit(cache=True, _nrt=False)
+def row_terms(k, r, A, rd, w, bi, bj, a, b, c):
+    """One constraint row of kind k between frames bi and bj, the single implementation of Haug's basic
+    constraints (every other evaluation calls this one): (phi, J_ri, J_pi, J_rj, J_pj, quad) with the
+    Jacobian rows on each frame's CM translation [m] and ground-axes virtual rotation [rad], and quad
+    the velocity term of phi's second derivative (phi_dd = J vd + quad; gamma = -quad).  Vectors a, b,
+    c in body axes:
+      k = 0, 1, 2  spherical, component k of P_j - P_i [m] (a = s_i, b = s_j: points from the CMs)
+      k = 3        dot1: a_i . a_j (a = a_i, b = a_j; unit vectors)
+      k = 4, 6     dot2: a_i . (P_j - P_i) [m] (a = a_i, b = s_i, c = s_j); 6 is a slide driver's row
+      k = 5        angle of j about f_i x g_i, atan2(g_i . f_j, f_i . f_j) [rad] in (-pi, pi]
+                   (a = f_i, b = g_i, c = f_j); an angle driver's row before its target is taken off."""
+    zero = (0.0, 0.0, 0.0)
+    wi = (w[bi, 0], w[bi, 1], w[bi, 2])
+    wj = (w[bj, 0], w[bj, 1], w[bj, 2])
+    if k <= 2:
+        si = _mv(A, bi, a)
+        sj = _mv(A, bj, b)
+        e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
+        # row k of the skew matrices: J_pi = e x s_i, J_pj = s_j x e
+        return (r[bj, k] + sj[k] - r[bi, k] - si[k], _sc(-1.0, e), _cr(e, si), e, _cr(sj, e),
+                _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k])
+    if k == 3:
+        val, cc, quad, _ = _dot1(A, w, bi, bj, a, b)
+        return val, zero, cc, zero, _sc(-1.0, cc), quad
+    if k == 4 or k == 6:
+        ai = _mv(A, bi, a)
+        si = _mv(A, bi, b)
+        sj = _mv(A, bj, c)
+        d = _sub(_add((r[bj, 0], r[bj, 1], r[bj, 2]), sj), _add((r[bi, 0], r[bi, 1], r[bi, 2]), si))
+        dd = _sub(_add((rd[bj, 0], rd[bj, 1], rd[bj, 2]), _cr(wj, sj)),
+                  _add((rd[bi, 0], rd[bi, 1], rd[bi, 2]), _cr(wi, si)))
+        wai = _cr(wi, ai)
+        quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
+                + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
+        return _dt(ai, d), _sc(-1.0, ai), _cr(ai, _add(d, si)), ai, _cr(sj, ai), quad
+    S, cS, qS, Sd = _dot1(A, w, bi, bj, b, c)
+    C, cC, qC, Cd = _dot1(A, w, bi, bj, a, c)
+    rho2 = S * S + C * C
+    N = C * Sd - S * Cd
+    Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
+    quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
+    return np.arctan2(S, C), zero, Jp, zero, _sc(-1.0, Jp), quad
+
+
+@njit(cache=True, _nrt=False)
+def row_rate(rd, w, bi, bj, Jri, Jpi, Jrj, Jpj):
+    """phi's rate J v of a row [its unit / s] (no explicit time term) from its Jacobian rows."""
+    return (_dt(Jri, (rd[bi, 0], rd[bi, 1], rd[bi, 2])) + _dt(Jpi, (w[bi, 0], w[bi, 1], w[bi, 2]))
+            + _dt(Jrj, (rd[bj, 0], rd[bj, 1], rd[bj, 2])) + _dt(Jpj, (w[bj, 0], w[bj, 1], w[bj, 2])))
+
+
 @njit(cache=True, _nrt=False)
 def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
-    """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row.
+    """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row (`row_terms`, the
+    drivers' targets f(t) [m or rad] and their rates taken off).
 
     Jc[row, 0] holds the row's coefficients on body_i's velocity variables (CM velocity [m/s],
     body-axes angular velocity [rad/s]), Jc[row, 1] those on body_j's (zero for ground)."""
-    zero = (0.0, 0.0, 0.0)
     for row in range(kind.shape[0]):
         k = kind[row]
         bi, bj = bi_[row], bj_[row]
+        ph, Jri, Jpi, Jrj, Jpj, quad = row_terms(k, r, A, rd, w, bi, bj, v1[row], v2[row], v3[row])
+        _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
+        _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
+        phi[row] = ph
         nu[row] = 0.0
-        wi = (w[bi, 0], w[bi, 1], w[bi, 2])
-        wj = (w[bj, 0], w[bj, 1], w[bj, 2])
-        if k <= 2:
-            si = _mv(A, bi, v1[row])
-            sj = _mv(A, bj, v2[row])
-            ph = (r[bj, k] + sj[k] - r[bi, k] - si[k])
-            qd = _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k]
-            e = (1.0 if k == 0 else 0.0, 1.0 if k == 1 else 0.0, 1.0 if k == 2 else 0.0)
-            # row k of skew(s): (s~)_k. = e_k x ... ; J_pi = s~_i row k, J_pj = -s~_j row k
-            ski = _cr(si, e)
-            skj = _cr(sj, e)
-            ski = (-ski[0], -ski[1], -ski[2])
-            _put(Jc, row, 0, bi, (-e[0], -e[1], -e[2]), ski, A, rigid)
-            _put(Jc, row, 1, bj, e, skj, A, rigid)
-            phi[row] = ph
-            gamma[row] = -qd
-        elif k == 3:
-            val, c, quad, _ = _dot1(A, w, bi, bj, v1[row], v2[row])
-            _put(Jc, row, 0, bi, zero, c, A, rigid)
-            _put(Jc, row, 1, bj, zero, _sc(-1.0, c), A, rigid)
-            phi[row] = val
-            gamma[row] = -quad
-        elif k == 4 or k == 6:
-            ai = _mv(A, bi, v1[row])
-            si = _mv(A, bi, v2[row])
-            sj = _mv(A, bj, v3[row])
-            d = _sub(_add((r[bj, 0], r[bj, 1], r[bj, 2]), sj), _add((r[bi, 0], r[bi, 1], r[bi, 2]), si))
-            dd = _sub(_add((rd[bj, 0], rd[bj, 1], rd[bj, 2]), _cr(wj, sj)),
-                      _add((rd[bi, 0], rd[bi, 1], rd[bi, 2]), _cr(wi, si)))
-            wai = _cr(wi, ai)
-            quad = (_dt(_cr(wi, wai), d) + 2.0 * _dt(wai, dd)
-                    + _dt(ai, _sub(_cr(wj, _cr(wj, sj)), _cr(wi, _cr(wi, si)))))
-            _put(Jc, row, 0, bi, _sc(-1.0, ai), _cr(ai, _add(d, si)), A, rigid)
-            _put(Jc, row, 1, bj, ai, _cr(sj, ai), A, rigid)
-            phi[row] = _dt(ai, d)
-            gamma[row] = -quad
-            if k == 6:
-                n = drv[row]
-                phi[row] -= f[n]
-                nu[row] = fd[n]
-                gamma[row] += fdd[n]
-        else:  # angle driver
-            S, cS, qS, Sd = _dot1(A, w, bi, bj, v2[row], v3[row])
-            C, cC, qC, Cd = _dot1(A, w, bi, bj, v1[row], v3[row])
-            rho2 = S * S + C * C
-            N = C * Sd - S * Cd
-            Jp = _sc(1.0 / rho2, _sub(_sc(C, cS), _sc(S, cC)))
-            _put(Jc, row, 0, bi, zero, Jp, A, rigid)
-            _put(Jc, row, 1, bj, zero, _sc(-1.0, Jp), A, rigid)
-            quad = (C * qS - S * qC) / rho2 - N * (2.0 * S * Sd + 2.0 * C * Cd) / (rho2 * rho2)
+        gamma[row] = -quad
+        if k >= 5:   # drivers: phi - f(t), nu = f'(t), gamma + f''(t); an angle's difference wrapped
             n = drv[row]
-            dth = np.arctan2(S, C) - f[n]
-            phi[row] = (dth + np.pi) % (2.0 * np.pi) - np.pi
+            if k == 5:
+                phi[row] = (ph - f[n] + np.pi) % (2.0 * np.pi) - np.pi
+            else:
+                phi[row] = ph - f[n]
             nu[row] = fd[n]
-            gamma[row] = -quad + fdd[n]
+            gamma[row] += fdd[n]
+
+
+@njit(cache=True, _nrt=False)
+def ground_rows(kind, r, A, rd, w, bi_, bj_, v1, v2, v3, phi, Jri, Jpi, Jrj, Jpj, quad, rate):
+    """`row_terms` of every row with its Jacobian rows in ground axes (Jri, Jpi, Jrj, Jpj: (n, 3)) and
+    its rate J v: the rows of `constraints.primitives` (frames may carry time samples flattened into
+    the frame axis)."""
+    for row in range(kind.shape[0]):
+        bi, bj = bi_[row], bj_[row]
+        ph, a, b, c, d, qd = row_terms(kind[row], r, A, rd, w, bi, bj, v1[row], v2[row], v3[row])
+        phi[row] = ph
+        quad[row] = qd
+        for m in range(3):
+            Jri[row, m], Jpi[row, m], Jrj[row, m], Jpj[row, m] = a[m], b[m], c[m], d[m]
+        rate[row] = row_rate(rd, w, bi, bj, a, b, c, d)
 
 
 @njit(cache=True)

@@ -110,8 +110,8 @@ def joint_coordinate(sys, fr, joint, dof=None):
     if is_angle(joint.kind) and not g.particle_j:
         ang, _, angd = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
     if has_slide(joint.kind):
-        sl = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)).phi
-        sld = pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
+        rows = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
+        sl, sld = rows.phi, rows.rate
     return ang, angd, sl, sld
 
 
@@ -163,10 +163,9 @@ def planar_coordinates(sys, fr, joint):
     N = fr.r.shape[0]
     ff, bi, bj = flat(fr, g.bi, g.bj)
     rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
-    u = pr.dot2(ff, bi, bj, rep(g.f_i), rep(g.s_i), rep(g.s_j)).phi
-    v = pr.dot2(ff, bi, bj, rep(g.g_i), rep(g.s_i), rep(g.s_j)).phi
-    ud = pr.dot2_rate(ff, bi, bj, rep(g.f_i), rep(g.s_i), rep(g.s_j))
-    vd = pr.dot2_rate(ff, bi, bj, rep(g.g_i), rep(g.s_i), rep(g.s_j))
+    U = pr.dot2(ff, bi, bj, rep(g.f_i), rep(g.s_i), rep(g.s_j))
+    V = pr.dot2(ff, bi, bj, rep(g.g_i), rep(g.s_i), rep(g.s_j))
+    u, v, ud, vd = U.phi, V.phi, U.rate, V.rate
     if g.particle_j:
         z = np.zeros(N)
         return np.stack([u, v, z], -1), np.stack([ud, vd, z], -1)

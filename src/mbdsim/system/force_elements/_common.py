@@ -84,7 +84,7 @@ def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
         x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi
         return x, rate, rows
     rows = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
-    return rows.phi, pr.dot2_rate(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j)), rows
+    return rows.phi, rows.rate, rows
 
 
 def angle_switch(sys, fr, joint, owner, t) -> np.ndarray:
