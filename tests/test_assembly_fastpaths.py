@@ -31,7 +31,20 @@ def _systems():
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             out.append(assemble_system(model))
-    return out + [assemble_system(slider_crank())]
+    return out + [assemble_system(slider_crank()), assemble_system(_screw_and_cv())]
+
+
+def _screw_and_cv():
+    """Rows of kinds 7 and 8 (screw, constant velocity) beside the others."""
+    import mbdsim as mb
+    m = mb.Model("screw and cv")
+    m.add_body("nut", 1.0, inertia=(0.05, 0.05, 0.01), position=(0, 0, 0.1))
+    m.add_screw("s", "ground", "nut", (0, 0, 0), (0, 0, 1), lead=0.01)
+    m.add_body("a", 1.0, inertia=(0.1, 0.1, 0.1), position=(1, 0, 0))
+    m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(2, 0, 0.5))
+    m.add_revolute("ra", "ground", "a", (1, 0, 0), (1, 0, 0))
+    m.add_constant_velocity("cv", "a", "b", (1.5, 0, 0), (1, 0, 0), (2, 0, 1))
+    return m
 
 
 @pytest.mark.parametrize("shape", [(18, 21), (21, 18), (6, 5), (3, 7), (0, 4), (4, 0)])
@@ -62,15 +75,16 @@ def test_lapack_as_scipy(shape):
 def _pack_rows_loop(sys):
     """Reference for system.packing.pack_rows: the rows packed one by one (the former kernels.pack_rows).
 
-    A point-on-curve group packs as spherical rows with v2 = the marker point s_j (body-j axes) and
-    v1 = 0: the caller writes the curve point c(s) (body-i axes) into v1 at each evaluation.  Rows of
-    the groups the kernel does not evaluate (couplers, screw, constant-velocity) stay ground-ground
-    spherical rows (all zero) for the caller to overwrite."""
+    A point-on-curve group packs as spherical rows with V[row, 1] = the marker point s_j (body-j axes)
+    and V[row, 0] = 0: the caller writes the curve point c(s) (body-i axes) there at each evaluation.
+    A screw row's parameter is its lead / 2 pi.  Rows of the groups the kernel does not evaluate
+    (couplers) stay ground-ground spherical rows (all zero) for the caller to overwrite."""
     nc = sys.nc
     kind = np.zeros(nc, np.int64)
     bi = np.zeros(nc, np.int64)
     bj = np.zeros(nc, np.int64)
-    v = np.zeros((3, nc, 3))
+    V = np.zeros((nc, 6, 3))
+    par = np.zeros(nc)
     drv = -np.ones(nc, np.int64)
     fns = []
     for g in sys.groups:
@@ -85,20 +99,22 @@ def _pack_rows_loop(sys):
                 kind[r] = c if three else kernels.KIND[g.kind]
                 bi[r], bj[r] = g.bi[k], g.bj[k]
                 for m, vec in enumerate(g.vecs):
-                    v[first + m, r] = vec[k]
+                    V[r, first + m] = vec[k]
+                if g.kind == "screw":
+                    par[r] = g.fns[k] / (2 * np.pi)
                 if g.kind in ("angle", "slide"):
                     drv[r] = len(fns)
                     fns.append(g.fns[k])
-    return kind, bi, bj, v[0], v[1], v[2], drv, fns
+    return kind, bi, bj, V, par, drv, fns
 
 
 def test_packing_and_topology_as_reference():
     rng = np.random.default_rng(0)
     for s in _systems():
         fast, ref = s.derived["packed"], _pack_rows_loop(s)
-        for x, y in zip(fast[:7], ref[:7]):
+        for x, y in zip(fast[:6], ref[:6]):
             assert x.dtype == y.dtype and np.array_equal(x, y)
-        assert all(f is g for f, g in zip(fast[7], ref[7])) and len(fast[7]) == len(ref[7])
+        assert all(f is g for f, g in zip(fast[6], ref[6])) and len(fast[6]) == len(ref[6])
         for _ in range(50):
             rows = np.sort(rng.choice(s.nc, rng.integers(0, s.nc + 1), replace=False))
             s.derived.pop("topologies", None)

@@ -232,7 +232,7 @@ def _constraints(cm, wk, t, q, v):
     frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
     if cm[19].shape[0] > 0:
         drivers_at(cm, wk, t)
-    rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[33], cm[34], cm[35], cm[15],
+    rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[33], cm[34], cm[15],
                 wk[34], wk[35], wk[36], rigid, phi, Jc, nu, gamma)
 
 

@@ -30,7 +30,7 @@ from .constraints.registry import JOINT_TYPES
 from .force_elements.friction import lock_specs
 from .packing import pack_rows
 
-KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide")   # row kinds of system.kernels
+KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide", "screw", "cvel")   # row kinds of system.kernels
 
 
 @dataclass
@@ -77,8 +77,8 @@ class System:
     aux_v_idx: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     lock_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     switched: dict = field(default_factory=dict)   # friction name -> StickSlip (mode history)
-    # issue 11: why the compiled core cannot run this system (rows of numpy-only kinds: screw, constant-
-    # velocity, couplers, user constraints; sensors); empty when it can.  compile_system checks it.
+    # issue 11: why the compiled core cannot run this system (rows the kernels do not carry: couplers,
+    # user constraints; sensors); empty when it can.  compile_system checks it.
     not_compiled: list = field(default_factory=list)
     # Caches of functions of this System alone (packed constraint rows, friction base rows, the compiled
     # model, the assembled initial state): computed on first use, never changed after, shared by the

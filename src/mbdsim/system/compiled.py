@@ -44,7 +44,7 @@ class CompiledModel:
     kind: np.ndarray          # constraint rows (system.packing.pack_rows)
     bi: np.ndarray
     bj: np.ndarray
-    vecs: np.ndarray          # (3, nc, 3) body-axes vectors of each row
+    vecs: np.ndarray          # (nc, 6, 3) body-axes vectors of each row (kernels.row_terms)
     drv: np.ndarray           # (nc,) driver index of each row, -1 if none
     code: np.ndarray          # driver programs (system.exprvm): value, d1, d2 of each driver
     consts: np.ndarray
@@ -70,6 +70,7 @@ class CompiledModel:
     tree: tuple = ()          # joint-coordinate tree (system.jointtree) when dims[5] == 1, else empty arrays
     exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
     ex_stack: int = 4         # stack size of their programs
+    par: np.ndarray | None = None   # (nc,) parameter of each row (a screw's lead / 2 pi [m/rad]), arrays()[34]
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -79,7 +80,8 @@ class CompiledModel:
                 self.M6, self.gravity, self.mass, self.inertia, self.kind, self.bi, self.bj, self.vecs,
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
-                self.dims, self.active, self.vecs[0].copy(), self.vecs[1].copy(), self.vecs[2].copy(),
+                self.dims, self.active, self.vecs,
+                np.zeros(len(self.kind)) if self.par is None else self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads)
 
 
@@ -207,7 +209,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     packed = sys.derived.get("packed")   # the rows as system.equations packed them, else packed here
     if packed is None:
         packed = sys.derived["packed"] = packing.pack_rows(sys)
-    kind, bi, bj, v1, v2, v3, drv, fns = packed
+    kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     code, consts, tables, start, end, stack = _driver_programs(fns)
     bushings, loads = _loads(sys)
@@ -222,6 +224,6 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
                          sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
-                         np.stack([v1, v2, v3]), drv, code, consts, tables, start, end, *loads,
+                         V, drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, par)

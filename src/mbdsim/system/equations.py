@@ -33,7 +33,7 @@ def group_rows(sys, fr: Frames, group):
     elif group.kind == "curve":   # point on a curve, with the curve parameter as extra coordinate
         from .constraints.path import curve_rows
         rows = curve_rows(sys, fr, group)
-    elif group.kind in PAIR_ROW_KINDS:   # screw, constant-velocity: numpy only
+    elif group.kind in PAIR_ROW_KINDS:   # screw, constant-velocity
         rows = PAIR_ROW_KINDS[group.kind](fr, group)
     elif group.kind in ("angle", "slide"):
         if group.kind == "angle":
@@ -73,7 +73,7 @@ def constraint_terms(sys, q, v, t, jacobian=True):
     """phi, phi_q, nu, gamma at (q, v, t); phi_q is None when jacobian=False.
 
     The compiled kernel evaluates every row of the kinds it knows (point-on-curve rows too, with the
-    curve point evaluated here); couplers, screw and constant-velocity rows are added by numpy."""
+    curve point evaluated here); coupler rows are added group by group."""
     if not sys.nc:
         return constraint_terms_numpy(sys, q, v, t, jacobian)
     if sys.kernel_rows:
@@ -94,16 +94,16 @@ def _terms_compiled(sys, q, v, t, jacobian):
     return phi_, (J if jacobian else None), nu, gamma
 
 
-def _kernel_terms(sys, fr, t, v1=None):
-    """phi, phi_q, nu, gamma of the packed rows from the compiled kernel at frames fr and time t [s]; v1:
-    the packed first vectors when the caller rewrote some (curve points), else the packed ones."""
-    kind, bi, bj, p1, v2, v3, drv, fns = _packed(sys)
+def _kernel_terms(sys, fr, t, V1=None):
+    """phi, phi_q, nu, gamma of the packed rows from the compiled kernel at frames fr and time t [s]; V1:
+    the packed vectors when the caller rewrote some (curve points), else the packed ones."""
+    kind, bi, bj, V, par, drv, fns = _packed(sys)
     f = np.array([fn.value(t) for fn in fns], dtype=float)
     fd = np.array([fn.d1(t) for fn in fns], dtype=float)
     fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
     phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
     J = np.zeros((sys.nc, sys.nv))
-    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, p1 if v1 is None else v1, v2, v3, drv,
+    kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, V if V1 is None else V1, par, drv,
                               f, fd, fdd, sys.frame_v_adr, sys.frame_rigid, phi_, J, nu, gamma)
     return phi_, J, nu, gamma
 
@@ -121,7 +121,7 @@ def _mixed_plan(sys):
 def _terms_mixed(sys, q, v, t, jacobian):
     """constraint_terms of a system with rows the kernel does not evaluate (see there)."""
     from .constraints.path import curve_extra_quad, curve_locals
-    v1 = _packed(sys)[3]
+    V1 = _packed(sys)[3]
     curve_groups, rest = _mixed_plan(sys)
     q, v = np.asarray(q), np.asarray(v)
     fr = body_frames(sys, q, v)
@@ -129,10 +129,10 @@ def _terms_mixed(sys, q, v, t, jacobian):
     fr.aux_q, fr.aux_v = q[sys.aux_q_idx], v[sys.aux_v_idx]
     curves = [(g, idx, curve_locals(fr, g)) for g, idx in curve_groups]
     if curves:
-        v1 = v1.copy()
+        V1 = V1.copy()
         for g, idx, (_, _, c, _, _) in curves:
-            v1[idx] = np.repeat(c, 3, axis=0)
-    phi_, J, nu, gamma = _kernel_terms(sys, fr, t, v1)
+            V1[idx, 0] = np.repeat(c, 3, axis=0)
+    phi_, J, nu, gamma = _kernel_terms(sys, fr, t, V1)
     for g, idx, (aux, sd, _, t1, t2) in curves:
         gamma[idx] += curve_extra_quad(fr, g, sd, t1, t2)
         J[idx, np.repeat(sys.aux_v_idx[aux], 3)] -= t1.reshape(-1)
@@ -167,9 +167,9 @@ def jacobians(sys, q) -> np.ndarray:
     if not sys.nc or not sys.kernel_rows:
         return np.array([constraint_terms(sys, x, np.zeros(sys.nv), 0.0)[1] for x in q]).reshape(len(q), sys.nc, sys.nv)
     packed = _packed(sys)
-    kind, bi, bj, v1, v2, v3, drv, fns = packed
+    kind, bi, bj, V, par, drv, fns = packed
     return kernels.jacobian_batch(q, sys.r_idx, sys.p_idx, sys.rd_idx, sys.w_idx, sys.rigid_fid, sys.nbody + 1,
-                                  kind, bi, bj, v1, v2, v3, drv, len(fns), sys.frame_v_adr, sys.frame_rigid,
+                                  kind, bi, bj, V, par, drv, len(fns), sys.frame_v_adr, sys.frame_rigid,
                                   sys.nv)
 
 

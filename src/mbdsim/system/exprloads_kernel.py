@@ -90,7 +90,7 @@ def measure(k, fi, fj, fk, si, sj, Ri, Rj, Rk, v, r, A, rd, w):
         return np.arctan2(a[0] * b[0] + a[1] * b[1] + a[2] * b[2], a[0] * c[0] + a[1] * c[1] + a[2] * c[2])
     # joint angle rate (21; absolute coordinates: the angle row's J v), slide (22) and its rate (23): the
     # rows of kernels.row_terms (v: f_i, g_i, f_j or h_i, s_i, s_j in body axes)
-    ph, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 21 else 4, r, A, rd, w, fi, fj, v[0], v[1], v[2])
+    ph, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 21 else 4, r, A, rd, w, fi, fj, v, 0.0)
     if k == 22:
         return ph
     return row_rate(rd, w, fi, fj, Jri, Jpi, Jrj, Jpj)
@@ -188,7 +188,6 @@ def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
             _force(F, A, fj, sj[0], sj[1], sj[2], -d0 * inv, -d1 * inv, -d2 * inv, rigid)
         else:               # joint torque (3) or force (4): T or F times the joint angle's or slide's
             #                   Jacobian rows (kernels.row_terms), the generalized force J^T T
-            _, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 3 else 4, r, A, rd, w, fi, fj, ld_v[e, 0], ld_v[e, 1],
-                                                 ld_v[e, 2])
+            _, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 3 else 4, r, A, rd, w, fi, fj, ld_v[e], 0.0)
             _row_load(F, A, fi, v0, Jri, Jpi, rigid)
             _row_load(F, A, fj, v0, Jrj, Jpj, rigid)

@@ -4,7 +4,8 @@ phi_q, nu, gamma by `rows_kernel`, or returned with ground-axes Jacobian rows by
 `constraints.primitives` API: measures, force elements, the rows of screw, constant-velocity, couplers
 and path constraints, batched over time samples); tests/test_core_jacobians.py holds every row kind
 against finite differences.  Row kinds: 0-2 spherical component x/y/z, 3 dot1, 4 dot2, 5 angle
-(driver), 6 slide (driver).  Vectors v1, v2, v3 per row are in body axes (see `system.packing.pack_rows`).
+(driver), 6 slide (driver), 7 screw, 8 constant velocity.  A row's vectors V[row] (up to six) are in
+body axes, its parameter par[row] (see `system.packing.pack_rows`).
 """
 from __future__ import annotations
 
@@ -14,7 +15,7 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 
-KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6}
+KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6, "screw": 7, "cvel": 8}
 
 
 @njit(cache=True, _nrt=False)
@@ -134,25 +135,53 @@ def _angle_row(A, w, bi, bj, a, b, c):
     return np.arctan2(S, C), (0.0, 0.0, 0.0), Jp, (0.0, 0.0, 0.0), _sc(-1.0, Jp), quad
 
 
+@njit(cache=True, _nrt=False, inline="always")
+def _screw_row(r, A, rd, w, bi, bj, V, c):
+    """Screw row c wrap(s / c - theta): s = h_i . (P_j - P_i), theta the angle of j about h_i (V: f_i, g_i,
+    f_j, h_i, s_i, s_j; c = lead / 2 pi [m/rad]); J = J_s - c J_theta, quad = quad_s - c quad_theta."""
+    s, sri, spi, srj, spj, sq = _dot2_row(r, A, rd, w, bi, bj, V[3], V[4], V[5])
+    th, tri, tpi, trj, tpj, tq = _angle_row(A, w, bi, bj, V[0], V[1], V[2])
+    x = s / c - th
+    return (c * ((x + np.pi) % (2.0 * np.pi) - np.pi), _sub(sri, _sc(c, tri)), _sub(spi, _sc(c, tpi)),
+            _sub(srj, _sc(c, trj)), _sub(spj, _sc(c, tpj)), sq - c * tq)
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _cvel_row(A, w, bi, bj, V):
+    """Constant-velocity row f_i . g_j - g_i . f_j (V: f_i, g_i, f_j, g_j)."""
+    a, _, api, _, apj, aq = _dot1_row(A, w, bi, bj, V[0], V[3])
+    b, _, bpi, _, bpj, bq = _dot1_row(A, w, bi, bj, V[1], V[2])
+    zero = (0.0, 0.0, 0.0)
+    return a - b, zero, _sub(api, bpi), zero, _sub(apj, bpj), aq - bq
+
+
 @njit(cache=True, _nrt=False)
-def row_terms(k, r, A, rd, w, bi, bj, a, b, c):
+def row_terms(k, r, A, rd, w, bi, bj, V, p):
     """One constraint row of kind k between frames bi and bj, the single implementation of Haug's basic
     constraints (every evaluation goes through it or, in `rows_kernel`'s loop, through the same
     per-kind functions): (phi, J_ri, J_pi, J_rj, J_pj, quad) with the Jacobian rows on each frame's CM
     translation [m] and ground-axes virtual rotation [rad], and quad the velocity term of phi's second
-    derivative (phi_dd = J vd + quad; gamma = -quad).  Vectors a, b, c in body axes:
-      k = 0, 1, 2  spherical, component k of P_j - P_i [m] (a = s_i, b = s_j: points from the CMs)
-      k = 3        dot1: a_i . a_j (a = a_i, b = a_j; unit vectors)
-      k = 4, 6     dot2: a_i . (P_j - P_i) [m] (a = a_i, b = s_i, c = s_j); 6 is a slide driver's row
+    derivative (phi_dd = J vd + quad; gamma = -quad).  V: the row's vectors (rows of V, body axes); p:
+    its parameter:
+      k = 0, 1, 2  spherical, component k of P_j - P_i [m] (V: s_i, s_j: points from the CMs)
+      k = 3        dot1: a_i . a_j (V: a_i, a_j; unit vectors)
+      k = 4, 6     dot2: a_i . (P_j - P_i) [m] (V: a_i, s_i, s_j); 6 is a slide driver's row
       k = 5        angle of j about f_i x g_i, atan2(g_i . f_j, f_i . f_j) [rad] in (-pi, pi]
-                   (a = f_i, b = g_i, c = f_j); an angle driver's row before its target is taken off."""
+                   (V: f_i, g_i, f_j); an angle driver's row before its target is taken off
+      k = 7        screw: p wrap(s / p - theta) [m], s the dot2 slide along h_i, theta the angle
+                   (V: f_i, g_i, f_j, h_i, s_i, s_j; p = lead / 2 pi [m/rad])
+      k = 8        constant velocity: f_i . g_j - g_i . f_j (V: f_i, g_i, f_j, g_j)"""
     if k <= 2:
-        return _sph_row(k, r, A, w, bi, bj, a, b)
+        return _sph_row(k, r, A, w, bi, bj, V[0], V[1])
     if k == 3:
-        return _dot1_row(A, w, bi, bj, a, b)
+        return _dot1_row(A, w, bi, bj, V[0], V[1])
     if k == 4 or k == 6:
-        return _dot2_row(r, A, rd, w, bi, bj, a, b, c)
-    return _angle_row(A, w, bi, bj, a, b, c)
+        return _dot2_row(r, A, rd, w, bi, bj, V[0], V[1], V[2])
+    if k == 5:
+        return _angle_row(A, w, bi, bj, V[0], V[1], V[2])
+    if k == 7:
+        return _screw_row(r, A, rd, w, bi, bj, V, p)
+    return _cvel_row(A, w, bi, bj, V)
 
 
 @njit(cache=True, _nrt=False)
@@ -163,44 +192,58 @@ def row_rate(rd, w, bi, bj, Jri, Jpi, Jrj, Jpj):
 
 
 @njit(cache=True, _nrt=False)
-def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
+def rows_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
     """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row (`row_terms`, the
-    drivers' targets f(t) [m or rad] and their rates taken off); the kinds are dispatched here with each
-    kind's function inlined by numba (inline="always") and its rows stored in its own branch, where
-    the zero and unit entries fold: calling `row_terms` per row, or storing after the branches, took
-    25-35 % longer (measured on the slider-crank's Jacobians).
+    drivers' targets f(t) [m or rad] and their rates taken off; V (nc, 6, 3) the rows' vectors, par
+    (nc,) their parameters); the kinds are dispatched here with each kind's function inlined by numba
+    (inline="always") and its rows stored in its own branch, where the zero and unit entries fold:
+    calling `row_terms` per row, or storing after the branches, took 25-35 % longer (measured on the
+    slider-crank's Jacobians).
 
     Jc[row, 0] holds the row's coefficients on body_i's velocity variables (CM velocity [m/s],
     body-axes angular velocity [rad/s]), Jc[row, 1] those on body_j's (zero for ground)."""
     for row in range(kind.shape[0]):
         k = kind[row]
         bi, bj = bi_[row], bj_[row]
+        Vr = V[row]
         nu[row] = 0.0
         if k <= 2:
-            ph, Jri, Jpi, Jrj, Jpj, quad = _sph_row(k, r, A, w, bi, bj, v1[row], v2[row])
+            ph, Jri, Jpi, Jrj, Jpj, quad = _sph_row(k, r, A, w, bi, bj, Vr[0], Vr[1])
             _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
             _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
             phi[row] = ph
             gamma[row] = -quad
         elif k == 3:
-            ph, Jri, Jpi, Jrj, Jpj, quad = _dot1_row(A, w, bi, bj, v1[row], v2[row])
+            ph, Jri, Jpi, Jrj, Jpj, quad = _dot1_row(A, w, bi, bj, Vr[0], Vr[1])
             _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
             _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
             phi[row] = ph
             gamma[row] = -quad
         elif k == 4 or k == 6:
-            ph, Jri, Jpi, Jrj, Jpj, quad = _dot2_row(r, A, rd, w, bi, bj, v1[row], v2[row], v3[row])
+            ph, Jri, Jpi, Jrj, Jpj, quad = _dot2_row(r, A, rd, w, bi, bj, Vr[0], Vr[1], Vr[2])
+            _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
+            _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
+            phi[row] = ph
+            gamma[row] = -quad
+        elif k == 5:
+            ph, Jri, Jpi, Jrj, Jpj, quad = _angle_row(A, w, bi, bj, Vr[0], Vr[1], Vr[2])
+            _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
+            _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
+            phi[row] = ph
+            gamma[row] = -quad
+        elif k == 7:
+            ph, Jri, Jpi, Jrj, Jpj, quad = _screw_row(r, A, rd, w, bi, bj, Vr, par[row])
             _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
             _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
             phi[row] = ph
             gamma[row] = -quad
         else:
-            ph, Jri, Jpi, Jrj, Jpj, quad = _angle_row(A, w, bi, bj, v1[row], v2[row], v3[row])
+            ph, Jri, Jpi, Jrj, Jpj, quad = _cvel_row(A, w, bi, bj, Vr)
             _put(Jc, row, 0, bi, Jri, Jpi, A, rigid)
             _put(Jc, row, 1, bj, Jrj, Jpj, A, rigid)
             phi[row] = ph
             gamma[row] = -quad
-        if k >= 5:   # drivers: phi - f(t), nu = f'(t), gamma + f''(t); an angle's difference wrapped
+        if k == 5 or k == 6:   # drivers: phi - f(t), nu = f'(t), gamma + f''(t); an angle's difference wrapped
             n = drv[row]
             if k == 5:
                 phi[row] = (phi[row] - f[n] + np.pi) % (2.0 * np.pi) - np.pi
@@ -211,13 +254,13 @@ def rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid,
 
 
 @njit(cache=True, _nrt=False)
-def ground_rows(kind, r, A, rd, w, bi_, bj_, v1, v2, v3, phi, Jri, Jpi, Jrj, Jpj, quad, rate):
+def ground_rows(kind, r, A, rd, w, bi_, bj_, V, par, phi, Jri, Jpi, Jrj, Jpj, quad, rate):
     """`row_terms` of every row with its Jacobian rows in ground axes (Jri, Jpi, Jrj, Jpj: (n, 3)) and
     its rate J v: the rows of `constraints.primitives` (frames may carry time samples flattened into
-    the frame axis)."""
+    the frame axis; V (n, 6, 3) and par (n,) as in `rows_kernel`)."""
     for row in range(kind.shape[0]):
         bi, bj = bi_[row], bj_[row]
-        ph, a, b, c, d, qd = row_terms(kind[row], r, A, rd, w, bi, bj, v1[row], v2[row], v3[row])
+        ph, a, b, c, d, qd = row_terms(kind[row], r, A, rd, w, bi, bj, V[row], par[row])
         phi[row] = ph
         quad[row] = qd
         for m in range(3):
@@ -226,16 +269,16 @@ def ground_rows(kind, r, A, rd, w, bi_, bj_, v1, v2, v3, phi, Jri, Jpi, Jrj, Jpj
 
 
 @njit(cache=True)
-def constraint_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, vadr, rigid,
+def constraint_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, vadr, rigid,
                       phi, J, nu, gamma):
     """Fill phi, the dense J (nc, nv; zeroed by the caller), nu, gamma for every row."""
     Jc = np.empty((kind.shape[0], 2, 6))
-    rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma)
+    rows_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma)
     scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
 
 
 @njit(cache=True)
-def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_, v1, v2, v3, drv, nd, vadr,
+def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_, V, par, drv, nd, vadr,
                    rigid, nv):
     """Constraint Jacobians phi_q (N, nc, nv) at the position samples Q (N, nq); phi_q does not depend on
     the velocities or on the driver values (those enter phi, nu and gamma only)."""
@@ -247,7 +290,7 @@ def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_
     phi, nu, gamma, Jc = np.zeros(nc), np.zeros(nc), np.zeros(nc), np.zeros((nc, 2, 6))
     for n in range(N):
         frames_into(Q[n], v0, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w)
-        rows_kernel(r, A, rd, w, kind, bi_, bj_, v1, v2, v3, drv, z, z, z, rigid, phi, Jc, nu, gamma)
+        rows_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, z, z, z, rigid, phi, Jc, nu, gamma)
         scatter_dense(Jc, bi_, bj_, vadr, rigid, out[n])
     return out
 

@@ -8,15 +8,18 @@ import numpy as np
 
 
 def pack_rows(sys):
-    """(kind, bi, bj, v1, v2, v3, driver index, driver functions) of every row: kinds 0-2 spherical x/y/z (point-on-curve rows too, v1 = 0 for the
-    caller's curve point), 3 dot1, 4 dot2, 5 angle, 6 slide; vectors in body axes; rows of kinds the
-    kernel does not evaluate stay ground-ground spherical rows of zeros, driver index -1."""
+    """(kind, bi, bj, V, par, driver index, driver functions) of every row: kinds 0-2 spherical x/y/z
+    (point-on-curve rows too, V[row, 0] = 0 for the caller's curve point), 3 dot1, 4 dot2, 5 angle,
+    6 slide, 7 screw (par = lead / 2 pi [m/rad]), 8 constant velocity; V (nc, 6, 3) the rows' vectors in
+    body axes (`kernels.row_terms`); rows of kinds the kernel does not evaluate (couplers) stay
+    ground-ground spherical rows of zeros, driver index -1."""
     from .kernels import KIND
     nc = sys.nc
     kind = np.zeros(nc, np.int64)
     bi = np.zeros(nc, np.int64)
     bj = np.zeros(nc, np.int64)
-    v = np.zeros((3, nc, 3))
+    V = np.zeros((nc, 6, 3))
+    par = np.zeros(nc)
     drv = -np.ones(nc, np.int64)
     fns = []
     for g in sys.groups:
@@ -32,13 +35,15 @@ def pack_rows(sys):
             kind[rows] = np.tile(np.arange(3), n)
             bi[rows], bj[rows] = np.repeat(g.bi, 3), np.repeat(g.bj, 3)
             for m, vec in enumerate(g.vecs):
-                v[first + m, rows] = np.repeat(vec, 3, axis=0)
+                V[rows, first + m] = np.repeat(vec, 3, axis=0)
         else:
             kind[r0] = KIND[g.kind]
             bi[r0], bj[r0] = g.bi, g.bj
             for m, vec in enumerate(g.vecs):
-                v[first + m, r0] = vec
+                V[r0, m] = vec
+            if g.kind == "screw":                  # the leads [m/rev] as c = lead / 2 pi [m/rad]
+                par[r0] = np.asarray(g.fns, dtype=float) / (2 * np.pi)
             if g.kind in ("angle", "slide"):
                 drv[r0] = len(fns) + np.arange(n)
                 fns.extend(g.fns)
-    return kind, bi, bj, v[0], v[1], v[2], drv, fns
+    return kind, bi, bj, V, par, drv, fns

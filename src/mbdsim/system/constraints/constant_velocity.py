@@ -2,7 +2,7 @@
 
 Frames (body axes of each body): on body_i (f_i, g_i, h_i) with h_i the shaft axis of body_i, on body_j
 (f_j, g_j, h_j) with h_j the shaft axis of body_j; f_i = f_j = the bend axis (axis_i x axis_j) as
-built, g = h x f.  Rows: the spherical joint's 3 and one equal-angle row (kind "cvel", numpy only)
+built, g = h x f.  Rows: the spherical joint's 3 and one equal-angle row (kind "cvel", `system.kernels.row_terms` kind 8)
 
     phi = f_i . g_j - g_i . f_j  (= -2 sin(alpha) n . h_i for a relative rotation alpha about n)
 
@@ -36,8 +36,4 @@ class ConstantVelocity(JointType):
 
 def cvel_rows(fr, group) -> pr.Rows:
     """Equal-angle rows of all constant-velocity joints of a group."""
-    f_i, g_i, f_j, g_j = group.vecs
-    A = pr.dot1(fr, group.bi, group.bj, f_i, g_j)
-    B = pr.dot1(fr, group.bi, group.bj, g_i, f_j)
-    return pr.Rows(group.bi, group.bj, A.phi - B.phi, A.J_ri - B.J_ri, A.J_pi - B.J_pi,
-                   A.J_rj - B.J_rj, A.J_pj - B.J_pj, A.quad - B.quad)
+    return pr.cvel(fr, group.bi, group.bj, *group.vecs)

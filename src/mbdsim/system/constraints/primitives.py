@@ -38,26 +38,24 @@ def cross(a, b):
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], -1)
 
 
-def _vectors(x, n):
-    """(n, 3) float64 C-contiguous body-axes vectors (broadcast views copied)."""
-    return np.ascontiguousarray(np.broadcast_to(np.asarray(x, dtype=float), (n, 3)))
-
-
 def _frames(fr):
     return tuple(np.ascontiguousarray(x, dtype=float) for x in (fr.r, fr.A, fr.rd, fr.w))
 
 
-def _evaluate(kind, fr, bi, bj, a, b, c=None) -> Rows:
-    """The compiled `kernels.row_terms` of rows of one kind (or kinds (n,)) between frames bi and bj."""
+def _evaluate(kind, fr, bi, bj, *vectors, par=None) -> Rows:
+    """The compiled `kernels.row_terms` of rows of one kind (or kinds (n,)) between frames bi and bj, with
+    the rows' vectors (body axes, each (n, 3) or one for all) and parameters par (n,)."""
     bi = np.ascontiguousarray(bi, dtype=np.int64)
     bj = np.ascontiguousarray(bj, dtype=np.int64)
     n = len(bi)
     kinds = np.full(n, kind, np.int64) if np.ndim(kind) == 0 else np.ascontiguousarray(kind, dtype=np.int64)
-    v1, v2 = _vectors(a, n), _vectors(b, n)
-    v3 = v1 if c is None else _vectors(c, n)
+    V = np.zeros((n, 6, 3))
+    for m, x in enumerate(vectors):
+        V[:, m] = np.broadcast_to(np.asarray(x, dtype=float), (n, 3))
+    p = np.zeros(n) if par is None else np.ascontiguousarray(np.broadcast_to(par, (n,)), dtype=float)
     phi, quad, rate = np.empty(n), np.empty(n), np.empty(n)
     J = np.empty((4, n, 3))
-    kernels.ground_rows(kinds, *_frames(fr), bi, bj, v1, v2, v3, phi, J[0], J[1], J[2], J[3], quad, rate)
+    kernels.ground_rows(kinds, *_frames(fr), bi, bj, V, p, phi, J[0], J[1], J[2], J[3], quad, rate)
     return Rows(bi, bj, phi, J[0], J[1], J[2], J[3], quad, rate)
 
 
@@ -75,7 +73,7 @@ def dot2(fr, bi, bj, a_iB, s_iB, s_jB) -> Rows:
 def spherical(fr, bi, bj, s_iB, s_jB) -> Rows:
     """P_j - P_i = 0 [m] (three rows per pair, ordered x, y, z per joint)."""
     n = len(bi)
-    rep = lambda x: np.repeat(_vectors(x, n), 3, axis=0)  # noqa: E731
+    rep = lambda x: np.repeat(np.broadcast_to(np.asarray(x, dtype=float), (n, 3)), 3, axis=0)  # noqa: E731
     return _evaluate(np.tile(np.arange(3), n), fr, np.repeat(bi, 3), np.repeat(bj, 3), rep(s_iB), rep(s_jB))
 
 
@@ -85,3 +83,14 @@ def angle(fr, bi, bj, f_iB, g_iB, f_jB):
     Returns (theta, Rows of theta with phi = theta, theta_dot [rad/s])."""
     rows = _evaluate(5, fr, bi, bj, f_iB, g_iB, f_jB)
     return rows.phi, rows, rows.rate
+
+
+def screw(fr, bi, bj, f_iB, g_iB, f_jB, h_iB, s_iB, s_jB, c) -> Rows:
+    """c wrap(s / c - theta) [m]: s = h_i . (P_j - P_i) the slide along the axis, theta the angle of j
+    about h_i (from f_i towards g_i, measured on f_j), c = lead / 2 pi [m/rad] (n,) (body axes given)."""
+    return _evaluate(7, fr, bi, bj, f_iB, g_iB, f_jB, h_iB, s_iB, s_jB, par=c)
+
+
+def cvel(fr, bi, bj, f_iB, g_iB, f_jB, g_jB) -> Rows:
+    """f_i . g_j - g_i . f_j: equal spin of the two shafts of a constant-velocity joint (body axes given)."""
+    return _evaluate(8, fr, bi, bj, f_iB, g_iB, f_jB, g_jB)

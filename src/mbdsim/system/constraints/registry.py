@@ -1,4 +1,5 @@
-"""Joint kind -> joint type class; numpy-only row kinds -> their evaluators."""
+"""Joint kind -> joint type class; the row kinds of screw and constant-velocity joints -> their Rows
+functions (the group-by-group path of system.equations)."""
 from .atpoint import Atpoint
 from .constant_velocity import ConstantVelocity, cvel_rows
 from .cylindrical import Cylindrical
@@ -18,6 +19,5 @@ from .universal import Universal
 JOINT_TYPES = {c.kind: c for c in (Revolute, Spherical, Cylindrical, Translational, Universal, Planar, Fixed,
                                    Inline, Inplane, Orientation, ParallelAxes, Perpendicular, Atpoint,
                                    Screw, ConstantVelocity)}
-# Row kinds evaluated by numpy only (the compiled kernels carry sph, dot1, dot2, angle, slide): a model
-# with any of them runs the reference path (compile_system raises NotCompiled).
+# Row kinds with their own Rows function (system.kernels.row_terms kinds 7 and 8, compiled like the others)
 PAIR_ROW_KINDS = {"screw": screw_rows, "cvel": cvel_rows}

@@ -1,7 +1,7 @@
 """Screw joint: a cylindrical joint whose slide follows the rotation, s = lead * theta / (2 pi).
 
 Rows: the cylindrical joint's 4 (h_j parallel to h_i, the point of body_j on the axis line of body_i)
-and one screw row (kind "screw", numpy only: the compiled core does not carry it), with
+and one screw row (kind "screw", `system.kernels.row_terms` kind 7), with
 c = lead / (2 pi) [m/rad], s = h_i . (P_j - P_i) [m] the slide and theta [rad] the rotation of body_j
 about h_i (both zero as built):
 
@@ -31,12 +31,4 @@ class Screw(JointType):
 
 def screw_rows(fr, group) -> pr.Rows:
     """Rows of all screw constraints of a group; `group.fns` holds each joint's lead [m/rev]."""
-    f_i, g_i, f_j, h_i, s_i, s_j = group.vecs
-    c = np.array(group.fns, dtype=float) / (2 * np.pi)
-    S = pr.dot2(fr, group.bi, group.bj, h_i, s_i, s_j)
-    th, A, _ = pr.angle(fr, group.bi, group.bj, f_i, g_i, f_j)
-    x = S.phi / c - th
-    phi = c * ((x + np.pi) % (2 * np.pi) - np.pi)
-    cc = c[:, None]
-    return pr.Rows(group.bi, group.bj, phi, S.J_ri - cc * A.J_ri, S.J_pi - cc * A.J_pi,
-                   S.J_rj - cc * A.J_rj, S.J_pj - cc * A.J_pj, S.quad - c * A.quad)
+    return pr.screw(fr, group.bi, group.bj, *group.vecs, np.array(group.fns, dtype=float) / (2 * np.pi))
