@@ -12,11 +12,12 @@ ground axes and angular velocities [rad/s] in body axes); the predictions use th
 `fastdyn.increment_into` (translation [m] in ground axes, rotation vector [rad] in body axes). Each
 time is reached from the previous solved state by sub-steps: q + h qdot + h^2/2 qddot + h^3/6 qdddot
 predicted (the third derivative from the accelerations at the start and end of the previous sub-step),
-Newton on the positions (`fastdyn.newton_positions`, as the projection of the dynamics), `fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the
-multipliers. A sub-step is retried at half length when the Newton iteration fails, when it turns any
-body by more than MAX_TURN, or when its correction is large against the predicted motion (a guard
-against converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned
-(lock-up: no configuration satisfies the constraints, or a singular one).
+Newton on the positions (`fastdyn.newton_positions`, as the projection of the dynamics),
+`fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the multipliers.
+A sub-step is retried at half length when the Newton iteration fails, when it turns any body by more
+than MAX_TURN, or when its correction is large against the predicted motion (a guard against
+converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned (lock-up:
+no configuration satisfies the constraints, or a singular one).
 """
 from __future__ import annotations
 
