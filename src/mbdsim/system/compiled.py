@@ -45,6 +45,7 @@ class CompiledModel:
     bi: np.ndarray
     bj: np.ndarray
     vecs: np.ndarray          # (nc, 6, 3) body-axes vectors of each row (kernels.row_terms)
+    par: np.ndarray           # (nc,) parameter of each row (a screw's lead / 2 pi [m/rad])
     drv: np.ndarray           # (nc,) driver index of each row, -1 if none
     code: np.ndarray          # driver programs (system.exprvm): value, d1, d2 of each driver
     consts: np.ndarray
@@ -70,7 +71,6 @@ class CompiledModel:
     tree: tuple = ()          # joint-coordinate tree (system.jointtree) when dims[5] == 1, else empty arrays
     exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
     ex_stack: int = 4         # stack size of their programs
-    par: np.ndarray | None = None   # (nc,) parameter of each row (a screw's lead / 2 pi [m/rad]), arrays()[34]
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -80,8 +80,9 @@ class CompiledModel:
                 self.M6, self.gravity, self.mass, self.inertia, self.kind, self.bi, self.bj, self.vecs,
                 self.drv, self.code, self.consts, self.tables, self.start, self.end, self.pf_f, self.pf_s,
                 self.pf_v, self.pf_ff, self.pf_R, self.pf_torque, self.sp_f, self.sp_s, self.sp_par, topo,
-                self.dims, self.active, self.vecs,
-                np.zeros(len(self.kind)) if self.par is None else self.par, np.zeros(0),
+                # 33, 34: the rows' vectors and parameters as `kernels.rows_kernel` takes them (33 is 14
+                # again); 35: unused, kept empty so that the later slots keep their numbers
+                self.dims, self.active, self.vecs, self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads)
 
 
@@ -224,6 +225,6 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
                          sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
-                         V, drv, code, consts, tables, start, end, *loads,
+                         V, par, drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, par)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack)

@@ -13,6 +13,7 @@ def pack_rows(sys):
     6 slide, 7 screw (par = lead / 2 pi [m/rad]), 8 constant velocity; V (nc, 6, 3) the rows' vectors in
     body axes (`kernels.row_terms`); rows of kinds the kernel does not evaluate (couplers) stay
     ground-ground spherical rows of zeros, driver index -1."""
+    from .constraints.screw import lead_per_radian
     from .kernels import KIND
     nc = sys.nc
     kind = np.zeros(nc, np.int64)
@@ -41,8 +42,8 @@ def pack_rows(sys):
             bi[r0], bj[r0] = g.bi, g.bj
             for m, vec in enumerate(g.vecs):
                 V[r0, m] = vec
-            if g.kind == "screw":                  # the leads [m/rev] as c = lead / 2 pi [m/rad]
-                par[r0] = np.asarray(g.fns, dtype=float) / (2 * np.pi)
+            if g.kind == "screw":
+                par[r0] = lead_per_radian(g)
             if g.kind in ("angle", "slide"):
                 drv[r0] = len(fns) + np.arange(n)
                 fns.extend(g.fns)

@@ -29,6 +29,11 @@ class Screw(JointType):
         return rows + [RowSpec("screw", (g.f_i, g.g_i, g.f_j, g.h_i, g.s_i, g.s_j), g.name, g.extra)]
 
 
+def lead_per_radian(group) -> np.ndarray:
+    """c = lead / 2 pi [m/rad] of each screw of a group (`group.fns` holds each joint's lead [m/rev])."""
+    return np.asarray(group.fns, dtype=float) / (2 * np.pi)
+
+
 def screw_rows(fr, group) -> pr.Rows:
-    """Rows of all screw constraints of a group; `group.fns` holds each joint's lead [m/rev]."""
-    return pr.screw(fr, group.bi, group.bj, *group.vecs, np.array(group.fns, dtype=float) / (2 * np.pi))
+    """Rows of all screw constraints of a group."""
+    return pr.screw(fr, group.bi, group.bj, *group.vecs, lead_per_radian(group))
