@@ -65,7 +65,8 @@ def write(results, here, log):
           "Every engine is measured in the same run; times are the best of repeats of the integration call only "
           "(models built and compiled outside it: MuJoCo's MjModel, Exudyn's Assemble; mbdsim's Model is built "
           "once per problem and its first simulate assembles and compiles it for the later ones, while "
-          "assembly checks, Result building and monitors stay inside every call). "
+          "assembly checks, Result building and monitors stay inside every call); runs under 50 ms are re-timed "
+          "in two more rounds that interleave all engines and settings of the problem. "
           "The time to reach an error target is interpolated log-log on each engine's Pareto front "
           "(`<=`: the cheapest run was already better, an upper bound; `~...*`: extrapolated).", ""]
     md += ["## Time to reach the error target", "",

@@ -75,11 +75,15 @@ def _constraint(res, diag, stride_limit=MAX_SAMPLES):
         # 1e-12 with a failure status otherwise (the kinematic sweep of a zero-DOF model: solved to 1e-12):
         # a consistency check at the first and last sample suffices
         stride_limit = 2
-    idx = np.unique(np.concatenate([np.linspace(0, n - 1, min(n, stride_limit)).astype(int), [n - 1]]))
-    zero = np.zeros(sys.nv)
+    # evenly spaced samples, the first and the last included (linspace's end point is n - 1)
+    idx = np.unique(np.linspace(0, n - 1, min(n, stride_limit)).astype(np.int64))
     rows = np.asarray(getattr(sys, "fixed_rows", np.arange(sys.nc)))   # not friction stick locks (switched)
     if not len(rows):
         return np.zeros(0), np.zeros(0), []
+    if res.residual_check is not None:   # a compiled run: every checked sample in one compiled call
+        val, arg = res.residual_check(idx, rows)
+        return res.time[idx], val, [sys.row_owner[j] for j in arg.tolist()]
+    zero = np.zeros(sys.nv)
     val, owner = np.zeros(len(idx)), []
     for k, i in enumerate(idx):
         phi = constraint_terms(sys, res.q[i], zero, res.time[i], jacobian=False)[0][rows]

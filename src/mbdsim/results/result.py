@@ -54,6 +54,9 @@ class Result:
         self.steps = None   # (t, q, v) at the solver's step starts and the end, or a callable giving them
         self.error = None   # the MbdsimError that stopped a failed run (time, joints, last good state)
         self.diagnostics = None   # run monitors (mbdsim.results.diagnostics.Diagnostics), set by simulate
+        # compiled runs: residual_check(idx, rows) -> (max |phi[rows]| [m or rad], its row) at the samples idx
+        # in one compiled call (the run monitors use it instead of evaluating the rows sample by sample)
+        self.residual_check = None
 
     # ------------------------------------------------------------ basics
     def __len__(self):

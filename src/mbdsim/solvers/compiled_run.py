@@ -282,7 +282,20 @@ def _result(sys, rep, run, t_out, Y, success=True, message="ok", stats=None) -> 
                  accelerations=accelerations)
     if len(t_out):   # the run's own steps (checkpoints), for joint angles independent of the sampling
         res.steps = lambda: run.step_states(float(t_out[-1]), Y[-1])
+    res.residual_check = residual_check(run, t_out, Y)
     return res
+
+
+def residual_check(run, t_out, Y):
+    """Result.residual_check of a compiled run (CompiledRun or KinematicRun) with output rows Y = [q, v]
+    (absolute coordinates) at t_out [s]: check(idx, rows) -> (max |phi[rows]| [m or rad] at each sample
+    idx, the row where it occurs), all samples in one compiled call (`fastdyn.residuals`)."""
+    def check(idx, rows):
+        idx, rows = np.asarray(idx, dtype=np.int64), np.asarray(rows, dtype=np.int64)
+        val, arg = np.zeros(len(idx)), np.zeros(len(idx), dtype=np.int64)
+        fastdyn.residuals(run.cm.arrays(), run.work.arrays(), t_out, Y, idx, rows, val, arg)
+        return val, arg
+    return check
 
 
 def _full_multipliers(sys, rows, times, Y, VD, LAM):

@@ -237,6 +237,26 @@ def _constraints(cm, wk, t, q, v):
 
 
 @njit(cache=True, _nrt=False)
+def residuals(cm, wk, times, Y, idx, rows, val, arg):
+    """Run monitor: the largest |phi| [m or rad] over the constraint rows `rows` at the output rows
+    Y[idx] = [q, v] (absolute coordinates, times [s]) into val, and the row where it occurs into arg
+    (NaN wins); one call for all the samples checked."""
+    nq = cm[31][0]
+    phi = wk[4]
+    for k in range(idx.shape[0]):
+        i = idx[k]
+        _constraints(cm, wk, times[i], Y[i, :nq], Y[i, nq:])
+        best, at = 0.0, 0
+        for a in range(rows.shape[0]):
+            x = abs(phi[rows[a]])
+            if not x <= best:
+                best, at = x, rows[a]
+                if not np.isfinite(x):
+                    break
+        val[k], arg[k] = best, at
+
+
+@njit(cache=True, _nrt=False)
 def _factor(cm, wk):
     if cm[31][4]:
         return dense_factor(wk[5], cm[12], cm[13], cm[7], cm[32], wk[32], wk[33])

@@ -19,7 +19,7 @@ from ..results.result import Result
 from ..results.stream import notify
 from ..system.compiled import Work, compile_system
 from . import fastdyn, fastkin
-from .compiled_run import CHUNK, _MESSAGES, _full_multipliers, failure
+from .compiled_run import CHUNK, _MESSAGES, _full_multipliers, failure, residual_check
 from .fastdyn import INTERRUPTED, OK
 
 PROJ_TOL = 1e-12   # Newton tolerance on max |phi| [m or rad], as the compiled integrator's projection
@@ -145,4 +145,5 @@ def _result(sys, rep, run, t_out, Y, VD, LAM, success=True, message="ok", stats=
                  accelerations=lambda: (VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)))
     if len(t_out):
         res.steps = lambda: (t_out.copy(), Y[:, :nq].copy(), Y[:, nq:].copy())
+    res.residual_check = residual_check(run, t_out, Y)
     return res
