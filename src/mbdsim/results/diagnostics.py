@@ -6,8 +6,10 @@ time a quantity exceeds its tolerance a `MonitorWarning` names the time [s], the
 the value; `Result.diagnostics` keeps the history.
 
 - constraint_violation: max |phi(q, t)| over the position constraint rows [m or rad] (the owning joint or
-  motion named), at most MAX_SAMPLES evenly spaced samples per run or chunk (plus the last); tolerance
-  CONSTRAINT_TOL.
+  motion named), at most MAX_SAMPLES evenly spaced samples per run or chunk (the first and the last
+  included); tolerance CONSTRAINT_TOL. A compiled run's outputs are on the constraints by construction
+  (joint coordinates, or projected to 1e-12 with a failure status otherwise): its first and last sample
+  are checked, both in one compiled call (Result.residual_check).
 - energy_error: (T + V + D - W) - (T + V + D - W)(t0) [J]: kinetic T, potential V (gravity and elastic
   elements), dissipated D (damping, friction, contact: trapezoidal rule on the samples) and the work W of
   applied forces and torques (trapezoidal rule of their power); tolerance ENERGY_TOL times the energy scale
