@@ -70,6 +70,7 @@ def test_pendulum_passes_the_bottom_at_the_elliptic_quarter_period():
     assert ev["back"] == pytest.approx(2 * quarter, rel=1e-9)
     assert res.time[-1] == pytest.approx(2 * quarter, rel=1e-9)
     assert res.joint_coordinate("pin")[-1] == pytest.approx(-2 * theta0, abs=1e-7)   # symmetric swing
+    assert "(compiled)" in res.stats["method"]   # expression sensors: watched inside the compiled step loop
 
 
 def test_driven_angle_past_several_turns():
@@ -81,7 +82,7 @@ def test_driven_angle_past_several_turns():
     m.add_sensor("twenty", "axle - 20", action="stop")
     res = mb.simulate(m, 30.0, 0.05)
     assert res.time[-1] == pytest.approx(20 / 3, abs=1e-9)
-    assert "not compiled yet: sensor 'twenty'" in res.stats["method"]
+    assert "the kinematic sweep does not watch sensors" in res.stats["method"]   # integrated instead
 
 
 def test_sensor_errors_name_the_field():
@@ -98,3 +99,57 @@ def test_sensor_errors_name_the_field():
     m.add_sensor("s", "pin")
     with pytest.raises(ModelError, match="sensor 's'.*method"):
         mb.simulate(m, 1.0, method="hht")
+
+
+def test_compiled_expression_sensors_stop_and_record_at_the_closed_form_times():
+    """Expression sensors run in the compiled DOP853's step loop: a crossing found at the end of an
+    accepted step is located on that step's dense output (to 1e-13 s); a "stop" makes its state the last
+    sample, "record" goes on, a direction filters. Free fall from 2 m: z = 1 at sqrt(2 / g), the floor at
+    sqrt(4 / g); the rising crossing of z = 1.5 never happens."""
+    m = falling()
+    m.add_sensor("floor", "DZ(ball)", value=0.0, direction=-1, action="stop")
+    m.add_sensor("half", "DZ(ball) - 1", action="record")
+    m.add_sensor("rising", "DZ(ball)", value=1.5, direction=+1, action="record")
+    m.add_sensor("late", "t", value=0.3, direction=+1, action="record")
+    res = mb.simulate(m, 5.0, 0.01)
+    assert "(compiled)" in res.stats["method"] and res.success
+    assert "stopped by sensor 'floor'" in res.message
+    ev = [(e.name, e.time, e.action) for e in res.sensor_events]
+    assert [e[0] for e in ev] == ["late", "half", "floor"]
+    assert ev[0][1] == pytest.approx(0.3, abs=1e-12)
+    assert ev[1][1] == pytest.approx(np.sqrt(2 / G), abs=1e-12)
+    assert ev[2][1] == pytest.approx(np.sqrt(4 / G), abs=1e-12) and ev[2][2] == "stop"
+    assert res.time[-1] == ev[2][1] and np.all(np.diff(res.time) > 0)
+    assert abs(res.position("ball")[-1, 2]) < 1e-12
+    assert res.velocity("ball")[-1, 2] == pytest.approx(-np.sqrt(4 * G), rel=1e-10)
+
+
+def test_compiled_sensor_events_beyond_the_buffer_and_the_reference_path_agree(monkeypatch):
+    """More events than the kernel's buffer holds (handed over to Python when full): sin(40 t) crosses
+    zero at k pi / 40, 127 times in 10 s (rising at the even k > 0; max_step keeps a step from holding two
+    crossings of this signal, which a free fall does not resolve); and a pendulum's joint-angle sensor
+    gives the same times on the compiled path and on the reference (scipy) path."""
+    from mbdsim.solvers import dynamic
+    from mbdsim.system import exprloads_pack
+    m = falling(h=1e3)
+    m.add_sensor("wave", "sin(40*t)", action="record")
+    m.add_sensor("up", "sin(40*t)", direction=+1, action="record")
+    res = mb.simulate(m, 10.0, 0.1, rtol=1e-10, max_step=0.01)
+    assert "(compiled)" in res.stats["method"]
+    times = {n: np.array([e.time for e in res.sensor_events if e.name == n]) for n in ("wave", "up")}
+    assert len(times["wave"]) == 127 > exprloads_pack.EVENT_CAPACITY
+    assert np.max(np.abs(times["wave"] - np.arange(1, 128) * np.pi / 40)) < 1e-10
+    assert np.max(np.abs(times["up"] - np.arange(2, 128, 2) * np.pi / 40)) < 1e-10
+
+    theta0 = np.radians(100)
+    runs = {}
+    for compiled in (True, False):
+        pm, _ = pendulum(theta0)
+        pm.add_sensor("bottom", "pin + 1.7453292519943295", action="record")   # theta = 0: every pass
+        pm.add_sensor("turn", "pin_dot", direction=+1, action="record")
+        monkeypatch.setattr(dynamic, "USE_COMPILED", compiled)
+        r = mb.simulate(pm, 4.0, 0.01, rtol=1e-11)
+        assert ("(compiled)" in r.stats["method"]) == compiled
+        runs[compiled] = [(e.name, e.time) for e in r.sensor_events]
+    assert [n for n, _ in runs[True]] == [n for n, _ in runs[False]] and len(runs[True]) >= 4
+    assert np.max(np.abs(np.array([t for _, t in runs[True]]) - [t for _, t in runs[False]])) < 1e-8

@@ -19,6 +19,7 @@ from ..system.compiled import Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
 from . import fastdop, fastdyn, minnorm
+from .sensors import SensorEvent
 from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
@@ -45,6 +46,8 @@ class CompiledRun:
         self.max_steps = int(max_steps)
         self.stats = np.zeros(6, dtype=np.int64)
         self.stiff_check = bool(stiff_check)
+        self.sensors = list(getattr(sys.model, "sensors", {}).values())   # watched by the kernel (fastdop.run)
+        self.sensor_events = []
 
     def integrate(self, t0, y0, tout, progress=None, checkpoints=False, partial=None):
         """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
@@ -67,30 +70,43 @@ class CompiledRun:
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         keep = checkpoints and n * 8 * 64 <= CHECKPOINT_BUDGET
         SY, ST, ns = np.zeros((64 if keep else 0, n)), np.zeros((64 if keep else 0, 2)), np.zeros(1, np.int64)
+        watch = bool(self.sensors)
         try:
-            while status in (0, fastdop.CHECKPOINTS_FULL) and iout < nout:
+            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL) and iout < nout:
                 if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
                     if 2 * SY.size * 8 <= CHECKPOINT_BUDGET:
                         SY = np.concatenate([SY, np.zeros_like(SY)])
                         ST = np.concatenate([ST, np.zeros_like(ST)])
                     else:
                         keep, SY, ST = False, SY[:0], ST[:0]
+                self._take_events()
                 status, iout = fastdop.run(a, w, fastdop.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
                                            self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
-                                           1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns)
+                                           1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns, watch)
                 if st[1] == 0.0:   # the start failed: not even the initial state is an output
                     iout = 0
                     break
                 notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
+        self._take_events()
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
-        if self.joint_space and status != 0:   # the last state as absolute coordinates (failure reports)
-            ymax = np.zeros(len(y0))
-            fastdyn.write_state(a, w, y, ymax, ymax[:0])
+        if self.joint_space and status != 0:   # the last state as absolute coordinates (failure reports, and
+            ymax = np.zeros(len(y0))            # a sensor's stop: continuous with the last output)
+            fastdyn.write_state(a, w, y, ymax, Y[iout - 1] if status == fastdop.SENSOR_STOP and iout else ymax[:0])
             y = ymax
         return Y, iout, status, st[0], y
+
+    def _take_events(self):
+        """Move the sensor events the kernel found (time [s], sensor index) to self.sensor_events."""
+        if not self.sensors:
+            return
+        ew = self.work.arrays()[44]
+        for t, k in ew[4][:int(ew[5][0])].tolist():
+            s = self.sensors[int(k)]
+            self.sensor_events.append(SensorEvent(s.name, float(t), float(s.value), s.action))
+        ew[5][0] = 0
 
     @property
     def joint_space(self) -> bool:
@@ -231,12 +247,20 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial)
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
+    if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the last sample
+        if not n or t_fail > times[n - 1] + 1e-14 * max(1.0, abs(t_fail)):
+            times, Y = np.append(times[:n], t_fail), np.vstack([Y[:n], y_fail])
+            n += 1
+        stop = next(e for e in reversed(run.sensor_events) if e.action == "stop")
+        message, status = f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s", 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed")
         success = False
     stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
     res.error = error
+    if run.sensors:
+        res.sensor_events = run.sensor_events
     return res
 
 

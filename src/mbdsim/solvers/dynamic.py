@@ -51,10 +51,11 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
     element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
     the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise "hht"
-    ("dop853" for joint friction, sensors, or rtol below 1e-6). A model with zero degrees of freedom
+    ("dop853" for joint friction, sensors, or rtol below 1e-6; expression sensors are watched inside the
+    compiled DOP853's step loop). A model with zero degrees of freedom
     (fully driven: assembly's dof == 0) on the compiled core is solved by "auto" as a kinematic
     analysis instead, exact to the Newton tolerance at every output (mbdsim.solvers.kinsweep;
-    res.stats["method"] "auto: kinematic (0 DOF)"; DOP853 when it meets a change point). With "auto", rtol (default 1e-7) is
+    res.stats["method"] "auto: kinematic (0 DOF)"; DOP853 when it meets a change point or has sensors). With "auto", rtol (default 1e-7) is
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical

@@ -17,10 +17,16 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
-from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, project, read_state,
-                      rhs, write_state)
+from ..system.exprloads_kernel import sensor_values
+from ..system.kernels import frames_into
+from . import fasttree
+from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, normalize_into, project,
+                      read_state, rhs, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
+SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
+EVENTS_FULL = 10       # run status: the sensor event buffer is full (hand the events over and call again)
+SENSOR_XTOL = 1e-13    # [s]: sensor times are located on the dense output to this
 
 N_STAGES = _c.N_STAGES
 # Hairer's stiffness test flags h |df|/|dy| above this; dop853.f uses 6.1, but stability-limited steps of an
@@ -102,6 +108,111 @@ def _dense(F, y_old, t_old, h, t, out):
 
 
 @njit(cache=True, _nrt=False)
+def _sensor_g(cm, wk, t, y, yo, g):
+    """Each expression sensor's signal minus its threshold at the integrator's state y at t [s] into g
+    (frames computed here from y: the tree's forward kinematics, or the absolute coordinates with the
+    Euler parameters normalised in the copy yo)."""
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    for i in range(y.shape[0]):
+        yo[i] = y[i]
+    if cm[31][5] == 1:
+        tw = wk[43]
+        fasttree.kinematics(cm[42], yo, yo.shape[0] // 2, r, A, rd, w, tw[10], tw[11])
+    else:
+        nq = cm[31][0]
+        normalize_into(cm, yo[:nq])
+        frames_into(yo[:nq], yo[nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
+    sensor_values(cm[43], wk[44], t, yo, r, A, rd, w, g)
+
+
+@njit(cache=True, _nrt=False)
+def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
+    """The time [s] in (t0, t0 + h] at which sensor k's value changes sign on the dense output (F, y0) of
+    the step from t0, by the Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the
+    step's ends do not bracket a sign change (the crossing is then not an event, as a failed bracket of
+    the reference path's brentq)."""
+    a, b = t0, t0 + h
+    _dense(F, y0, t0, h, a, yd)
+    _sensor_g(cm, wk, a, yd, yo, g)
+    fa = g[k]
+    _dense(F, y0, t0, h, b, yd)
+    _sensor_g(cm, wk, b, yd, yo, g)
+    fb = g[k]
+    if fb == 0.0:
+        return b
+    if fa == 0.0 or (fa > 0.0) == (fb > 0.0):
+        return -np.inf
+    side = 0
+    for _ in range(200):
+        if b - a <= SENSOR_XTOL + 4e-16 * abs(b):
+            break
+        c = b - fb * (b - a) / (fb - fa)
+        if not a < c < b:
+            c = 0.5 * (a + b)
+        _dense(F, y0, t0, h, c, yd)
+        _sensor_g(cm, wk, c, yd, yo, g)
+        fc = g[k]
+        if fc == 0.0:
+            return c
+        if (fc > 0.0) == (fb > 0.0):   # c replaces b; a is kept (its value halved when kept twice)
+            b, fb = c, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:                          # c replaces a
+            a, fa = c, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
+    return 0.5 * (a + b)
+
+
+@njit(cache=True, _nrt=False)
+def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
+    """Sensors after the accepted step (t, h) from y to ynew: each sign change of a sensor's value since the
+    last accepted step is located on the step's dense output (F, computed here unless have_F); a crossing
+    in the sensor's direction is an event, appended (time [s], sensor) to the event buffer unless it comes
+    after the step's first "stop" event. The values at ynew become the last accepted ones (the sign after
+    the event where a value is exactly zero). Returns (the time [s] of the first "stop" event, np.inf if
+    none; whether F holds the step's dense output)."""
+    ex, ew = cm[43], wk[44]
+    g_prev, g_new, EVT, nev, g_tmp = ew[2], ew[3], ew[4], ew[5], ew[6]
+    n_s = g_new.shape[0]
+    _sensor_g(cm, wk, t + h, ynew, scale, g_new)
+    t_stop = np.inf
+    n0 = nev[0]
+    for k in range(n_s):
+        gp, gn = g_prev[k], g_new[k]
+        if gp == 0.0 or (gn != 0.0 and (gn > 0.0) == (gp > 0.0)):
+            continue
+        if not have_F:
+            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+            have_F = True
+        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp)
+        rising = gn > gp
+        if tk <= t or (ex[19][k] != 0 and (ex[19][k] > 0) != rising):
+            continue
+        EVT[nev[0], 0] = tk
+        EVT[nev[0], 1] = k
+        nev[0] += 1
+        if ex[20][k] == 1:
+            t_stop = min(t_stop, tk)
+    if t_stop < np.inf:   # events after the stop did not happen
+        m = n0
+        for e in range(n0, nev[0]):
+            if EVT[e, 0] <= t_stop + 1e-12 * max(1.0, abs(t_stop)):
+                EVT[m, 0], EVT[m, 1] = EVT[e, 0], EVT[e, 1]
+                m += 1
+        nev[0] = m
+    for k in range(n_s):
+        if g_new[k] != 0.0:
+            g_prev[k] = g_new[k]
+        elif g_prev[k] != 0.0:   # exactly at the threshold: the sign after the crossing
+            g_prev[k] = -g_prev[k]
+    return t_stop, have_F
+
+
+@njit(cache=True, _nrt=False)
 def _stages(cm, wk, co, t, h, y, K, ys, ynew):
     """The 12 stages of a DOP853 step from y (K[0] = f(t, y) given), ynew and K[12] = f(t + h, ynew);
     False when an evaluation failed."""
@@ -149,7 +260,7 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
 
 @njit(cache=True, _nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
-        proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns):
+        proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns, watch=False):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end (h = 0: the start,
     where f and the starting step are computed first, and a joint-coordinate tree's y from the absolute
     state in Y[0]; a failure there returns with h still 0), writing the
@@ -160,7 +271,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     on the last stage, 15 times without 6 non-stiff steps between) stops the run with STIFF.
     Checkpoints: when SY has rows, each accepted step's start state goes to SY[ns[0]] and its (t, h) to
     ST[ns[0]] (so that `from_checkpoint` redoes exactly that step for dense output on demand); when they
-    are full the run returns CHECKPOINTS_FULL before its next step for the caller to grow them."""
+    are full the run returns CHECKPOINTS_FULL before its next step for the caller to grow them.
+    With `watch`, the model's expression sensors (cm[43] slots 18-21) are evaluated after every accepted
+    step (`_watch`): events go to the buffer wk[44][4] (EVENTS_FULL when it may not hold the next step's:
+    hand them over, reset the count wk[44][5] and call again), and a "stop" event ends the run with
+    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time."""
     E3, E5 = co[3], co[4]
     nq = cm[31][0]
     n = y.shape[0]
@@ -174,6 +289,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             return s_, iout
         h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
         st[1] = h
+        if watch:   # the sensors' values at the start: a sign change from them is an event
+            _sensor_g(cm, wk, t, y, sc[3], wk[44][2])
+    n_sensors = wk[44][2].shape[0] if watch else 0
     written = 0
     steps0 = stats[0]
     rejected = False
@@ -185,6 +303,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if SY.shape[0] > 0 and ns[0] >= SY.shape[0]:
             st[0], st[1] = t, h
             return CHECKPOINTS_FULL, iout
+        if n_sensors > 0 and wk[44][5][0] + n_sensors > wk[44][4].shape[0]:
+            st[0], st[1] = t, h
+            return EVENTS_FULL, iout
         hmin = 10.0 * eps * max(abs(t), 1.0)
         h = min(h, max_step, t_end - t)
         if h < hmin:
@@ -242,9 +363,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 stats[5] += 1
                 if stats[5] >= 6:
                     stats[4] = 0
+        have_F = False
         if tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):   # outputs inside this step
             _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
             stats[2] += 3
+            have_F = True
             while iout < tout.shape[0] and tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):
                 to = min(tout[iout], t_new)
                 _dense(F, y, t, h, to, yo)
@@ -256,6 +379,21 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 write_state(cm, wk, yo, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
                 iout += 1
                 written += 1
+        if n_sensors > 0:
+            computed = have_F
+            t_stop, have_F = _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale)
+            if have_F and not computed:
+                stats[2] += 3
+            if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
+                while iout > 0 and tout[iout - 1] > t_stop + 1e-14 * max(1.0, abs(t_stop)):
+                    iout -= 1
+                _dense(F, y, t, h, t_stop, yo)
+                s_ = project(cm, wk, t_stop, yo[:nq], yo[nq:], proj_tol, False)
+                stats[3] += 1
+                for i in range(n):
+                    y[i] = yo[i]
+                st[0], st[1] = t_stop, h
+                return (SENSOR_STOP if s_ == OK else s_), iout
         for i in range(n):
             y[i] = ynew[i]
         if cm[31][5] == 1:   # joint coordinates: no projection, and f(t_new, ynew) is the last stage
@@ -303,7 +441,7 @@ def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps
     st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
     while status == OK and iout < tout.shape[0]:
         status, iout = run(cm, wk, co, st, y, f, tout[-1], tout, iout, Y, rtol, atol, max_step, max_steps,
-                           tout.shape[0], 1e-12, stats, K, F, sc, False, Y[:0], Y[:0, :2], stats[:1])
+                           tout.shape[0], 1e-12, stats, K, F, sc, False, Y[:0], Y[:0, :2], stats[:1], False)
     done = outputs_at(cm, wk, tout[:iout], Y[:iout], VD[:iout], LAM[:iout])
     if done < iout:
         return SINGULAR, done

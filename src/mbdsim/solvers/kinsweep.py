@@ -111,6 +111,9 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     sub-steps taken and retried between outputs, "nfev" and "njev" 0 (no right-hand side, no Jacobian
     by differences), "factorizations" and "projections" counted, "order" None (no integration formula:
     every output is exact to the Newton tolerance PROJ_TOL)."""
+    if getattr(sys.model, "sensors", None):   # located on an integrator's dense output (DOP853 runs it)
+        from ..system.compiled import NotCompiled
+        raise NotCompiled(f"sensor '{next(iter(sys.model.sensors))}': the kinematic sweep does not watch sensors")
     run = KinematicRun(sys, rep)
     if run.joint_space:
         return None

@@ -166,6 +166,9 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     from . import fastdop
     from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import INTERRUPTED
+    if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
+        from ..system.compiled import NotCompiled
+        raise NotCompiled("sensors are not streamed in parts")
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v))
     path = prepare(out, resume)
     a, w = run.cm.arrays(), run.work.arrays()
@@ -210,7 +213,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                 tout = np.asarray(times[g0:g0 + L], float)
                 status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
                                           run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
-                                          run.stats, K, F, sc, False, SY, ST, nsv)
+                                          run.stats, K, F, sc, False, SY, ST, nsv, False)
                 if status == 0 and got == L and g0 + L < nout and \
                         times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
                     # the last step covered outputs beyond the window: redo it from the saved state into a

@@ -219,7 +219,9 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
         jointtree.tree_arrays(sys, rows, *state)
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES)]
-    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state) if exl else (exprloads_pack.empty(), 4)
+    sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
+    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \
+        (exprloads_pack.empty(), 4)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
                          sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),

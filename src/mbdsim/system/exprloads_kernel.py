@@ -138,14 +138,12 @@ def _value(code, consts, tables, start, end, p, x, stack):
 
 
 @njit(cache=True, _nrt=False)
-def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
-    """Measures, expression programs and their loads at one state into F (see the module docstring).
-    y: the joint-coordinate state [theta, theta_dot] on the tree path (read by joint measures that have
-    a tree coordinate), else unused."""
+def expr_measures(ex, ew, t, y, r, A, rd, w):
+    """The variable vector x = ew[0] at one state: x[0] = t [s], x[1 + m] the value of measure m (frames
+    r, A, rd, w; y: the joint-coordinate state [theta, theta_dot] on the tree path, read by joint
+    measures that have a tree coordinate, else unused)."""
     ms_kind, ms_f, ms_s, ms_R, ms_v, ms_jq, ms_jc = ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6]
-    ld_kind, ld_f, ld_s, ld_R, ld_v, ld_prog = ex[7], ex[8], ex[9], ex[10], ex[11], ex[12]
-    code, consts, tables, start, end = ex[13], ex[14], ex[15], ex[16], ex[17]
-    x, stack = ew[0], ew[1]
+    x = ew[0]
     x[0] = t
     nj = y.shape[0] // 2
     for m in range(ms_kind.shape[0]):
@@ -159,6 +157,27 @@ def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
             continue
         x[1 + m] = measure(k, ms_f[m, 0], ms_f[m, 1], ms_f[m, 2], ms_s[m, 0], ms_s[m, 1], ms_R[m, 0],
                            ms_R[m, 1], ms_R[m, 2], ms_v[m], r, A, rd, w)
+
+
+@njit(cache=True, _nrt=False)
+def sensor_values(ex, ew, t, y, r, A, rd, w, g):
+    """g[s] = signal - threshold of each expression sensor at one state (frames r, A, rd, w; y as in
+    `expr_measures`)."""
+    expr_measures(ex, ew, t, y, r, A, rd, w)
+    code, consts, tables, start, end = ex[13], ex[14], ex[15], ex[16], ex[17]
+    for s in range(ex[18].shape[0]):
+        g[s] = _value(code, consts, tables, start, end, ex[18][s], ew[0], ew[1]) - ex[21][s]
+
+
+@njit(cache=True, _nrt=False)
+def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
+    """Measures, expression programs and their loads at one state into F (see the module docstring).
+    y: the joint-coordinate state [theta, theta_dot] on the tree path (read by joint measures that have
+    a tree coordinate), else unused."""
+    ld_kind, ld_f, ld_s, ld_R, ld_v, ld_prog = ex[7], ex[8], ex[9], ex[10], ex[11], ex[12]
+    code, consts, tables, start, end = ex[13], ex[14], ex[15], ex[16], ex[17]
+    x, stack = ew[0], ew[1]
+    expr_measures(ex, ew, t, y, r, A, rd, w)
     for e in range(ld_kind.shape[0]):
         k = ld_kind[e]
         fi, fj = ld_f[e, 0], ld_f[e, 1]

@@ -1,7 +1,10 @@
-"""Arrays of the expression loads (issue 14) for the compiled kernel `system.exprloads_kernel`.
+"""Arrays of the expression loads (issue 14) and sensors (issue 11) for `system.exprloads_kernel`.
 
-`pack(sys, elems, mode, tree, state)` turns ExprForce/ExprTorque/LineForce/JointForce elements into the
-tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`); `work(ex)` gives its scratch.
+`pack(sys, elems, mode, tree, state, sensors)` turns ExprForce/ExprTorque/LineForce/JointForce elements
+and expression sensors into the tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`,
+then the sensors: program, direction, stop flag and value, slots 18-21); `work(ex)` gives its scratch
+(slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
+count and scratch; `solvers.fastdop.run` watches them).
 A Python callable, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
 event-driven reference path), raises NotCompiled with the reason. On the joint-coordinate path a joint
 measure reads the tree's own coordinate: angle = angle at assembly + sign theta (sign -1 when the
@@ -12,7 +15,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model.forces import ExprForce, ExprTorque, JointForce, LineForce
-from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr
+from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr, parse_load
 from .measures import locate
 
 EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce)
@@ -28,12 +31,20 @@ def empty() -> tuple:
     return (np.zeros(0, i), np.zeros((0, 3), i), np.zeros((0, 2, 3)), np.zeros((0, 3, 3, 3)), np.zeros((0, 3, 3)),
             np.zeros(0, i), np.zeros((0, 2)), np.zeros(0, i), np.zeros((0, 3), i), np.zeros((0, 2, 3)),
             np.zeros((0, 3, 3)), np.zeros((0, 3, 3)), np.zeros((0, 3), i), np.zeros((0, 2), i), np.zeros(0, f),
-            np.zeros(0, f), np.zeros(0, i), np.zeros(0, i))
+            np.zeros(0, f), np.zeros(0, i), np.zeros(0, i), np.zeros(0, i), np.zeros(0, i), np.zeros(0, i),
+            np.zeros(0, f))
+
+
+EVENT_CAPACITY = 64   # sensor events a run holds before returning to Python to hand them over
 
 
 def work(ex, stack_size) -> tuple:
-    """Scratch of `expr_loads`: the variable vector x (1 + measures) and the interpreter's stack."""
-    return np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4))
+    """Scratch of `expr_loads`: the variable vector x (1 + measures) and the interpreter's stack; of the
+    sensors: their values (minus the threshold) at the last accepted step and at the new one, the events
+    found (time [s], sensor index), their count, and the values at a probed time."""
+    ns = len(ex[18])
+    return (np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4)), np.zeros(ns), np.zeros(ns),
+            np.zeros((EVENT_CAPACITY if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns))
 
 
 def _target(sys, name):
@@ -63,9 +74,9 @@ def _joint_measure(sys, m, mode, tree, fr):
     return kind, (g.bi, g.bj, 0), v, jq, jc
 
 
-def pack(sys, elems, mode, tree, state):
-    """(ex, stack size) of the expression loads `elems`; NotCompiled (from system.compiled) when one cannot
-    be compiled."""
+def pack(sys, elems, mode, tree, state, sensors=()):
+    """(ex, stack size) of the expression loads `elems` and the Sensors `sensors` (expression signals);
+    NotCompiled (from system.compiled) when one cannot be compiled."""
     from . import exprvm
     from .compiled import NotCompiled
     from .frames import body_frames
@@ -76,7 +87,7 @@ def pack(sys, elems, mode, tree, state):
         fr = Frames(f1.r[None], f1.A[None], f1.rd[None], f1.w[None])
     measures, ms, loads, progs = {}, [], [], []
 
-    def program(elem, v):
+    def program(elem, v, what="load"):
         if isinstance(v, LoadExpr):
             slots = {n: 0 for n in TIME_NAMES}
             for var, m in v.measures.items():
@@ -85,11 +96,11 @@ def pack(sys, elems, mode, tree, state):
                     try:
                         ms.append(_measure_row(sys, m, mode, tree, fr))
                     except _NotCompiled as exc:
-                        raise NotCompiled(f"load '{elem.name}' reads {exc}") from None
+                        raise NotCompiled(f"{what} '{elem.name}' reads {exc}") from None
                 slots[var] = 1 + measures[m]
             progs.append(exprvm.compile_expr(v.expr, slots))
         elif callable(v):
-            raise NotCompiled(f"load '{elem.name}' is a Python callable")
+            raise NotCompiled(f"{what} '{elem.name}' is a Python callable")
         else:
             progs.append(exprvm.constant_program(float(v)))
         return len(progs) - 1
@@ -112,7 +123,13 @@ def pack(sys, elems, mode, tree, state):
             rot = e.dof == "rotation"
             v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
             loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, e.value), -1, -1]))
-    if not loads:
+    sn = []
+    for sensor in sensors:
+        if sensor.text is None:
+            raise NotCompiled(f"sensor '{sensor.name}' is a Python callable")
+        le = parse_load(sys.model, sensor.text, f"sensor '{sensor.name}'", "signal")
+        sn.append((program(sensor, le, "sensor"), sensor.direction, int(sensor.action == "stop"), sensor.value))
+    if not loads and not sn:
         return empty(), 4
     pk = exprvm.pack(progs)
     i = np.int64
@@ -124,7 +141,8 @@ def pack(sys, elems, mode, tree, state):
           np.array([x[0] for x in loads], i), np.array([x[1] for x in loads], i).reshape(-1, 3),
           np.array([x[2] for x in loads], float).reshape(-1, 2, 3), np.array([x[3] for x in loads], float).reshape(-1, 3, 3),
           np.array([x[4] for x in loads], float).reshape(-1, 3, 3), np.array([x[5] for x in loads], i).reshape(-1, 3),
-          pk.code, pk.consts, pk.tables, pk.start, pk.end)
+          pk.code, pk.consts, pk.tables, pk.start, pk.end,
+          *(np.array([x[c] for x in sn], dt).reshape(len(sn)) for c, dt in enumerate((i, i, i, float))))
     return ex, int(pk.stack_size)
 
 
