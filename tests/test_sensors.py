@@ -153,3 +153,17 @@ def test_compiled_sensor_events_beyond_the_buffer_and_the_reference_path_agree(m
         runs[compiled] = [(e.name, e.time) for e in r.sensor_events]
     assert [n for n, _ in runs[True]] == [n for n, _ in runs[False]] and len(runs[True]) >= 4
     assert np.max(np.abs(np.array([t for _, t in runs[True]]) - [t for _, t in runs[False]])) < 1e-8
+
+
+def test_more_sensors_than_the_event_buffer_holds():
+    """70 time sensors crossing within a few steps (more than the 64-event buffer's default size): the
+    buffer grows with the number of sensors, every event is reported at its own time, none twice."""
+    m = falling()
+    levels = np.linspace(0.05, 0.6, 70)
+    for i, c in enumerate(levels):
+        m.add_sensor(f"s{i}", f"t - {float(c)!r}", action="record")
+    res = mb.simulate(m, 0.62, 0.31)
+    assert "(compiled)" in res.stats["method"]
+    got = sorted((e.time, e.name) for e in res.sensor_events)
+    assert [n for _, n in got] == [f"s{i}" for i in range(70)]
+    assert np.max(np.abs(np.array([t for t, _ in got]) - levels)) < 1e-12

@@ -251,7 +251,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
         if not n or t_fail > times[n - 1] + 1e-14 * max(1.0, abs(t_fail)):
             times, Y = np.append(times[:n], t_fail), np.vstack([Y[:n], y_fail])
             n += 1
-        stop = next(e for e in reversed(run.sensor_events) if e.action == "stop")
+        stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
         message, status = f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s", 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed")

@@ -35,7 +35,7 @@ def empty() -> tuple:
             np.zeros(0, f))
 
 
-EVENT_CAPACITY = 64   # sensor events a run holds before returning to Python to hand them over
+EVENT_CAPACITY = 64   # sensor events a run holds (at least two steps' worth) before handing them to Python
 
 
 def work(ex, stack_size) -> tuple:
@@ -44,7 +44,7 @@ def work(ex, stack_size) -> tuple:
     found (time [s], sensor index), their count, and the values at a probed time."""
     ns = len(ex[18])
     return (np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4)), np.zeros(ns), np.zeros(ns),
-            np.zeros((EVENT_CAPACITY if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns))
+            np.zeros((max(EVENT_CAPACITY, 2 * ns) if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns))
 
 
 def _target(sys, name):
