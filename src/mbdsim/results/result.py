@@ -98,6 +98,7 @@ class Result:
                 fr = _LazyFrames(fr, self)
             self._fr = fr
             fr.t = self.time   # sample times, for time-dependent element measures
+            fr.angle = lambda jt: jm.one_axis(self, jt)[0]   # angles continued by this Result (elements)
         return self._fr
 
     def at(self, t: float | ArrayLike) -> "Result":

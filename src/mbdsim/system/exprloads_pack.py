@@ -14,11 +14,27 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..model.element_specs import TorsionSpring
 from ..model.forces import ExprForce, ExprTorque, JointForce, LineForce
-from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr, parse_load
+from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr, Measure, parse_load
 from .measures import locate
 
-EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce)
+# packed here: loads written as expressions, and torsion springs as the joint torque expression of
+# `torsion_expression`
+EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce, TorsionSpring)
+
+
+def torsion_expression(elem) -> LoadExpr:
+    """The joint torque [N m] of a TorsionSpring as a load expression of its joint's angle [rad] and rate
+    [rad/s]: -(stiffness (theta - free_angle) + damping theta_dot + preload), the torque on body_j about
+    the joint axis (system.force_elements.torsion)."""
+    from ..expressions import parse
+    text = (f"-({float(elem.stiffness)!r}*(theta - {float(elem.free_angle)!r}) + {float(elem.damping)!r}*theta_dot"
+            f" + {float(elem.preload)!r})")
+    jn = elem.joint.name
+    return LoadExpr(parse(text, (*TIME_NAMES, "theta", "theta_dot")),
+                    {"theta": Measure("joint", joint=jn, dof="rotation"),
+                     "theta_dot": Measure("joint", joint=jn, dof="rotation", rate=True)})
 
 
 class _NotCompiled(Exception):
@@ -118,11 +134,12 @@ def pack(sys, elems, mode, tree, state, sensors=()):
             p = [program(e, e.magnitude), -1, -1]
             loads.append((2, (sys.fid[e.marker_i.body], sys.fid[e.marker_j.body], 0),
                           (e.marker_i.s_B, e.marker_j.s_B), eye, np.zeros((3, 3)), p))
-        else:
+        else:   # a joint force or torque, or a torsion spring (a joint torque)
             g = sys.geoms[e.joint.name]
-            rot = e.dof == "rotation"
+            rot = isinstance(e, TorsionSpring) or e.dof == "rotation"
+            value = torsion_expression(e) if isinstance(e, TorsionSpring) else e.value
             v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
-            loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, e.value), -1, -1]))
+            loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, value), -1, -1]))
     sn = []
     for sensor in sensors:
         if sensor.text is None:

@@ -30,6 +30,9 @@ class Frames:
     v: np.ndarray | None = None
     aux_q: np.ndarray | None = None
     aux_v: np.ndarray | None = None
+    # a Result's frames: angle(joint) -> the joint's angle [rad] at these samples, continued in time by
+    # the Result (force-element measures take it instead of the anchors a run's events left)
+    angle: object = None
 
 
 def body_frames(sys, q, v=None, vd=None) -> Frames:

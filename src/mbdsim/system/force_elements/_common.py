@@ -79,8 +79,9 @@ def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
     rep = lambda x: np.broadcast_to(x, (N, 3))  # noqa: E731
     if dof == "rotation":
         raw, rows, rate = pr.angle(ff, bi, bj, rep(g.f_i), rep(g.g_i), rep(g.f_j))
-        ts = times_of(fb, t, N)
-        ref = _ref(sys, owner, ts)
+        angle = getattr(fr, "angle", None)   # a Result's frames: its own continuation (any solver)
+        ref = np.asarray(angle(joint), dtype=float).reshape(N) if angle is not None else \
+            _ref(sys, owner, times_of(fb, t, N))
         x = ref + (raw - ref + np.pi) % (2 * np.pi) - np.pi
         return x, rate, rows
     rows = pr.dot2(ff, bi, bj, rep(g.h_i), rep(g.s_i), rep(g.s_j))
