@@ -1,10 +1,11 @@
 """DOP853 (Hairer's explicit Runge-Kutta 8(5,3) with 7th-order dense output) compiled with numba.
 
 The whole step loop runs in compiled code: stages (the O(N) equations of motion of `fastdyn`), the
-error norm, step-size control, coordinate projection after every accepted step, and the outputs at the
+error norm, step-size control, coordinate projection after every accepted step, the outputs at the
 requested times (dense output, then projection; accelerations and multipliers after the run, on
-demand: `outputs_at`). Python is re-entered only when a chunk of outputs is written, at the end, or on
-failure. The Butcher tableau is scipy's
+demand: `outputs_at`) and the model's expression sensors (`_watch`: crossings located on the step's
+dense output). Python is re-entered only when a chunk of outputs is written, when the sensor event
+buffer is full, at a sensor's stop, at the end, or on failure. The Butcher tableau is scipy's
 (`scipy.integrate._ivp.dop853_coefficients`); the control follows scipy's `DOP853`: error norm
 |h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2)) with scale atol + rtol max(|y_old|, |y_new|), safety 0.9,
 factor limits 0.2..10, exponent -1/8.
