@@ -1,7 +1,7 @@
 """Arrays of the expression loads (issue 14) and sensors (issue 11) for `system.exprloads_kernel`.
 
-`pack(sys, elems, mode, tree, state, sensors)` turns ExprForce/ExprTorque/LineForce/JointForce elements
-and expression sensors into the tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`,
+`pack(sys, elems, mode, tree, state, sensors)` turns ExprForce/ExprTorque/LineForce/JointForce elements,
+torsion springs (as joint torques, `torsion_expression`) and expression sensors into the tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`,
 then the sensors: program, direction, stop flag and value, slots 18-21); `work(ex)` gives its scratch
 (slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
 count and scratch; `solvers.fastdop.run` watches them).

@@ -71,7 +71,9 @@ def joint_coordinate(sys, fr: Frames, joint, dof, owner, t=None):
     true angle stays within pi of ref(t).  The anchors (t, theta) of element `owner` are recorded on
     the System from accepted states only, at the events of `angle_switch` (|theta - ref| = WRAP_LIMIT):
     trial states of rejected steps never move them.  Without event support (solvers that do not
-    call switch/on_event) ref stays 0, i.e. theta is wrapped to (-pi, pi]."""
+    call switch/on_event) ref stays 0, i.e. theta is wrapped to (-pi, pi].  Frames of a Result carry
+    `angle` (the angle continued by the Result along its run's steps, whichever solver ran): it is the
+    reference then."""
     fb, _ = batched(fr)
     g = sys.geoms[joint.name]
     N = fb.r.shape[0]
