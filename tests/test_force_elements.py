@@ -185,15 +185,29 @@ def test_bushing_preload_equilibrium():
 
 
 # --------------------------------------------------------------------------- stops
-def test_translational_bump_stop_linear_closed_form():
-    """Linear undamped stop: contact lasts half a period pi sqrt(m/k) and returns the speed reversed."""
+def _stop_contacts(res, path, name, jt, levels):
+    """Times [s] the joint coordinate meets the stop's walls: the contact events of the reference path
+    (located there as events), or the crossings of the walls on the compiled run's dense output."""
+    if path == "reference":
+        return np.array(element_state(res.system, name)["events"])
+    return np.sort(np.concatenate([res.crossings(lambda r: r.joint_coordinate(jt), w) for w in levels]))
+
+
+@pytest.mark.parametrize("path", ["compiled", "reference"])
+def test_translational_bump_stop_linear_closed_form(path, monkeypatch):
+    """Linear undamped stop: contact lasts half a period pi sqrt(m/k) and returns the speed reversed.
+    Compiled: the stop is the IMPACT law of the joint slide in the step loop (no event at the walls);
+    reference: wall contacts located as events."""
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", path == "compiled")
     mass, k, v0, gap = 2.0, 5e4, 1.5, 0.05
     m = mb.Model()
     b = m.add_body("slider", mass, (1, 1, 1), velocity=(v0, 0, 0))
     jt = m.add_translational("slide", m.ground, b, (0, 0, 0), (1, 0, 0))
     m.add_stop("bump", jt, upper=gap, stiffness=k, exponent=1.0, damping=0.0, penetration=1e-3)
     res = mb.simulate(m, 0.06, 0.001, **TIGHT)
-    ev = element_state(res.system, "bump")["events"]
+    assert ("(compiled)" in res.stats["method"]) == (path == "compiled")
+    ev = _stop_contacts(res, path, "bump", jt, [gap])
     t_on = gap / v0
     assert abs(ev[0] - t_on) < 1e-9
     assert abs(ev[1] - (t_on + np.pi * np.sqrt(mass / k))) < 1e-9
@@ -204,14 +218,19 @@ def test_translational_bump_stop_linear_closed_form():
     assert abs(x.spring_force("bump")[0] + k * v0 * np.sqrt(mass / k)) < 1e-5
 
 
-def test_revolute_two_sided_stop_period_and_energy():
+@pytest.mark.parametrize("path", ["compiled", "reference"])
+def test_revolute_two_sided_stop_period_and_energy(path, monkeypatch):
+    """BISTOP on the tree's own angle (compiled) and the event-driven reference path."""
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", path == "compiled")
     J, k, w0, lo, hi = 0.5, 2e3, 3.0, -0.4, 0.3
     m, b, jt = rotor(J, w0)
     m.add_stop("limits", jt, lower=lo, upper=hi, stiffness=k, exponent=1.0, damping=0.0, penetration=1e-2)
     res = mb.simulate(m, 1.5, 0.005, **TIGHT)
+    assert ("(compiled)" in res.stats["method"]) == (path == "compiled")
     half = np.pi * np.sqrt(J / k)
     period = (hi - lo) / w0 * 2 + 2 * half
-    ev = np.array(element_state(res.system, "limits")["events"])
+    ev = _stop_contacts(res, path, "limits", jt, [lo, hi])
     expect = np.array([hi / w0, hi / w0 + half, hi / w0 + half + (hi - lo) / w0, hi / w0 + 2 * half + (hi - lo) / w0])
     assert np.allclose(ev[:4], expect, rtol=0, atol=1e-9)
     assert abs(ev[4] - ev[0] - period) < 1e-9

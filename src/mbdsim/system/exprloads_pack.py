@@ -1,7 +1,8 @@
 """Arrays of the expression loads (issue 14) and sensors (issue 11) for `system.exprloads_kernel`.
 
 `pack(sys, elems, mode, tree, state, sensors)` turns ExprForce/ExprTorque/LineForce/JointForce elements,
-torsion springs (as joint torques, `torsion_expression`) and expression sensors into the tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`,
+torsion springs and stops (as joint loads, `torsion_expression`, `stop_expression`) and expression
+sensors into the tuple `ex` (measures, loads, packed postfix programs of `system.exprvm`,
 then the sensors: program, direction, stop flag and value, slots 18-21); `work(ex)` gives its scratch
 (slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
 count and scratch; `solvers.fastdop.run` watches them).
@@ -14,14 +15,14 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..model.element_specs import TorsionSpring
+from ..model.element_specs import Stop, TorsionSpring
 from ..model.forces import ExprForce, ExprTorque, JointForce, LineForce
 from ..model.loadexpr import JOINT_ANGLE, JOINT_SLIDE, TIME_NAMES, LoadExpr, Measure, parse_load
 from .measures import locate
 
-# packed here: loads written as expressions, and torsion springs as the joint torque expression of
-# `torsion_expression`
-EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce, TorsionSpring)
+# packed here: loads written as expressions, and torsion springs and stops as the joint torque or force
+# expressions of `torsion_expression` and `stop_expression`
+EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce, TorsionSpring, Stop)
 
 
 def torsion_expression(elem) -> LoadExpr:
@@ -35,6 +36,25 @@ def torsion_expression(elem) -> LoadExpr:
     return LoadExpr(parse(text, (*TIME_NAMES, "theta", "theta_dot")),
                     {"theta": Measure("joint", joint=jn, dof="rotation"),
                      "theta_dot": Measure("joint", joint=jn, dof="rotation", rate=True)})
+
+
+def stop_expression(elem) -> LoadExpr:
+    """The load [N or N m] of a Stop along its joint coordinate x (> 0 pushes x up) as a load expression of
+    x and its rate: Adams IMPACT at the lower wall, its mirror image at the upper one, BISTOP for both
+    (mbdsim.functions; the law of system.force_elements.stop)."""
+    from ..expressions import parse
+    f = lambda v: repr(float(v))  # noqa: E731
+    law = f"{f(elem.stiffness)}, {f(elem.exponent)}, {f(elem.damping)}, {f(elem.penetration)}"
+    if elem.lower is not None and elem.upper is not None:
+        text = f"BISTOP(x, x_dot, {f(elem.lower)}, {f(elem.upper)}, {law})"
+    elif elem.lower is not None:
+        text = f"IMPACT(x, x_dot, {f(elem.lower)}, {law})"
+    else:
+        text = f"-IMPACT(-x, -x_dot, {f(-elem.upper)}, {law})"
+    jn = elem.joint.name
+    return LoadExpr(parse(text, (*TIME_NAMES, "x", "x_dot")),
+                    {"x": Measure("joint", joint=jn, dof=elem.dof),
+                     "x_dot": Measure("joint", joint=jn, dof=elem.dof, rate=True)})
 
 
 class _NotCompiled(Exception):
@@ -134,10 +154,11 @@ def pack(sys, elems, mode, tree, state, sensors=()):
             p = [program(e, e.magnitude), -1, -1]
             loads.append((2, (sys.fid[e.marker_i.body], sys.fid[e.marker_j.body], 0),
                           (e.marker_i.s_B, e.marker_j.s_B), eye, np.zeros((3, 3)), p))
-        else:   # a joint force or torque, or a torsion spring (a joint torque)
+        else:   # a joint force or torque, a torsion spring (a joint torque) or a stop
             g = sys.geoms[e.joint.name]
             rot = isinstance(e, TorsionSpring) or e.dof == "rotation"
-            value = torsion_expression(e) if isinstance(e, TorsionSpring) else e.value
+            value = torsion_expression(e) if isinstance(e, TorsionSpring) else \
+                stop_expression(e) if isinstance(e, Stop) else e.value
             v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
             loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, value), -1, -1]))
     sn = []
