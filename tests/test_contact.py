@@ -9,6 +9,23 @@ from mbdsim.system.force_elements.contact import normal_force
 
 TIGHT = dict(method="dop853", rtol=1e-11, atol=1e-13)
 G = 9.81
+PATHS = pytest.mark.parametrize("path", ["compiled", "reference"])
+
+
+def _use(path, monkeypatch):
+    """Run on the compiled core (the contact law in the step loop, no events at onset and separation) or
+    on the event-driven reference path (onset and separation located as events)."""
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", path == "compiled")
+
+
+def _contact_times(res, path, name):
+    """Onsets and separations [s]: the reference path's events, or the gap's zero crossings located on
+    the compiled run's dense output."""
+    assert ("(compiled)" in res.stats["method"]) == (path == "compiled"), res.stats["method"]
+    if path == "reference":
+        return list(element_state(res.system, name)["events"])
+    return list(res.crossings(lambda r: r.spring_length(name), 0.0))
 
 
 def ball_on_floor(h=0.3, R=0.05, mass=1.0, k=1e5, e=1.5, c=20.0, mu=0.0, v=(0, 0, 0), w=(0, 0, 0), vs=1e-2,
@@ -33,14 +50,16 @@ def test_normal_force_is_the_adams_impact_function():
 
 
 # --------------------------------------------------------------------------- must-show 5
-def test_ball_drop_onset_time_and_rebounds():
+@PATHS
+def test_ball_drop_onset_time_and_rebounds(path, monkeypatch):
+    _use(path, monkeypatch)
     h = 0.3
     m, ball = ball_on_floor(h=h)
     res = mb.simulate(m, 1.2, 0.002, **TIGHT)
     assert res.success
     t_fall = np.sqrt(2 * h / G)
-    events = element_state(res.system, "floor")["events"]
-    assert abs(events[0] - t_fall) < 1e-9                      # onset located as an event
+    events = _contact_times(res, path, "floor")
+    assert abs(events[0] - t_fall) < 1e-9                      # onset (an event on the reference path)
     gap = res.crossings(lambda r: r.spring_length("floor"), 0.0)
     assert abs(gap[0] - t_fall) < 1e-9 and len(events) >= 6    # several bounces, onset + separation each
     assert np.allclose(gap[:len(events)], events[:len(gap)], rtol=0, atol=1e-9)
@@ -58,39 +77,45 @@ def test_ball_drop_onset_time_and_rebounds():
     assert np.all(np.diff(D) > -1e-12)
 
 
-def test_undamped_contact_conserves_energy_and_rebounds_to_drop_height():
+@PATHS
+def test_undamped_contact_conserves_energy_and_rebounds_to_drop_height(path, monkeypatch):
+    _use(path, monkeypatch)
     h = 0.3
     m, ball = ball_on_floor(h=h, c=0.0)
     res = mb.simulate(m, 2 * np.sqrt(2 * h / G) + 0.06, 0.002, **TIGHT)
     E = res.kinetic_energy() + res.potential_energy()
     assert np.max(np.abs(E - E[0])) < 1e-9 * E[0]
-    events = element_state(res.system, "floor")["events"]
+    events = _contact_times(res, path, "floor")
     t_apex, z_apex = res.maximum(lambda r: np.where(r.time > events[1], r.position(ball)[:, 2], -1.0))
     assert abs(z_apex - (h + 0.05)) < 1e-8
 
 
-def test_linear_contact_duration_closed_form():
+@PATHS
+def test_linear_contact_duration_closed_form(path, monkeypatch):
     """e = 1, no damping, no gravity: half a period pi sqrt(m/k) in contact, speed reversed."""
+    _use(path, monkeypatch)
     mass, k, v0 = 0.5, 2e4, 1.2
     m = mb.Model()
     p = m.add_particle("p", mass, position=(0.1, 0.2, 0.06), velocity=(0, 0, -v0))
     m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), mb.Sphere(p, 0.05), k, 1.0, 0.0, 1e-3)
     res = mb.simulate(m, 0.05, 0.001, **TIGHT)
-    ev = element_state(res.system, "c")["events"]
+    ev = _contact_times(res, path, "c")
     assert abs(ev[0] - 0.01 / v0) < 1e-9
     assert abs(ev[1] - ev[0] - np.pi * np.sqrt(mass / k)) < 1e-9
     assert np.allclose(res.at(0.05).velocity(p)[0], (0, 0, v0), atol=1e-9)
 
 
-def test_sphere_sphere_elastic_exchange():
+@PATHS
+def test_sphere_sphere_elastic_exchange(path, monkeypatch):
     """Equal spheres, head-on, linear undamped contact: velocities exchange; duration pi sqrt(m_red/k)."""
+    _use(path, monkeypatch)
     mass, k, v0, R = 1.0, 1e4, 2.0, 0.1
     m = mb.Model()
     a = m.add_body("a", mass, (0.004,) * 3, position=(0, 0, 0), velocity=(v0, 0, 0))
     b = m.add_body("b", mass, (0.004,) * 3, position=(0.3, 0, 0))
     m.add_contact("c", mb.Sphere(a, R), mb.Sphere(b, R), k, 1.0, 0.0, 1e-3)
     res = mb.simulate(m, 0.1, 0.001, **TIGHT)
-    ev = element_state(res.system, "c")["events"]
+    ev = _contact_times(res, path, "c")
     assert abs(ev[0] - 0.1 / v0) < 1e-9
     assert abs(ev[1] - ev[0] - np.pi * np.sqrt(0.5 * mass / k)) < 1e-9
     end = res.at(0.1)
@@ -98,9 +123,11 @@ def test_sphere_sphere_elastic_exchange():
     assert np.allclose(res.spring_force("c")[res.time < ev[0]], 0.0)
 
 
-def test_sliding_sphere_ends_rolling_at_five_sevenths():
+@PATHS
+def test_sliding_sphere_ends_rolling_at_five_sevenths(path, monkeypatch):
     """Thrown without spin on a rough floor: angular momentum about the contact line is conserved, so
     the final rolling speed is v0 / (1 + I / (m R'^2)) with R' the centre-to-contact-point distance."""
+    _use(path, monkeypatch)
     R, mass, k, v0 = 0.05, 1.0, 1e5, 1.0
     delta = mass * G / k                      # static penetration of the linear contact
     m = mb.Model(gravity=(0, 0, -G))
@@ -108,6 +135,7 @@ def test_sliding_sphere_ends_rolling_at_five_sevenths():
     m.add_contact("floor", mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), mb.Sphere(ball, R), k, 1.0, 5.0, 1e-3,
                   mu=0.3, friction_velocity=1e-2)
     res = mb.simulate(m, 0.3, 0.005, **TIGHT)
+    assert ("(compiled)" in res.stats["method"]) == (path == "compiled")
     Rp = R - delta / 2
     v_end = res.velocity(ball)[-1, 0]
     assert abs(v_end - v0 / (1 + 0.4 * R**2 / Rp**2)) < 1e-6
@@ -117,9 +145,11 @@ def test_sliding_sphere_ends_rolling_at_five_sevenths():
 
 
 # --------------------------------------------------------------------------- must-show 6
-def test_energy_balance_damped_frictional_contacting_model():
+@PATHS
+def test_energy_balance_damped_frictional_contacting_model(path, monkeypatch):
     """Spinning ball thrown at a tilted plane with damping and friction, plus a bushing-tethered second
     ball hitting it and a constant applied force: KE + PE + dissipated = E0 + work of the force."""
+    _use(path, monkeypatch)
     m = mb.Model(gravity=(0, 0, -G))
     R = 0.05
     ball = m.add_body("ball", 1.0, (1e-3,) * 3, position=(0, 0, 0.15), velocity=(0.8, 0.2, 0),
@@ -135,8 +165,8 @@ def test_energy_balance_damped_frictional_contacting_model():
     m.add_force("push", (ball, (0, 0, 0.15)), F)
     res = mb.simulate(m, 0.6, 0.002, method="dop853", rtol=1e-10, atol=1e-12)
     assert res.success
-    assert len(element_state(res.system, "floor")["events"]) >= 2
-    assert len(element_state(res.system, "balls")["events"]) >= 2
+    assert len(_contact_times(res, path, "floor")) >= 2
+    assert len(_contact_times(res, path, "balls")) >= 2
     W = (res.position(ball) - res.position(ball)[0]) @ F
     E = res.kinetic_energy() + res.potential_energy()
     D = res.dissipated_energy()

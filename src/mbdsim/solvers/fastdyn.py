@@ -54,6 +54,70 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
                         wk[42][1])
     if cm[43][7].shape[0]:
         expr_loads(cm[43], wk[44], t, y, r, A, rd, w, cm[6], F)
+    if cm[44][0].shape[0]:
+        ct = cm[44]
+        contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F)
+
+
+@njit(cache=True, _nrt=False)
+def _centre(r, A, f, s):
+    """Ground position [m] of the body-axes point s of frame f."""
+    return (r[f, 0] + A[f, 0, 0] * s[0] + A[f, 0, 1] * s[1] + A[f, 0, 2] * s[2],
+            r[f, 1] + A[f, 1, 0] * s[0] + A[f, 1, 1] * s[1] + A[f, 1, 2] * s[2],
+            r[f, 2] + A[f, 2, 0] * s[0] + A[f, 2, 1] * s[1] + A[f, 2, 2] * s[2])
+
+
+@njit(cache=True, _nrt=False)
+def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F):
+    """Compliant contacts (system.force_elements.contact) into F: signed gap g [m] between the shapes, normal
+    n from body_i's shape towards body_j's, contact point cp in the middle of the overlap; while g < 0 the
+    Adams IMPACT normal force max(0, k delta^e - STEP(delta, 0, 0, d, c_max) g_dot) along n and the
+    regularised Coulomb friction -mu Fn v_t / sqrt(|v_t|^2 + v_s^2) (v_t: the tangential part of the
+    relative velocity of the material points at cp) act on body_j at cp, their opposite on body_i.
+    Arrays of `system.compiled._contacts`; frames r, A, rd, w (w in ground axes)."""
+    for c in range(ct_f.shape[0]):
+        fi, fj, kind = ct_f[c, 0], ct_f[c, 1], ct_kind[c]
+        Ri, Rj, k, ex, cmax, dpen, mu, vs = (ct_par[c, 0], ct_par[c, 1], ct_par[c, 2], ct_par[c, 3],
+                                            ct_par[c, 4], ct_par[c, 5], ct_par[c, 6], ct_par[c, 7])
+        if kind == 0:   # sphere-sphere: along the line of centres
+            a0, a1, a2 = _centre(r, A, fi, ct_s[c, 0])
+            b0, b1, b2 = _centre(r, A, fj, ct_s[c, 1])
+            d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+            L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            inv = 1.0 / L if L > 0.0 else 1.0
+            n0, n1, n2 = d0 * inv, d1 * inv, d2 * inv
+            g = L - Ri - Rj
+            if not g < 0.0:
+                continue
+            h = Ri + 0.5 * g
+            p0, p1, p2 = a0 + h * n0, a1 + h * n1, a2 + h * n2
+        else:           # sphere-plane: along the plane's normal
+            fs, fp, R, sign = (fj, fi, Rj, 1.0) if kind == 1 else (fi, fj, Ri, -1.0)
+            ss, sp = (ct_s[c, 1], ct_s[c, 0]) if kind == 1 else (ct_s[c, 0], ct_s[c, 1])
+            c0, c1, c2 = _centre(r, A, fs, ss)
+            q0, q1, q2 = _centre(r, A, fp, sp)
+            m0, m1, m2 = _rot(A, fp, ct_n[c, 0], ct_n[c, 1], ct_n[c, 2])
+            g = m0 * (c0 - q0) + m1 * (c1 - q1) + m2 * (c2 - q2) - R
+            if not g < 0.0:
+                continue
+            h = R + 0.5 * g
+            p0, p1, p2 = c0 - h * m0, c1 - h * m1, c2 - h * m2
+            n0, n1, n2 = sign * m0, sign * m1, sign * m2
+        # relative velocity of the material points at cp (body_j minus body_i)
+        x0, x1, x2 = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
+        y0, y1, y2 = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
+        v0 = rd[fj, 0] + x0 - rd[fi, 0] - y0
+        v1 = rd[fj, 1] + x1 - rd[fi, 1] - y1
+        v2 = rd[fj, 2] + x2 - rd[fi, 2] - y2
+        gd = n0 * v0 + n1 * v1 + n2 * v2
+        delta = -g
+        u = min(delta / dpen, 1.0)
+        Fn = max(k * delta ** ex - cmax * u * u * (3.0 - 2.0 * u) * gd, 0.0)
+        t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2
+        mf = mu * Fn / np.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + vs * vs) if mu > 0.0 else 0.0
+        G0, G1, G2 = Fn * n0 - mf * t0, Fn * n1 - mf * t1, Fn * n2 - mf * t2
+        _point_force(F, A, fj, p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2], G0, G1, G2, rigid)
+        _point_force(F, A, fi, p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2], -G0, -G1, -G2, rigid)
 
 
 @njit(cache=True, _nrt=False)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..model.element_specs import Bushing
+from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
 from . import exprloads_pack, jointtree, packing
 from .measures import locate
@@ -71,6 +71,7 @@ class CompiledModel:
     tree: tuple = ()          # joint-coordinate tree (system.jointtree) when dims[5] == 1, else empty arrays
     exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
     ex_stack: int = 4         # stack size of their programs
+    contacts: tuple = ()      # sphere-sphere / sphere-plane contacts (`_contacts`), arrays()[44]
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -83,7 +84,7 @@ class CompiledModel:
                 # 33, 34: the rows' vectors and parameters as `kernels.rows_kernel` takes them (33 is 14
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
-                *self.bushings, self.tree, self.exprloads)
+                *self.bushings, self.tree, self.exprloads, self.contacts)
 
 
 @dataclass
@@ -117,6 +118,27 @@ class Work:
         return self.arrays_
 
 
+def _contacts(sys) -> tuple:
+    """The model's contacts for `fastdyn.contacts_kernel`: frames (i, j) (n, 2), kind (n,) (0 sphere-sphere,
+    1 plane on i and sphere on j, 2 sphere on i and plane on j), shape points s_B (n, 2, 3) [m, body axes],
+    the plane's normal (n, 3) [body axes] and (radius_i, radius_j, stiffness, exponent, damping,
+    penetration, mu, friction_velocity) (n, 8) (SI; a plane's radius 0)."""
+    rows = []
+    for e in sys.model.forces.values():
+        if type(e) is not Contact:
+            continue
+        si, sj = e.shape_i, e.shape_j
+        kind = 0 if si.kind == sj.kind == "sphere" else (1 if sj.kind == "sphere" else 2)
+        plane = None if kind == 0 else (si if kind == 1 else sj)
+        rows.append(((sys.fid[si.body], sys.fid[sj.body]), kind, (si.s_B, sj.s_B),
+                     np.zeros(3) if plane is None else plane.n_B,
+                     (si.radius, sj.radius, e.stiffness, e.exponent, e.damping, e.penetration, e.mu,
+                      e.friction_velocity)))
+    n = len(rows)
+    arr = lambda k, shape, dt=float: np.array([r[k] for r in rows], dtype=dt).reshape(shape)  # noqa: E731
+    return (arr(0, (n, 2), np.int64), arr(1, (n,), np.int64), arr(2, (n, 2, 3)), arr(3, (n, 3)), arr(4, (n, 8)))
+
+
 def _singular_masses(M6) -> bool:
     """True when a body's 6x6 mass matrix (stack (n, 6, 6)) has an eigenvalue <= 1e-12 of its largest
     entry (one batched eigvalsh)."""
@@ -145,7 +167,8 @@ def _driver_programs(fns):
 
 
 def _loads(sys):
-    """Constant point forces and torques, spring-dampers and bushings as arrays; NotCompiled for anything
+    """Constant point forces and torques, spring-dampers and bushings as arrays (expression loads, torsion
+    springs and stops are packed by exprloads_pack, contacts by `_contacts`); NotCompiled for anything
     else."""
     pf, sp, bu = [], [], []
     for e in sys.model.forces.values():
@@ -162,6 +185,8 @@ def _loads(sys):
             mi, mj = e.marker_i, e.marker_j
             bu.append(((sys.fid[mi.body], sys.fid[mj.body]), (mi.s_B, mj.s_B), (mi.R_BM, mj.R_BM),
                        e.stiffness, e.damping, e.preload))
+        elif type(e) is Contact:
+            continue   # packed by _contacts
         elif type(e) is SpringDamper:
             sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
@@ -229,4 +254,4 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys))
