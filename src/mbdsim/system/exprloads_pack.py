@@ -25,24 +25,28 @@ from .measures import locate
 EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce, TorsionSpring, Stop)
 
 
+def _coordinate_expression(text, joint, dof) -> LoadExpr:
+    """A load expression `text` of a joint's coordinate x [rad or m] and its rate x_dot (dof "rotation"
+    or "translation"), for the elements packed as joint loads."""
+    from ..expressions import parse
+    return LoadExpr(parse(text, (*TIME_NAMES, "x", "x_dot")),
+                    {"x": Measure("joint", joint=joint.name, dof=dof),
+                     "x_dot": Measure("joint", joint=joint.name, dof=dof, rate=True)})
+
+
 def torsion_expression(elem) -> LoadExpr:
     """The joint torque [N m] of a TorsionSpring as a load expression of its joint's angle [rad] and rate
     [rad/s]: -(stiffness (theta - free_angle) + damping theta_dot + preload), the torque on body_j about
     the joint axis (system.force_elements.torsion)."""
-    from ..expressions import parse
-    text = (f"-({float(elem.stiffness)!r}*(theta - {float(elem.free_angle)!r}) + {float(elem.damping)!r}*theta_dot"
+    text = (f"-({float(elem.stiffness)!r}*(x - {float(elem.free_angle)!r}) + {float(elem.damping)!r}*x_dot"
             f" + {float(elem.preload)!r})")
-    jn = elem.joint.name
-    return LoadExpr(parse(text, (*TIME_NAMES, "theta", "theta_dot")),
-                    {"theta": Measure("joint", joint=jn, dof="rotation"),
-                     "theta_dot": Measure("joint", joint=jn, dof="rotation", rate=True)})
+    return _coordinate_expression(text, elem.joint, "rotation")
 
 
 def stop_expression(elem) -> LoadExpr:
     """The load [N or N m] of a Stop along its joint coordinate x (> 0 pushes x up) as a load expression of
     x and its rate: Adams IMPACT at the lower wall, its mirror image at the upper one, BISTOP for both
     (mbdsim.functions; the law of system.force_elements.stop)."""
-    from ..expressions import parse
     f = lambda v: repr(float(v))  # noqa: E731
     law = f"{f(elem.stiffness)}, {f(elem.exponent)}, {f(elem.damping)}, {f(elem.penetration)}"
     if elem.lower is not None and elem.upper is not None:
@@ -51,10 +55,7 @@ def stop_expression(elem) -> LoadExpr:
         text = f"IMPACT(x, x_dot, {f(elem.lower)}, {law})"
     else:
         text = f"-IMPACT(-x, -x_dot, {f(-elem.upper)}, {law})"
-    jn = elem.joint.name
-    return LoadExpr(parse(text, (*TIME_NAMES, "x", "x_dot")),
-                    {"x": Measure("joint", joint=jn, dof=elem.dof),
-                     "x_dot": Measure("joint", joint=jn, dof=elem.dof, rate=True)})
+    return _coordinate_expression(text, elem.joint, elem.dof)
 
 
 class _NotCompiled(Exception):
