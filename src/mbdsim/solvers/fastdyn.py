@@ -23,6 +23,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
         return 0.0
 from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, _rot, expr_loads
 from ..system.kernels import frames_into, quat_step, rows_kernel
+from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 from . import fasttree
 
@@ -322,8 +323,13 @@ def residuals(cm, wk, times, Y, idx, rows, val, arg):
 
 @njit(cache=True, _nrt=False)
 def _factor(cm, wk):
-    if cm[31][4]:
+    """Factor the augmented matrix at the rows in wk: dense LU (dims[4] = 1, singular body masses), the
+    square Jacobian's LU (dims[4] = 2, zero-DOF models, `kkt_square`; the tree instead where it declines)
+    or the tree elimination of `kkt_tree`. False if singular."""
+    if cm[31][4] == 1:
         return dense_factor(wk[5], cm[12], cm[13], cm[7], cm[32], wk[32], wk[33])
+    if cm[31][4] == 2 and square_factor(wk[5], cm[12], cm[13], cm[5], cm[6], cm[32], wk[32], wk[33]):
+        return True
     t = cm[30]
     return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8],
                       wk[9], wk[10], wk[11], wk[12], wk[13], wk[14], wk[15], wk[16], wk[17], wk[18],
@@ -332,12 +338,24 @@ def _factor(cm, wk):
 
 @njit(cache=True, _nrt=False)
 def _solve(cm, wk, F, c_rows, x6, lam):
-    if cm[31][4]:
+    if cm[31][4] == 1:
         dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
+        return
+    if cm[31][4] == 2 and wk[33][cm[32].shape[0]] == 1:
+        square_solve(cm[32], cm[5], cm[6], cm[7], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
         return
     t = cm[30]
     kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
               wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[21], F, c_rows, x6, lam, wk[38], wk[41])
+
+
+@njit(cache=True, _nrt=False)
+def rows_dropped(cm, wk):
+    """True when the factorisation in wk left dependent loop rows out of the solve (the tree's pivoted
+    Cholesky at a change point, where the constraints do not determine the rates)."""
+    if cm[31][4] == 1 or (cm[31][4] == 2 and wk[33][cm[32].shape[0]] == 1):
+        return False
+    return wk[41][0] < cm[30][8].shape[0]
 
 
 @njit(cache=True, _nrt=False)

@@ -26,7 +26,7 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, increment_into, newton_positions,
-                      project_velocities)
+                      project_velocities, rows_dropped)
 
 MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-step
 CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted increment (+ CORR_ABS) ...
@@ -84,7 +84,7 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
             status = project_velocities(cm, wk, v, True)
             stats[3] += 1
             stats[4] += 1
-        if status == OK and cm[31][4] == 0 and wk[41][0] < cm[30][8].shape[0]:
+        if status == OK and rows_dropped(cm, wk):
             stats[5] += 1
         if status == OK:
             status = accelerations(cm, wk, t + h, q, v, vd, lam, False)

@@ -18,6 +18,11 @@ from . import exprloads_pack, jointtree, packing
 from .measures import locate
 from .topology import Topology, system_topology
 
+# zero-DOF models with at most this many velocity variables solve their augmented equations through the
+# LU of the square Jacobian (solvers.kkt_square): 1.5 us against 3.4 us for the tree elimination at
+# nv = 18 (slider-crank); the LU grows as nv^3, the tree linearly
+SQUARE_MAX = 24
+
 
 USE_TREE = True   # trees of revolute/translational/fixed joints in joint coordinates (False: absolute only)
 
@@ -63,7 +68,9 @@ class CompiledModel:
     sp_par: np.ndarray
     topo: Topology
     dims: np.ndarray          # (nq, nv, nc, nf, dense, mode): dense = 1 when a body's mass matrix is
-    #                           singular; mode = 1: joint-coordinate tree (state [theta, theta_dot])
+    #                           singular, 2 for a small zero-DOF model (the independent rows' Jacobian is
+    #                           square: solvers.kkt_square); mode = 1: joint-coordinate tree (state
+    #                           [theta, theta_dot])
     active: np.ndarray        # independent rows in force
     stack_size: int
     bushings: tuple = ()      # (frames (n, 2), marker points s_B (n, 2, 3), marker axes R_BM (n, 2, 3, 3),
@@ -96,7 +103,9 @@ class Work:
     @classmethod
     def for_model(cls, cm: CompiledModel) -> "Work":
         nq, nv, nc, nf, dense, _mode = (int(x) for x in cm.dims)
-        nk = 6 * (nf - 1) + len(cm.active) if dense else 1   # dense augmented matrix (singular masses)
+        # 32, 33, 39: the dense augmented matrix (dense = 1: singular masses) or the square Jacobian's LU
+        # (dense = 2: zero-DOF models, solvers.kkt_square; 33's last slot flags a valid LU)
+        nk = 6 * (nf - 1) + len(cm.active) if dense == 1 else (nv if dense == 2 else 1)
         t = cm.topo
         nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
         nd = len(cm.start) // 3
@@ -107,7 +116,7 @@ class Work:
              z((nf, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nblk, 6, 6)), z((nf, 6)),
              z((nblk, 6)), z((nl, nf, 6)), z((nl, nl)), z((1, nl, nl)), z((1, nl)), z(nc), z((nl, nc)), z((3, nd)), z(4),
              z(max(cm.stack_size, 4)), z((nf, 6)), z(nc), z((nf, 6)), z(nv), z(nc), z((nf, 6)), z((0, 6)),
-             z((nk, nk)), np.zeros(nk, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
+             z((nk, nk)), np.zeros(nk + 1, np.int64), z(nd), z(nd), z(nd), z((nf, 6)), z((6, 6)), z(nk), z((6, 6)), np.zeros(nl + 1, np.int64), z((2, 3, 3)),
              # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
              (z((nf, 6, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z(nf), z(nf), z((6, 6)),
               z(6), z((nf, 3)), z((2, 3, 3))),
@@ -240,9 +249,11 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     code, consts, tables, start, end, stack = _driver_programs(fns)
     bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
-    dense = _singular_masses(M6[1:])
+    dense = int(_singular_masses(M6[1:]))
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
         jointtree.tree_arrays(sys, rows, *state)
+    if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
+        dense = 2   # zero DOF: the independent rows' Jacobian is square (solvers.kkt_square)
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES)]
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
     ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \
@@ -253,5 +264,5 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
-                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, int(dense), mode], np.int64),
+                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys))
