@@ -7,6 +7,8 @@ import numpy as np
 
 import mbdsim as mb
 from mbdsim.solvers import common, fastdyn
+from mbdsim.solvers.compiled_run import _full_multipliers
+from mbdsim.system.equations import jacobians
 from mbdsim.solvers.assembly import assemble_state
 from mbdsim.system.assemble import assemble_system
 from mbdsim.system.compiled import SQUARE_MAX, Work, compile_system
@@ -100,12 +102,27 @@ def test_kinematic_sweep_square_against_tree():
             runs[mode] = run.sweep(0.0, y0, times)
         finally:
             run.cm.dims[4] = 2
-    (Y2, VD2, L2, n2, s2, *_), (Y0, VD0, L0, n0, s0, *_) = runs[2], runs[0]
+    (Y2, VD2, L2, M2, n2, s2, *_), (Y0, VD0, L0, M0, n0, s0, *_) = runs[2], runs[0]
     assert n2 == n0 == 101 and s2 == s0 == fastdyn.OK
     assert np.max(np.abs(Y2 - Y0)) < 1e-11 * (1 + np.max(np.abs(Y0)))
     assert np.max(np.abs(VD2 - VD0)) < 1e-10 * (1 + np.max(np.abs(VD0)))
-    assert np.max(np.abs(L2 - L0)) < 1e-10 * (1 + np.max(np.abs(L0)))
     assert np.array_equal(res.q, Y2[:, :sys.nq])      # simulate ran the square mode
+    # the square sweep stores the minimum-norm multipliers of all 21 rows itself; the tree sweep those of
+    # the 18 independent rows, completed afterwards by solvers.minnorm (Cholesky of J_r J_r^T per sample)
+    assert M2.all() and not M0.any() and np.all(L0[:, np.setdiff1d(np.arange(sys.nc), rep.rows)] == 0)
+    full = _full_multipliers(sys, rep.rows, times, Y0, VD0, L0)
+    assert np.max(np.abs(L2 - full)) < 1e-10 * np.max(np.abs(full))
+    load = lambda L: np.einsum("nri,nr->ni", jacobians(sys, Y2[:, :sys.nq]), L)  # noqa: E731 - J^T lambda_
+    assert np.max(np.abs(load(L2) - load(L0))) < 1e-10 * np.max(np.abs(load(L0)))
+    assert np.all(np.linalg.norm(L2, axis=1) <= np.linalg.norm(L0, axis=1) + 1e-12)  # least norm
+    # the dense output (refinement grids) gives them too, and reactions read them
+    mid = res.at(np.array([0.123, 0.5, 0.777]))
+    for k, t in enumerate(mid.time):
+        J = jacobians(sys, mid.q[k:k + 1])[0]
+        _, lam_ref = common.accelerations(sys, mid.q[k], mid.v[k], t, rep.rows)   # reference solve
+        lam = mid.lambda_[k]
+        assert np.max(np.abs(J.T @ lam - J[rep.rows].T @ lam_ref[rep.rows])) < 1e-9 * np.max(np.abs(lam_ref))
+        assert np.max(np.abs(lam - J @ np.linalg.pinv(J) @ lam)) < 1e-9 * np.max(np.abs(lam))   # least norm
 
 
 def test_change_point_hands_the_factorisation_to_the_tree():

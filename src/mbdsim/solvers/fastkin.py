@@ -27,6 +27,7 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, increment_into, newton_positions,
                       project_velocities, rows_dropped)
+from .kkt_square import square_min_norm
 
 MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-step
 CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted increment (+ CORR_ABS) ...
@@ -112,6 +113,34 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
 
 
 @njit(cache=True, _nrt=False)
+def min_norm_at(cm, wk, lam):
+    """Turn the multipliers lam just solved (`fastdyn.accelerations`, rows and factorisation in wk at
+    the same state) into the minimum-norm multipliers of all rows when the square LU is in wk
+    (`kkt_square.square_min_norm`; nothing to do without dependent rows). True when lam now holds them,
+    False when they are still the independent rows' (the caller's `compiled_run._full_multipliers`)."""
+    if cm[31][4] != 2:
+        return cm[32].shape[0] == cm[31][2]
+    mn = wk[45]
+    return square_min_norm(wk[5], cm[12], cm[13], cm[5], cm[6], cm[32], wk[32], wk[33], lam, mn[0], mn[1],
+                           mn[2])
+
+
+@njit(cache=True, _nrt=False)
+def _solved_at(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
+    """`advance` to t1 [s], then the minimum-norm multipliers (`min_norm_at`); when no sub-step was
+    needed (t1 at the state's time to round-off) the equations are solved again there first, so that the
+    rows and the factorisation in wk are those of the returned state. Returns (status, min-norm)."""
+    before = stats[1]
+    status = advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6)
+    if status == OK and stats[1] == before:
+        status = accelerations(cm, wk, st[0], q, v, vd, lam, True)
+        stats[4] += 1
+    if status != OK:
+        return status, False
+    return OK, min_norm_at(cm, wk, lam)
+
+
+@njit(cache=True, _nrt=False)
 def _store(q, v, vd, lam, Y, VD, LAM, row):
     """Row `row` of the outputs: [q, v] into Y, vd into VD, the multipliers into LAM."""
     nq = q.shape[0]
@@ -125,14 +154,15 @@ def _store(q, v, vd, lam, Y, VD, LAM, row):
 
 
 @njit(cache=True, _nrt=False)
-def sweep(cm, wk, st, tout, iout, Y, VD, LAM, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
+def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
     """Solve the outputs tout[iout:] [s] in turn from the solved state (q, v, vd, lam) at st[0], writing
-    [q, v] rows into Y, vd into VD and the multipliers (zero at inactive rows) into LAM; stops after
+    [q, v] rows into Y, vd into VD and the multipliers into LAM: the minimum-norm ones of all rows where
+    MN is set (`min_norm_at`), else those of the independent rows (zero at the others); stops after
     `chunk` outputs; st and p6 as in `advance`. Returns (status, next iout); on failure st[0] and (q, v)
     are the last solved state."""
     written = 0
     while iout < tout.shape[0]:
-        status = advance(cm, wk, st, tout[iout], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
+        status, MN[iout] = _solved_at(cm, wk, st, tout[iout], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
         if status != OK:
             return status, iout
         _store(q, v, vd, lam, Y, VD, LAM, iout)
@@ -145,10 +175,12 @@ def sweep(cm, wk, st, tout, iout, Y, VD, LAM, q, v, vd, lam, tol, chunk, stats, 
 
 
 @njit(cache=True, _nrt=False)
-def states_at(cm, wk, times, Y, VD, LAM, ts, Yo, VDo, LAMo, tol, stats, S, dx6, a6, p6, q, v, vd, lam, st):
-    """States, accelerations and multipliers at the times ts [s] (inside the run) into Yo, VDo, LAMo: the
-    same solve as `sweep`, from the output at or before each t (times, Y, VD, LAM: the run's outputs;
-    an output time gives its row as stored). Returns the number of times done (< len(ts) on failure)."""
+def states_at(cm, wk, times, Y, VD, LAM, MN, ts, Yo, VDo, LAMo, MNo, tol, stats, S, dx6, a6, p6, q, v, vd, lam,
+              st):
+    """States, accelerations and multipliers at the times ts [s] (inside the run) into Yo, VDo, LAMo
+    (MNo: minimum-norm multipliers, as MN of `sweep`): the same solve as `sweep`, from the output at or
+    before each t (times, Y, VD, LAM, MN: the run's outputs; an output time gives its row as stored).
+    Returns the number of times done (< len(ts) on failure)."""
     nq, n = q.shape[0], times.shape[0]
     for j in range(ts.shape[0]):
         lo, hi = 0, n   # k: the last output with times[k] <= ts[j] (0 before the first)
@@ -170,7 +202,10 @@ def states_at(cm, wk, times, Y, VD, LAM, ts, Yo, VDo, LAMo, tol, stats, S, dx6, 
         if k > 0:   # the third derivative from the accelerations at the two outputs before t
             _to6(cm, VD[k - 1], p6)
             st[2] = times[k] - times[k - 1]
-        if ts[j] > times[k] and advance(cm, wk, st, ts[j], q, v, vd, lam, tol, stats, S, dx6, a6, p6) != OK:
-            return j
+        MNo[j] = MN[k]
+        if ts[j] > times[k]:
+            status, MNo[j] = _solved_at(cm, wk, st, ts[j], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
+            if status != OK:
+                return j
         _store(q, v, vd, lam, Yo, VDo, LAMo, j)
     return ts.shape[0]

@@ -45,14 +45,17 @@ class KinematicRun:
         return (np.zeros((3, max(sys.nq, sys.nv, 1))), np.zeros((nf, 6)), np.zeros((nf, 6)), np.zeros((nf, 6)))
 
     def sweep(self, t0, y0, tout, progress=None, partial=None):
-        """(Y, VD, LAM, n, status, t_last, y_last): output rows [q, v], accelerations vd and multipliers of
-        the independent rows (zero elsewhere) at tout [s] from the consistent state y0 = [q, v] at t0 [s]
-        (tout[0] == t0); n outputs written; on failure t_last [s] and y_last are the last solved state.
-        After each chunk of outputs, `notify(progress, t, build)` (build: partial(Y, VD, LAM, n))."""
+        """(Y, VD, LAM, MN, n, status, t_last, y_last): output rows [q, v], accelerations vd and
+        multipliers at tout [s] from the consistent state y0 = [q, v] at t0 [s] (tout[0] == t0): the
+        minimum-norm multipliers of all rows where MN (bool) is set, else those of the independent rows
+        (zero elsewhere; `multipliers` completes them); n outputs written; on failure t_last [s] and
+        y_last are the last solved state. After each chunk of outputs, `notify(progress, t, build)`
+        (build: partial(Y, VD, LAM, MN, n))."""
         sys = self.sys
         a, w = self.cm.arrays(), self.work.arrays()
         nout, nq = len(tout), sys.nq
         Y, VD, LAM = np.zeros((nout, nq + sys.nv)), np.zeros((nout, sys.nv)), np.zeros((nout, sys.nc))
+        MN = np.zeros(nout, dtype=np.bool_)
         q, v = np.array(y0[:nq], dtype=float), np.array(y0[nq:], dtype=float)
         vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
         st = np.array([float(t0), np.inf, 0.0])
@@ -60,18 +63,31 @@ class KinematicRun:
         self.stats[4] += 1
         iout = 0
         if status == OK:
+            MN[0] = fastkin.min_norm_at(a, w, lam)
             Y[0], VD[0], LAM[0] = y0, vd, lam
             iout = 1
         S, dx6, a6, p6 = self._scratch()
         try:
             while status == OK and iout < nout:
-                status, iout = fastkin.sweep(a, w, st, tout, iout, Y, VD, LAM, q, v, vd, lam, PROJ_TOL, CHUNK,
-                                             self.stats, S, dx6, a6, p6)
+                status, iout = fastkin.sweep(a, w, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, PROJ_TOL,
+                                             CHUNK, self.stats, S, dx6, a6, p6)
                 notify(progress, st[0], None if partial is None else
-                       (lambda n=iout: partial(Y, VD, LAM, n)))
+                       (lambda n=iout: partial(Y, VD, LAM, MN, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
-        return Y, VD, LAM, iout, status, float(st[0]), np.concatenate([q, v])
+        return Y, VD, LAM, MN, iout, status, float(st[0]), np.concatenate([q, v])
+
+    def multipliers(self, times, Y, VD, LAM, MN):
+        """Multipliers of every row at the outputs (times [s], rows Y = [q, v]): LAM where MN says they
+        are the minimum-norm ones already, `compiled_run._full_multipliers` for the others."""
+        if MN.all():
+            return LAM
+        todo = np.flatnonzero(~MN)
+        if len(todo) == len(MN):
+            return _full_multipliers(self.sys, self.rows, times, Y, VD, LAM)
+        out = LAM.copy()
+        out[todo] = _full_multipliers(self.sys, self.rows, times[todo], Y[todo], VD[todo], LAM[todo])
+        return out
 
     def outputs(self, times, Y):
         """(VD, LAM): accelerations and multipliers of the independent rows recomputed at the output rows
@@ -84,21 +100,23 @@ class KinematicRun:
                 raise SolverError(_MESSAGES[fastdyn.SINGULAR] + " at an output time", time=float(t))
         return VD, LAM
 
-    def states_at(self, times, Y, VD, LAM, ts):
+    def states_at(self, times, Y, VD, LAM, MN, ts):
         """(q, v, vd, lambda_) at the times ts [s]: the same kinematic solve from the output at or before
-        each t (all of ts in one compiled call); an output time gives its stored sample."""
+        each t (all of ts in one compiled call); an output time gives its stored sample (times, Y, VD,
+        LAM, MN: the outputs of `sweep`)."""
         sys = self.sys
         ts = np.atleast_1d(np.asarray(ts, dtype=float))
         n = len(ts)
         Yo, VDo, LAMo = np.zeros((n, Y.shape[1])), np.zeros((n, sys.nv)), np.zeros((n, sys.nc))
         S, dx6, a6, p6 = self._scratch()
-        done = fastkin.states_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM, ts,
-                                 Yo, VDo, LAMo, PROJ_TOL, np.zeros(6, np.int64), S, dx6, a6, p6, np.zeros(sys.nq),
-                                 np.zeros(sys.nv), np.zeros(sys.nv), np.zeros(sys.nc), np.zeros(3))
+        MNo = np.zeros(n, dtype=np.bool_)
+        done = fastkin.states_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM, MN,
+                                 ts, Yo, VDo, LAMo, MNo, PROJ_TOL, np.zeros(6, np.int64), S, dx6, a6, p6,
+                                 np.zeros(sys.nq), np.zeros(sys.nv), np.zeros(sys.nv), np.zeros(sys.nc), np.zeros(3))
         if done < n:
             raise SolverError(_MESSAGES[fastdyn.PROJECTION] + " (kinematic solve)", time=float(ts[done]))
         nq = sys.nq
-        return Yo[:, :nq], Yo[:, nq:], VDo, _full_multipliers(sys, self.rows, ts, Yo, VDo, LAMo)
+        return Yo[:, :nq], Yo[:, nq:], VDo, self.multipliers(ts, Yo, VDo, LAMo, MNo)
 
 
 def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
@@ -119,9 +137,9 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
         return None
     times = np.asarray(times, float)
     y0 = np.concatenate([rep.q, rep.v])
-    partial = lambda Y, VD, LAM, n: _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n],  # noqa: E731
-                                            stats={"assembly": rep})
-    Y, VD, LAM, n, status, t_fail, y_fail = run.sweep(times[0], y0, times, progress, partial)
+    partial = lambda Y, VD, LAM, MN, n: _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n],  # noqa: E731
+                                                MN[:n], stats={"assembly": rep})
+    Y, VD, LAM, MN, n, status, t_fail, y_fail = run.sweep(times[0], y0, times, progress, partial)
     if status == OK and run.stats[5]:   # rates left to continuity somewhere: integrate instead
         return None
     success, message, error = True, "ok", None
@@ -132,20 +150,20 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,
              "factorizations": int(s[4]), "projections": int(s[3]), "order": None, "method": METHOD,
              "formulation": "absolute coordinates (tree elimination)", "assembly": rep}
-    res = _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n], success, message, stats)
+    res = _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n], MN[:n], success, message, stats)
     res.error = error
     return res
 
 
-def _result(sys, rep, run, t_out, Y, VD, LAM, success=True, message="ok", stats=None) -> Result:
+def _result(sys, rep, run, t_out, Y, VD, LAM, MN, success=True, message="ok", stats=None) -> Result:
     """The Result of the solved outputs: positions and velocities at t_out [s], accelerations and the
-    multipliers of every row (minimum norm where redundant) from the stored VD, LAM on first use; dense
-    output (`Result.at`) by the same kinematic solve; res.steps: the outputs themselves (no steps)."""
+    multipliers of every row (minimum norm where redundant) from the stored VD, LAM, MN on first use;
+    dense output (`Result.at`) by the same kinematic solve; res.steps: the outputs themselves."""
     nq = sys.nq
     res = Result(sys, t_out, Y[:, :nq], Y[:, nq:], None, None,
-                 evaluate=lambda ts: run.states_at(t_out, Y, VD, LAM, ts), success=success,
+                 evaluate=lambda ts: run.states_at(t_out, Y, VD, LAM, MN, ts), success=success,
                  status=0 if success else -1, message=message, stats=stats,
-                 accelerations=lambda: (VD, _full_multipliers(sys, rep.rows, t_out, Y, VD, LAM)))
+                 accelerations=lambda: (VD, run.multipliers(t_out, Y, VD, LAM, MN)))
     if len(t_out):
         res.steps = lambda: (t_out.copy(), Y[:, :nq].copy(), Y[:, nq:].copy())
     res.residual_check = residual_check(run, t_out, Y)

@@ -106,6 +106,7 @@ class Work:
         # 32, 33, 39: the dense augmented matrix (dense = 1: singular masses) or the square Jacobian's LU
         # (dense = 2: zero-DOF models, solvers.kkt_square; 33's last slot flags a valid LU)
         nk = 6 * (nf - 1) + len(cm.active) if dense == 1 else (nv if dense == 2 else 1)
+        n_dep = nc - len(cm.active) if dense == 2 else 0   # dependent rows of a square model
         t = cm.topo
         nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
         nd = len(cm.start) // 3
@@ -120,7 +121,9 @@ class Work:
              # 43: articulated-body scratch (solvers.fasttree): IA, pA, U, zeta, S, acc, D, u, Ia, pa, P, Rtmp
              (z((nf, 6, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z((nf, 6)), z(nf), z(nf), z((6, 6)),
               z(6), z((nf, 3)), z((2, 3, 3))),
-             exprloads_pack.work(cm.exprloads, cm.ex_stack))   # 44: expression loads' x and stack
+             exprloads_pack.work(cm.exprloads, cm.ex_stack),   # 44: expression loads' x and stack
+             # 45: minimum-norm multipliers through the square LU (solvers.kkt_square): C, S, y
+             (z((max(n_dep, 1), max(nv, 1))), z((max(n_dep, 1), max(n_dep, 1))), z(max(n_dep, nv, 1))))
         return cls(a)
 
     def arrays(self) -> tuple:
