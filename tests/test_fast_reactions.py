@@ -150,3 +150,28 @@ def test_min_norm_kernel_per_sample_equals_pseudo_inverse(name):
     for k in (0, *range(2, len(LAM), max(1, len(LAM) // 7))):
         ref = np.linalg.pinv(J[k].T, rcond=1e-10) @ (J[k, rows].T @ LAM[k, rows])
         assert np.abs(out[k] - ref).max() <= 1e-11 * max(np.abs(ref).max(), 1e-300)
+
+
+def test_reactions_of_one_result_compute_its_jacobians_once(monkeypatch):
+    """Every reaction (and driver effort) read from a Result's multipliers needs the constraint Jacobians at
+    its samples: they are computed for the first and kept for the others (reactions.keep_jacobians), also
+    across the dense-output grids a refinement evaluates in between; the values are those of a fresh
+    computation."""
+    import mbdsim.system.reactions as rx
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.simulate(slider_crank(crank=0.2, rod=0.5, crank_mass=1.0, rod_mass=2.0, slider_mass=1.5,
+                                       speed=6.0), 1.0, 0.01)
+    fresh = {j: joint_reaction(res.system, res.q, res.lambda_, j, J=jacobians(res.system, res.q))
+             for j in res.system.model.joints}
+    calls = []
+    monkeypatch.setattr(rx, "jacobians", lambda sys_, q: calls.append(len(q)) or jacobians(sys_, q))
+    res.system.run_state.clear()
+    for j in res.system.model.joints:
+        F, T = res._reaction(j, None, None)
+        assert np.array_equal(F, fresh[j][0]) and np.array_equal(T, fresh[j][1])
+    grid = res.at(np.linspace(0.2, 0.3, 17))
+    grid._reaction("crank_rod", None, None)
+    effort = res.driver_effort("drive")
+    assert calls == [len(res.time), 17]            # one per multiplier array, not one per reaction
+    assert np.array_equal(effort, res.driver_effort("drive"))

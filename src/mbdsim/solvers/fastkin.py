@@ -13,7 +13,9 @@ ground axes and angular velocities [rad/s] in body axes); the predictions use th
 time is reached from the previous solved state by sub-steps: q + h qdot + h^2/2 qddot + h^3/6 qdddot
 predicted (the third derivative from the accelerations at the start and end of the previous sub-step),
 Newton on the positions (`fastdyn.newton_positions`, as the projection of the dynamics),
-`fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the multipliers.
+`fastdyn.project_velocities` for the velocities, `fastdyn.accelerations` for vd and the multipliers
+(at each output the minimum-norm multipliers of all rows when the factorisation held is the square
+Jacobian's LU, `min_norm_at`: small zero-DOF models, `kkt_square`).
 A sub-step is retried at half length when the Newton iteration fails, when it turns any body by more
 than MAX_TURN, or when its correction is large against the predicted motion (a guard against
 converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned (lock-up:

@@ -13,29 +13,42 @@ from .equations import jacobians
 from .frames import body_frames
 
 
-JACOBIAN_KEEP = 2**23   # bytes: the Jacobians of the last multipliers computed are kept up to this size
+JACOBIAN_KEEP = 2**23   # bytes: Jacobians of recent multipliers are kept up to this size in all
+KEEP_LAST = 3           # ... for at most this many multiplier arrays (a run's samples, dense-output grids)
 
 
 def keep_jacobians(sys, lambda_, J) -> None:
-    """Keep the constraint Jacobians J (N, nc, nv) at the samples of the multipliers `lambda_` (N, nc) just
-    computed from them, for the reactions read from those multipliers (this run's samples: run state;
-    up to JACOBIAN_KEEP bytes)."""
-    if J.nbytes <= JACOBIAN_KEEP:
-        sys.run_state["jacobians of multipliers"] = (lambda_, J)
+    """Keep the constraint Jacobians J (N, nc, nv) at the samples of the multipliers `lambda_` (N, nc), for
+    the reactions read from those multipliers (run state): the last KEEP_LAST arrays given, up to
+    JACOBIAN_KEEP bytes in all, so that the reactions of a run's samples keep theirs while dense-output
+    grids come and go."""
+    kept = [e for e in sys.run_state.get("jacobians of multipliers", []) if e[0] is not lambda_]
+    kept.append((lambda_, J))
+    while kept and (len(kept) > KEEP_LAST or sum(e[1].nbytes for e in kept) > JACOBIAN_KEEP):
+        kept.pop(0)
+    sys.run_state["jacobians of multipliers"] = kept
 
 
 def jacobians_of(sys, lambda_):
-    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when it is the array last given
-    to `keep_jacobians` (the object itself, not equal values), else None."""
-    kept = sys.run_state.get("jacobians of multipliers")
-    return kept[1] if kept is not None and kept[0] is lambda_ else None
+    """The constraint Jacobians (N, nc, nv) at the samples of `lambda_` when that array (the object
+    itself, not equal values) was given to `keep_jacobians` lately, else None."""
+    for lam, J in sys.run_state.get("jacobians of multipliers", []):
+        if lam is lambda_:
+            return J
+    return None
 
 
 def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None):
     """Force [N] and torque [N m] (N, 3), ground axes, that `joint` (a Joint or motion name) exerts on `on`.
 
     Optional precomputed geometry of the samples q (N, nq): A (N, nbody + 1, 3, 3) body rotation
-    matrices (Frames.A), J (N, nc, nv) constraint Jacobians; computed here when not given."""
+    matrices (Frames.A), J (N, nc, nv) constraint Jacobians; computed here when not given (and kept for
+    the next reaction read from the same `lambda_` array, `keep_jacobians`)."""
+    if J is None:
+        J = jacobians_of(sys, lambda_)
+        if J is None:
+            J = jacobians(sys, q)
+            keep_jacobians(sys, lambda_, J)
     name = joint if isinstance(joint, str) else joint.name
     rows, geom = _rows_and_geometry(sys, name)
     body = on if on is not None else (joint.body_j if not isinstance(joint, str) else None)
