@@ -8,19 +8,21 @@ mechanism), their Jacobian J (nv x nv) is square and nonsingular, and the augmen
 decouple: vd = J^-1 c and lambda_ = J^-T (F - M vd), both from one LU factorisation of J (partial
 pivoting). For the small mechanisms this is chosen for (at most `system.compiled.SQUARE_MAX` velocity
 variables) it costs less than the tree elimination of `kkt_tree` with its loop Schur complement
-(slider-crank, nv = 18: 1.5 us against 3.4 us per factorisation). The Newton steps and velocity projections of `fastdyn` solve the same
-system with F = 0, where the unique solution is the mass-weighted minimum-norm one as well.
+(slider-crank, nv = 18: 1.0-1.5 us against 3.4 us per factorisation). The Newton steps and velocity
+projections of `fastdyn` solve the same system with F = 0, where the unique solution is the
+mass-weighted minimum-norm one as well.
 
 Near a change point (a driven parallelogram with its links collinear) J loses rank; the tree
 factorisation decides there which loop rows drop out (`kkt_tree.pivoted_chol`), so `square_factor`
 declines (returns False) when a pivot falls below SQUARE_PIVOT of the largest entry and the caller
 factors the tree instead.
 
-With redundant rows (a planar loop of 3D revolutes) the same LU gives the minimum-norm multipliers of all
-rows at little cost (`square_min_norm`: d transposed solves and a d x d Cholesky, d dependent rows), so
-a kinematic sweep stores them directly instead of a separate pass over the samples (`solvers.minnorm`). Velocity slots as `fastdyn`: x6 (nf, 6) per frame [m/s^2 in ground axes,
-rad/s^2 in body axes], J's columns are the velocity variables v (frame f's slot k at vadr[f] + k; a
-particle has its three translational slots only).
+With redundant rows (a planar loop of 3D revolutes) the same LU gives the minimum-norm multipliers of
+all rows at little cost (`square_min_norm`: d transposed solves and a d x d Cholesky, d dependent
+rows), so a kinematic sweep stores them directly instead of a separate pass over the samples
+(`solvers.minnorm`). Velocity slots as `fastdyn`: x6 (nf, 6) per frame [m/s^2 in ground axes, rad/s^2
+in body axes]; J's columns are the velocity variables v (frame f's slot k at vadr[f] + k; a particle
+has its three translational slots only).
 """
 from __future__ import annotations
 

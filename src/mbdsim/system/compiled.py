@@ -131,7 +131,7 @@ class Work:
 
 
 def _contacts(sys) -> tuple:
-    """The model's contacts for `fastdyn.contacts_kernel`: frames (i, j) (n, 2), kind (n,) (0 sphere-sphere,
+    """The model's contacts for `fastloads.contacts_kernel`: frames (i, j) (n, 2), kind (n,) (0 sphere-sphere,
     1 plane on i and sphere on j, 2 sphere on i and plane on j), shape points s_B (n, 2, 3) [m, body axes],
     the plane's normal (n, 3) [body axes] and (radius_i, radius_j, stiffness, exponent, damping,
     penetration, mu, friction_velocity) (n, 8) (SI; a plane's radius 0)."""
