@@ -42,14 +42,21 @@ def _joint(m, kind, a, b, point):
     return m.add_fixed(kind, a, b, point)
 
 
-def _compare(model, seed=0, tol=1e-10):
-    """Compiled vs reference accelerations and multipliers at a random consistent state."""
+def random_consistent_state(model, seed=0):
+    """(System, AssemblyReport, q, v): the model assembled at t = 0, and a random state near the assembled
+    one projected onto the constraints (positions, then velocities)."""
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, 0.0)
     rng = np.random.default_rng(seed)
     q = common.project_positions(sys, common.increment(sys, rep.q, 0.05 * rng.standard_normal(sys.nv)),
                                  0.0, rep.rows)[0]
     v = common.project_velocities(sys, q, rng.standard_normal(sys.nv), 0.0, rep.rows)
+    return sys, rep, q, v
+
+
+def _compare(model, seed=0, tol=1e-10):
+    """Compiled vs reference accelerations and multipliers at a random consistent state."""
+    sys, rep, q, v = random_consistent_state(model, seed)
     vd_ref, lam_ref = common.accelerations(sys, q, v, 0.0, rep.rows)
     cm = compile_system(sys, rep.rows)
     vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)

@@ -14,19 +14,14 @@ from mbdsim.system.assemble import assemble_system
 from mbdsim.system.compiled import SQUARE_MAX, Work, compile_system
 from mbdsim.studies.models import slider_crank
 
-from test_compiled_core import _parallelogram
+from test_compiled_core import _parallelogram, random_consistent_state
 
 
 def _both(model, seed=0):
     """The compiled model, a random consistent state (q, v) and the arrays of the square and tree modes."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)
-        sys = assemble_system(model)
-        rep = assemble_state(sys, sys.q0, sys.v0, 0.0)
-    rng = np.random.default_rng(seed)
-    q = common.project_positions(sys, common.increment(sys, rep.q, 0.05 * rng.standard_normal(sys.nv)),
-                                 0.0, rep.rows)[0]
-    v = common.project_velocities(sys, q, rng.standard_normal(sys.nv), 0.0, rep.rows)
+        sys, rep, q, v = random_consistent_state(model, seed)
     cm = compile_system(sys, rep.rows)
     assert rep.dof == 0 and cm.dims[4] == 2
     square = cm.arrays()

@@ -19,9 +19,8 @@ from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_fo
 @njit(cache=True, _nrt=False)
 def _centre(r, A, f, s):
     """Ground position [m] of the body-axes point s of frame f."""
-    return (r[f, 0] + A[f, 0, 0] * s[0] + A[f, 0, 1] * s[1] + A[f, 0, 2] * s[2],
-            r[f, 1] + A[f, 1, 0] * s[0] + A[f, 1, 1] * s[1] + A[f, 1, 2] * s[2],
-            r[f, 2] + A[f, 2, 0] * s[0] + A[f, 2, 1] * s[1] + A[f, 2, 2] * s[2])
+    x0, x1, x2 = _rot(A, f, s[0], s[1], s[2])
+    return r[f, 0] + x0, r[f, 1] + x1, r[f, 2] + x2
 
 
 @njit(cache=True, _nrt=False)

@@ -26,12 +26,26 @@ has its three translational slots only).
 """
 from __future__ import annotations
 
-import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .kkt_tree import lu_factor, lu_solve, lu_solve_transposed
+from .minnorm import _chol_solve, _cholesky
 
 SQUARE_PIVOT = 1e-6    # a pivot below this fraction of J's largest entry: near-singular, tree instead
+
+
+@njit(cache=True, _nrt=False, inline="always")
+def _add_row(Jc, bi, bj, vadr, rigid, row, X, i):
+    """Add the compact row `row` of Jc (nc, 2, 6) into row i of X, dense over the velocity variables v
+    (frame f's slot k at vadr[f] + k; a particle's translational slots only). Inlined where it is called,
+    with X and i rather than a row view: as a call, or on a view, it made the LU's scatter twice as slow."""
+    for side in range(2):
+        f = bi[row] if side == 0 else bj[row]
+        if f != 0:
+            nk = 6 if rigid[f] else 3
+            for k in range(nk):
+                X[i, vadr[f] + k] += Jc[row, side, k]
 
 
 @njit(cache=True, _nrt=False)
@@ -46,56 +60,11 @@ def square_factor(Jc, bi, bj, vadr, rigid, active, A, piv):
         for j in range(n):
             A[i, j] = 0.0
     for a in range(n):
-        row = active[a]
-        for side in range(2):
-            f = bi[row] if side == 0 else bj[row]
-            if f != 0:
-                nk = 6 if rigid[f] else 3
-                for k in range(nk):
-                    A[a, vadr[f] + k] += Jc[row, side, k]
-    scale = 0.0
-    for i in range(n):
-        for j in range(n):
-            scale = max(scale, abs(A[i, j]))
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > abs(A[p, k]):
-                p = i
-        piv[k] = p
-        if not abs(A[p, k]) > SQUARE_PIVOT * scale:
-            return False
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        r = 1.0 / A[k, k]
-        for i in range(k + 1, n):
-            A[i, k] *= r
-            m = A[i, k]
-            if m != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= m * A[k, j]
+        _add_row(Jc, bi, bj, vadr, rigid, active[a], A, a)
+    if not lu_factor(A, n, piv, SQUARE_PIVOT):
+        return False
     piv[n] = 1
     return True
-
-
-@njit(cache=True, _nrt=False)
-def _transposed_solve(A, piv, n, x):
-    """x <- A^-T x with the LU of `square_factor` (U^T w = x, L^T z = w, then the row swaps undone)."""
-    for i in range(n):
-        s = x[i]
-        for k in range(i):
-            s -= A[k, i] * x[k]
-        x[i] = s / A[i, i]
-    for i in range(n - 1, -1, -1):
-        s = x[i]
-        for k in range(i + 1, n):
-            s -= A[k, i] * x[k]
-        x[i] = s
-    for k in range(n - 1, -1, -1):
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
 
 
 @njit(cache=True, _nrt=False)
@@ -106,20 +75,7 @@ def square_solve(active, vadr, rigid, M6, A, piv, F, c_rows, x6, lam, x):
     n = active.shape[0]
     for a in range(n):
         x[a] = c_rows[active[a]]
-    for k in range(n):                      # P c
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-    for i in range(n):                      # L y = P c (unit lower)
-        s = x[i]
-        for k in range(i):
-            s -= A[i, k] * x[k]
-        x[i] = s
-    for i in range(n - 1, -1, -1):          # U vd = y
-        s = x[i]
-        for k in range(i + 1, n):
-            s -= A[i, k] * x[k]
-        x[i] = s / A[i, i]
+    lu_solve(A, piv, n, x)                  # vd = J^-1 c
     for k in range(6):
         x6[0, k] = 0.0
     for f in range(1, x6.shape[0]):
@@ -133,7 +89,7 @@ def square_solve(active, vadr, rigid, M6, A, piv, F, c_rows, x6, lam, x):
             for j in range(6):
                 s -= M6[f, i, j] * x6[f, j]
             x[vadr[f] + i] = s
-    _transposed_solve(A, piv, n, x)         # lambda_ = J^-T r
+    lu_solve_transposed(A, piv, n, x)       # lambda_ = J^-T r
     for a in range(n):
         lam[active[a]] = x[a]
 
@@ -145,7 +101,8 @@ def square_min_norm(Jc, bi, bj, vadr, rigid, active, A, piv, lam, C, S, y):
     multipliers of all rows with the same constraint load (J^T lam = J_r^T lam_r), as
     `solvers.minnorm` computes them: with C = J_d J_r^-1 (d x nv, d the rows not in `active`) and
     S = I + C C^T, lam_d = S^-1 C lam_r and lam_r - C^T lam_d on the active rows. C (>= d, nv),
-    S (>= d, >= d), y (>= max(d, nv)) scratch. False (lam untouched) when no valid LU is in A."""
+    S (>= d, >= d), y (>= max(d, nv)) scratch. False (lam untouched) when no valid LU is in A or S is
+    not positive definite (rows not finite)."""
     n, nc = active.shape[0], Jc.shape[0]
     d = nc - n
     if d == 0:
@@ -158,14 +115,11 @@ def square_min_norm(Jc, bi, bj, vadr, rigid, active, A, piv, lam, C, S, y):
             a += 1
             continue
         for i in range(n):
-            y[i] = 0.0
-        for side in range(2):
-            f = bi[row] if side == 0 else bj[row]
-            if f != 0:
-                nk = 6 if rigid[f] else 3
-                for k in range(nk):
-                    y[vadr[f] + k] += Jc[row, side, k]
-        _transposed_solve(A, piv, n, y)          # row m of C: J_d[m] J_r^-1
+            C[m, i] = 0.0
+        _add_row(Jc, bi, bj, vadr, rigid, row, C, m)
+        for i in range(n):
+            y[i] = C[m, i]
+        lu_solve_transposed(A, piv, n, y)        # row m of C: J_d[m] J_r^-1
         for i in range(n):
             C[m, i] = y[i]
         m += 1
@@ -179,26 +133,9 @@ def square_min_norm(Jc, bi, bj, vadr, rigid, active, A, piv, lam, C, S, y):
         for i in range(n):
             s += C[p, i] * lam[active[i]]
         y[p] = s
-    for j in range(d):
-        s = S[j, j]
-        for k in range(j):
-            s -= S[j, k] * S[j, k]
-        S[j, j] = np.sqrt(s)                     # >= 1: S is I plus a positive semi-definite matrix
-        for i in range(j + 1, d):
-            s = S[i, j]
-            for k in range(j):
-                s -= S[i, k] * S[j, k]
-            S[i, j] = s / S[j, j]
-    for i in range(d):                           # S lam_d = C lam_r
-        s = y[i]
-        for k in range(i):
-            s -= S[i, k] * y[k]
-        y[i] = s / S[i, i]
-    for i in range(d - 1, -1, -1):
-        s = y[i]
-        for k in range(i + 1, d):
-            s -= S[k, i] * y[k]
-        y[i] = s / S[i, i]
+    if not _cholesky(S, d):                      # S lam_d = C lam_r (S: I plus a semi-definite matrix)
+        return False
+    _chol_solve(S, d, y)
     for i in range(n):                           # lam_r - C^T lam_d
         s = 0.0
         for p in range(d):

@@ -337,26 +337,73 @@ def dense_factor(Jc, bi, bj, M6, active, KD, piv):
                 for k in range(6):
                     KD[6 * nb + a, 6 * (f - 1) + k] += Jc[row, side, k]
                     KD[6 * (f - 1) + k, 6 * nb + a] += Jc[row, side, k]
+    return lu_factor(KD, n, piv, 1e-13)
+
+
+@njit(cache=True, _nrt=False)
+def lu_factor(A, n, piv, rel_tol):
+    """LU with partial pivoting of the leading n x n block of A in place (L unit lower below the diagonal,
+    U on and above it), the row swaps in piv[:n]; False when a pivot is not above rel_tol times the
+    largest entry (singular to that tolerance). Used by `dense_factor` and `kkt_square.square_factor`."""
     scale = 0.0
     for i in range(n):
         for j in range(n):
-            scale = max(scale, abs(KD[i, j]))
+            scale = max(scale, abs(A[i, j]))
     for k in range(n):
         p = k
         for i in range(k + 1, n):
-            if abs(KD[i, k]) > abs(KD[p, k]):
+            if abs(A[i, k]) > abs(A[p, k]):
                 p = i
         piv[k] = p
-        if not abs(KD[p, k]) > 1e-13 * scale:
+        if not abs(A[p, k]) > rel_tol * scale:
             return False
         if p != k:
             for j in range(n):
-                KD[k, j], KD[p, j] = KD[p, j], KD[k, j]
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+        r = 1.0 / A[k, k]   # one division per column (the multipliers by product)
         for i in range(k + 1, n):
-            KD[i, k] /= KD[k, k]
-            for j in range(k + 1, n):
-                KD[i, j] -= KD[i, k] * KD[k, j]
+            A[i, k] *= r
+            m = A[i, k]
+            if m != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= m * A[k, j]
     return True
+
+
+@njit(cache=True, _nrt=False)
+def lu_solve(A, piv, n, x):
+    """x <- A^-1 x (leading n entries) with the LU of `lu_factor`."""
+    for k in range(n):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
+    for i in range(n):
+        for k in range(i):
+            x[i] -= A[i, k] * x[k]
+    for i in range(n - 1, -1, -1):
+        for k in range(i + 1, n):
+            x[i] -= A[i, k] * x[k]
+        x[i] /= A[i, i]
+
+
+@njit(cache=True, _nrt=False)
+def lu_solve_transposed(A, piv, n, x):
+    """x <- A^-T x (leading n entries) with the LU of `lu_factor` (U^T w = x, L^T z = w, then the row
+    swaps undone)."""
+    for i in range(n):
+        s = x[i]
+        for k in range(i):
+            s -= A[k, i] * x[k]
+        x[i] = s / A[i, i]
+    for i in range(n - 1, -1, -1):
+        s = x[i]
+        for k in range(i + 1, n):
+            s -= A[k, i] * x[k]
+        x[i] = s
+    for k in range(n - 1, -1, -1):
+        p = piv[k]
+        if p != k:
+            x[k], x[p] = x[p], x[k]
 
 
 @njit(cache=True, _nrt=False)
@@ -369,17 +416,7 @@ def dense_solve(active, KD, piv, F, c_rows, vd, lam, x):
             x[6 * (f - 1) + k] = F[f, k]
     for a in range(active.shape[0]):
         x[6 * nb + a] = c_rows[active[a]]
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            x[k], x[p] = x[p], x[k]
-    for i in range(n):
-        for k in range(i):
-            x[i] -= KD[i, k] * x[k]
-    for i in range(n - 1, -1, -1):
-        for k in range(i + 1, n):
-            x[i] -= KD[i, k] * x[k]
-        x[i] /= KD[i, i]
+    lu_solve(KD, piv, n, x)
     for k in range(6):
         vd[0, k] = 0.0
     for f in range(1, nb + 1):
