@@ -14,7 +14,8 @@ d2 per s^2. Build them with :func:`time_function` (re-exported by :mod:`mbdsim.e
   within 0.1 s of t, need explicit d1/d2 or an expression.
 
 :func:`integrated` and :func:`double_integrated` turn a velocity or acceleration driver into a
-displacement TimeFunction by adaptive quadrature (scipy.integrate.quad).
+displacement TimeFunction: an exact expression when the driver's expression has a closed-form
+antiderivative (mbdsim._exprint), else by adaptive quadrature (scipy.integrate.quad).
 """
 from __future__ import annotations
 
@@ -240,9 +241,40 @@ class _Integrated:
         return self.a + self.b * t + rest
 
 
+def _closed_form(g, times, x0, v0):
+    """TimeFunction of the `times`-fold integral of expression TimeFunction g (x0 + v0 t + ...), from the
+    closed-form antiderivative (mbdsim._exprint), or None when g is not an expression or has none."""
+    from ._exprint import antiderivative
+    from ._exprtree import Const, Var, add, mul
+    from .expressions import Expr
+    if isinstance(g.f, _Constant):
+        g = TimeFunction(Expr(Const(g.f.c)), Expr(Const(0.0)), Expr(Const(0.0)), g.description, Expr(Const(g.f.c)))
+    if g.expr is None:
+        return None
+    F = antiderivative(g.expr.node, "t", times)
+    if F is None:
+        return None
+    F = add(add(Const(float(x0)), mul(Const(float(v0)), Var("t"))), F)
+    value = Expr(F, ("t",))
+    if times == 1:
+        d1, d2 = g.f, g.f_d1
+    else:
+        G = antiderivative(g.expr.node, "t", 1)
+        d1, d2 = Expr(add(Const(float(v0)), G), ("t",)), g.f
+    kind = "integral" if times == 1 else "double integral"
+    return TimeFunction(value, d1, d2, f"{x0} + {kind} of {g.description} (closed form)", value)
+
+
 def integrated(f, x0=0.0) -> TimeFunction:
-    """Displacement x(t) = x0 + integral_0^t f of a velocity driver f (d1 = f, d2 = f'); x0 at t = 0."""
+    """Displacement x(t) = x0 + integral_0^t f of a velocity driver f (d1 = f, d2 = f'); x0 at t = 0.
+
+    An expression with a closed-form antiderivative (polynomials, sin/cos/exp of a t + b times
+    polynomials, STEP/STEP5/HAVSIN/POLY/SHF: mbdsim._exprint) gives an exact expression (`expr` set: the
+    compiled core evaluates it); anything else is integrated by adaptive quadrature when evaluated."""
     g = time_function(f)
+    exact = _closed_form(g, 1, x0, 0.0)
+    if exact is not None:
+        return exact
     return TimeFunction(_Integrated(float(x0), 0.0, _Cumulative(g.value)), g.value, g.d1,
                         f"{x0} + integral of {g.description}")
 
@@ -250,9 +282,13 @@ def integrated(f, x0=0.0) -> TimeFunction:
 def double_integrated(f, x0=0.0, v0=0.0) -> TimeFunction:
     """Displacement of an acceleration driver f: x = x0 + v0 t + integral_0^t (t - tau) f(tau) dtau.
 
-    d1 = v0 + integral_0^t f, d2 = f; x0 and v0 are the values at t = 0.
+    d1 = v0 + integral_0^t f, d2 = f; x0 and v0 are the values at t = 0. Closed form when the
+    expression allows (see `integrated`), else quadrature.
     """
     g = time_function(f)
+    exact = _closed_form(g, 2, x0, v0)
+    if exact is not None:
+        return exact
     i1, i2 = _Cumulative(g.value), _Cumulative(g.value, moment=True)
     return TimeFunction(_Integrated(float(x0), float(v0), i1, i2), _Integrated(float(v0), 0.0, i1), g.value,
                         f"{x0} + {v0} t + double integral of {g.description}")

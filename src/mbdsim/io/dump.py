@@ -148,14 +148,10 @@ def _motion(m) -> dict:
     if m.kind == "displacement":
         d["displacement"] = _source(entity, "displacement", tf)
     else:
-        src = tf.f_d1 if m.kind == "velocity" else tf.f_d2
-        inner = getattr(src, "__self__", None)
-        if inner is None or not hasattr(tf.f, "a"):
-            raise ModelError(entity, m.kind, "a Python callable cannot be stored in a model file")
-        d[m.kind] = _source(entity, m.kind, inner)
-        d["initial_displacement"] = float(tf.f.a)
+        d[m.kind] = _source(entity, m.kind, m.given)
+        d["initial_displacement"] = float(m.initial[0])
         if m.kind == "acceleration":
-            d["initial_velocity"] = float(tf.f.b)
+            d["initial_velocity"] = float(m.initial[1])
     return _put(d, "dof", m.dof if m.joint.kind == "cylindrical" else None)
 
 

@@ -61,7 +61,9 @@ class Motion:
     """A driver imposing a joint coordinate as a function of time.
 
     `function` is an mbdsim.expressions.TimeFunction of t [s] giving the coordinate [rad or m];
-    `dof` is "rotation" or "translation" (which coordinate of the joint is driven).
+    `dof` is "rotation" or "translation" (which coordinate of the joint is driven). A velocity or
+    acceleration driver keeps the function as given in `given` and its initial values in `initial`;
+    `function` is then its integral (closed form when the expression has one).
     """
 
     name: str
@@ -69,6 +71,8 @@ class Motion:
     kind: str            # "displacement", "velocity" or "acceleration" (as given by the user)
     function: Any        # TimeFunction with value/d1/d2 of the driven displacement
     dof: str = "rotation"
+    given: Any = None    # velocity / acceleration kinds: the TimeFunction as given [unit/s or unit/s^2]
+    initial: tuple = (0.0, 0.0)   # and its initial displacement [m or rad] and velocity [m/s or rad/s]
 
     def __repr__(self) -> str:
         return f"Motion({self.name!r} on {self.joint.name}, {self.kind})"

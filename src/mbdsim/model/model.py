@@ -215,7 +215,7 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
                 if callable(f) and not hasattr(f, "d1"):
                     from ._check import check_time_callable
                     check_time_callable(entity, kind, f)
-                tf = time_function(f)
+                given = tf = time_function(f)
                 x0 = scalar(entity, "initial_displacement", initial_displacement)
                 v0 = scalar(entity, "initial_velocity", initial_velocity)
                 if kind == "velocity":
@@ -230,7 +230,7 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
         except ModelError:
             self._names.discard(name)
             raise
-        m = Motion(name, jt, kind, tf, dof)
+        m = Motion(name, jt, kind, tf, dof, None if kind == "displacement" else given, (x0, v0))
         self.motions[name] = m
         return m
 

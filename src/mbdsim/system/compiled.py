@@ -172,7 +172,9 @@ def _driver_programs(fns):
     for fn in fns:
         p = exprvm.time_programs(fn)
         if p is None:
-            raise NotCompiled(f"driver function {fn!r} is a Python callable")
+            why = "an integral without a closed form (sin(t**2), tables, ...)" if "integral of" in \
+                fn.description else "a Python callable"
+            raise NotCompiled(f"driver function {fn.description} is {why}")
         progs.extend(p)
     pk = exprvm.pack(progs)
     return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size)
