@@ -78,7 +78,7 @@ def test_articulated_body_accelerations_equal_the_augmented_solve():
     phi, J, nu, _ = constraint_terms(sys_, q, v, 0.0)
     assert np.abs(phi).max() < 1e-12 and np.abs(J @ v - nu).max() < 1e-12
     vd, lam = np.zeros(sys_.nv), np.zeros(sys_.nc)
-    assert fastdyn.accelerations(a, w, 0.0, q, v, vd, lam) == 0
+    assert fastdyn.accelerations(a, w, 0.0, q, v, y, vd, lam) == 0   # loads read the joint state y
     acc = tw[5]
     for k in range(sys_.nbody):
         f, ad = k + 1, sys_.frame_v_adr[k + 1]

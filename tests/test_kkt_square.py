@@ -49,7 +49,7 @@ def _check_same_solves(model, seed):
     for name, a in (("square", square), ("tree", tree)):
         w = Work.for_model(cm).arrays()
         vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
-        assert fastdyn.accelerations(a, w, 0.3, q, v, vd, lam, True) == fastdyn.OK
+        assert fastdyn.accelerations(a, w, 0.3, q, v, q, vd, lam, True) == fastdyn.OK
         assert (w[33][sys.nv] == 1) == (name == "square")       # which factorisation is in the work arrays
         qn = common.increment(sys, q, 1e-3 * np.random.default_rng(seed + 1).standard_normal(sys.nv))
         status, _, _ = fastdyn.newton_positions(a, w, 0.3, qn, v, 1e-13)

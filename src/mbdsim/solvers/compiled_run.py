@@ -134,10 +134,33 @@ class CompiledRun:
         SolverError naming the time if the equations of motion are singular at one of them."""
         sys = self.sys
         VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
-        done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM)
+        YJ = self.joint_states(times, Y)
+        done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y,
+                                  np.zeros((len(times), 0)) if YJ is None else YJ, VD, LAM)
         if done < len(times):
             raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[done]))
         return VD, LAM
+
+    def joint_states(self, times, Y):
+        """Tree path: the joint state [theta, theta_dot] of each output row Y[k] at times[k] with continuous
+        angles, each continued from the run's own state at the last accepted step before it when the run
+        kept its steps (checkpoints), else from the previous row (np.unwrap); None on the absolute path."""
+        if not self.joint_space:
+            return None
+        a, w = self.cm.arrays(), self.work.arrays()
+        Y = np.ascontiguousarray(Y, dtype=float)
+        YJ = np.zeros((len(Y), self.state_size))
+        cp = getattr(self, "checkpoints", None)
+        if cp is not None and len(cp[1]):
+            SY, ST = cp
+            k = np.clip(np.searchsorted(ST[:, 0], np.asarray(times, float), side="right") - 1, 0, len(ST) - 1)
+            fastdyn.joint_rows(a, w, Y, np.ascontiguousarray(SY[k]), YJ)
+        else:
+            fastdyn.joint_rows(a, w, Y, np.zeros((1, self.state_size)), YJ)
+            jtype, qadr = self.cm.tree[1], self.cm.tree[7]
+            ang = qadr[(qadr >= 0) & (jtype == 1)]
+            YJ[:, ang] = np.unwrap(YJ[:, ang], axis=0)
+        return YJ
 
     def states_at(self, times, Y, ts):
         """(q, v, vd, lambda_) at times ts: from the dense output of the run's own step containing each t
@@ -164,12 +187,15 @@ class CompiledRun:
         Ys, VD, LAM = np.zeros((len(ts), n)), np.zeros((len(ts), self.sys.nv)), np.zeros((len(ts), self.sys.nc))
         a, w = self.cm.arrays(), self.work.arrays()
         ns = len(self.state_of(Y[0]))
+        YJ0 = self.joint_states(times, Y)   # a tree's continuous joint states to restart from
         K, F, sc, f = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns)), np.zeros(ns)
         for j, t in enumerate(ts):
             k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
             tout = np.array([t]) if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)) else np.array([times[k], t])
             Yk, VDk, LAMk = np.zeros((len(tout), n)), np.zeros((len(tout), self.sys.nv)), np.zeros((len(tout), self.sys.nc))
-            status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), self.state_of(Y[k]), f, tout, Yk, VDk, LAMk,
+            y0 = self.state_of(Y[k]) if YJ0 is None else YJ0[k].copy()
+            YJk = np.zeros((len(tout), 0 if YJ0 is None else ns))
+            status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), y0, f, tout, Yk, YJk, VDk, LAMk,
                                      self.rtol, self.atol, self.max_step, self.max_steps, self.stats, K, F, sc)
             if m < len(tout):
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))

@@ -21,7 +21,7 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
 from . import fasttree
-from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, normalize_into, project,
+from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
                       read_state, rhs, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
@@ -73,22 +73,15 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
 
 
 @njit(cache=True, _nrt=False)
-def write_output(cm, wk, t, y, yout, vdout, lamout, refactor=True):
-    """Accelerations and multipliers at a consistent state y into the output rows; status.
-    refactor=False right after `project` at this y (its factorisation is reused)."""
-    nq = cm[31][0]
-    for i in range(y.shape[0]):
-        yout[i] = y[i]
-    return accelerations(cm, wk, t, y[:nq], y[nq:], vdout, lamout, refactor)
-
-
-@njit(cache=True, _nrt=False)
-def outputs_at(cm, wk, times, Y, VD, LAM):
+def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     """Accelerations VD and multipliers LAM at the output states Y (rows at `times`), computed after the
-    run and only when a result asks for them; returns the number of rows done (< len on failure)."""
+    run and only when a result asks for them; returns the number of rows done (< len on failure).
+    YJ: on the tree path the joint-coordinate state of each row (continuous angles: what joint loads
+    read), else empty (0 columns)."""
     nq = cm[31][0]
     for k in range(times.shape[0]):
-        if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], True) != OK:
+        y = YJ[k] if YJ.shape[1] else Y[k, :nq]
+        if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], y, VD[k], LAM[k], True) != OK:
             return k
     return times.shape[0]
 
@@ -425,11 +418,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
 
 
 @njit(cache=True, _nrt=False)
-def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps, stats, K, F, sc):
+def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_steps, stats, K, F, sc):
     """Short re-integration in one compiled call (Result.at): from the consistent state y at t0 over all
     of tout (tout[0] == t0 is written as is), then accelerations and multipliers at the outputs; returns
     (status, outputs written); st = [t0, (step)] as in `run`. Same stepping as `run`; no stiffness test,
-    no return to Python."""
+    no return to Python. YJ (len(tout), len(y)): scratch for a tree's joint states (0 columns otherwise)."""
     n = y.shape[0]
     t0 = st[0]
     status = rhs(cm, wk, t0, y, f)
@@ -443,7 +436,11 @@ def span(cm, wk, co, st, y, f, tout, Y, VD, LAM, rtol, atol, max_step, max_steps
     while status == OK and iout < tout.shape[0]:
         status, iout = run(cm, wk, co, st, y, f, tout[-1], tout, iout, Y, rtol, atol, max_step, max_steps,
                            tout.shape[0], 1e-12, stats, K, F, sc, False, Y[:0], Y[:0, :2], stats[:1], False)
-    done = outputs_at(cm, wk, tout[:iout], Y[:iout], VD[:iout], LAM[:iout])
+    if cm[31][5] == 1:   # the outputs' joint states, angles continued from the final state y (one step on)
+        for i in range(n):
+            sc[0, i] = y[i]
+        joint_rows(cm, wk, Y[:iout], sc[:1], YJ[:iout])
+    done = outputs_at(cm, wk, tout[:iout], Y[:iout], YJ[:iout], VD[:iout], LAM[:iout])
     if done < iout:
         return SINGULAR, done
     return status, iout
@@ -469,6 +466,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
         if s_ != OK:
             return s_
         write_state(cm, wk, yo, Y[k], Y[k, :0])
-        if accelerations(cm, wk, tq[k], Y[k, :nq], Y[k, nq:], VD[k], LAM[k], cm[31][5] == 1) != OK:
+        ys_ = yo if cm[31][5] == 1 else Y[k, :nq]   # a tree's joint state from the dense output
+        if accelerations(cm, wk, tq[k], Y[k, :nq], Y[k, nq:], ys_, VD[k], LAM[k], cm[31][5] == 1) != OK:
             return SINGULAR
     return OK

@@ -131,14 +131,16 @@ def rows_dropped(cm, wk):
 
 
 @njit(cache=True, _nrt=False)
-def accelerations(cm, wk, t, q, v, vd, lam, refactor=True):
+def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status.
-    refactor=False reuses the factorisation in wk, valid when it was made at these positions q (the
-    factorisation depends on q only), e.g. right after `project`."""
+    y: the state the loads read (`loads_into`): q itself on the absolute path, the joint-coordinate state
+    [theta, theta_dot] (continuous angles) on the tree path. refactor=False reuses the factorisation in
+    wk, valid when it was made at these positions q (the factorisation depends on q only), e.g. right
+    after `project`."""
     _constraints(cm, wk, t, q, v)
     F = wk[8]
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
-    loads_into(cm, wk, t, q, r, A, rd, w, F)
+    loads_into(cm, wk, t, y, r, A, rd, w, F)
     if refactor and not _factor(cm, wk):
         return SINGULAR
     x6 = wk[25]
@@ -206,7 +208,7 @@ def rhs(cm, wk, t, y, ydot, refactor=True):
     nq = cm[31][0]
     q = y[:nq]
     v = y[nq:]
-    st = accelerations(cm, wk, t, q, v, ydot[nq:], wk[26], refactor)
+    st = accelerations(cm, wk, t, q, v, q, ydot[nq:], wk[26], refactor)
     qdot_into(cm, q, v, ydot[:nq])
     return st
 
@@ -254,6 +256,23 @@ def read_state(cm, wk, yrow, y):
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     frames_into(yrow[:nq], yrow[nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
     fasttree.from_maximal(cm[42], y.shape[0] // 2, r, A, rd, w, y)
+
+
+@njit(cache=True, _nrt=False)
+def joint_rows(cm, wk, Y, Yref, YJ):
+    """Tree path: the joint state YJ[k] of each output row Y[k] (`read_state`), every angle continued to
+    within pi of the reference joint state Yref[k] (Yref[-1] past its rows; e.g. the run's own state at a
+    nearby step), so that
+    loads of joint angles see the run's continuous angles beyond +-pi."""
+    jtype, qadr = cm[42][1], cm[42][7]
+    for k in range(Y.shape[0]):
+        read_state(cm, wk, Y[k], YJ[k])
+        kr = min(k, Yref.shape[0] - 1)   # one reference row serves all rows
+        for c in range(qadr.shape[0]):
+            if qadr[c] >= 0 and jtype[c] == 1:
+                ref = Yref[kr, qadr[c]]
+                d = YJ[k, qadr[c]] - ref
+                YJ[k, qadr[c]] = ref + (d - 2.0 * np.pi * np.floor((d + np.pi) / (2.0 * np.pi)))
 
 
 @njit(cache=True, _nrt=False)

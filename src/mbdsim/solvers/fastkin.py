@@ -90,7 +90,7 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
         if status == OK and rows_dropped(cm, wk):
             stats[5] += 1
         if status == OK:
-            status = accelerations(cm, wk, t + h, q, v, vd, lam, False)
+            status = accelerations(cm, wk, t + h, q, v, q, vd, lam, False)
         if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):
             t += h
             stats[1] += 1
@@ -135,7 +135,7 @@ def _solved_at(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     before = stats[1]
     status = advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6)
     if status == OK and stats[1] == before:
-        status = accelerations(cm, wk, st[0], q, v, vd, lam, True)
+        status = accelerations(cm, wk, st[0], q, v, q, vd, lam, True)
         stats[4] += 1
     if status != OK:
         return status, False

@@ -59,7 +59,7 @@ class KinematicRun:
         q, v = np.array(y0[:nq], dtype=float), np.array(y0[nq:], dtype=float)
         vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
         st = np.array([float(t0), np.inf, 0.0])
-        status = fastdyn.accelerations(a, w, float(t0), q, v, vd, lam, True)
+        status = fastdyn.accelerations(a, w, float(t0), q, v, q, vd, lam, True)
         self.stats[4] += 1
         iout = 0
         if status == OK:
@@ -96,7 +96,7 @@ class KinematicRun:
         VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
         for k, t in enumerate(np.asarray(times, float)):
             y = np.array(Y[k], dtype=float)
-            if fastdyn.accelerations(a, w, float(t), y[:sys.nq], y[sys.nq:], VD[k], LAM[k], True) != OK:
+            if fastdyn.accelerations(a, w, float(t), y[:sys.nq], y[sys.nq:], y[:sys.nq], VD[k], LAM[k], True) != OK:
                 raise SolverError(_MESSAGES[fastdyn.SINGULAR] + " at an output time", time=float(t))
         return VD, LAM
 

@@ -47,10 +47,29 @@ def _why_not(sys, rows) -> str | None:
         return "joints other than revolute, translational and fixed"
     if len(model.joints) != len(sys.bodies):
         return "not a tree of joints (loops or free bodies)"
-    if sys.bodies and (min(b.mass for b in sys.bodies) <= 0 or
-                       np.linalg.eigvalsh(np.array([b.inertia for b in sys.bodies], float)).min() <= 0):
-        return "a body without positive mass and inertia"
+    if sys.bodies:
+        J = np.array([b.inertia for b in sys.bodies], float)
+        ev = np.linalg.eigvalsh(J)
+        if min(b.mass for b in sys.bodies) <= 0 or np.any(ev.min(axis=1) < -1e-12 * np.abs(ev).max(axis=1)):
+            return "a body without positive mass and positive semi-definite inertia"
     return None
+
+
+def _pivots_positive(sys, parent, jtype, axis, spt, c0, R0) -> bool:
+    """True when every revolute's child body has a positive moment of inertia about the joint axis
+    through the joint point (a lower bound of the articulated-body pivot D = S^T I^A S, which only grows
+    with the subtree): slender rods and bodies with zero axial inertia qualify; a particle-like body
+    turning about an axis through its own centre does not."""
+    for c in np.flatnonzero(jtype == 1):
+        b = sys.bodies[c - 1]
+        a = axis[c]
+        d = spt[c] - c0[c]
+        d_perp = d - (d @ a) * a
+        I_p = R0[c] @ np.asarray(b.inertia, float) @ R0[c].T
+        moment = a @ I_p @ a + b.mass * (d_perp @ d_perp)
+        if not moment > 1e-12 * max(np.trace(I_p) + b.mass * (d @ d), 1e-300):
+            return False
+    return True
 
 
 def tree_arrays(sys, rows, q, v) -> tuple[int, tuple]:
@@ -90,6 +109,8 @@ def tree_arrays(sys, rows, q, v) -> tuple[int, tuple]:
             c0[c] = Ap.T @ (fr.r[c] - fr.r[p])
             R0[c] = Ap.T @ fr.A[c]
     if len(order) != nf - 1 or not np.any(jtype[1:] > 0):   # (all welded: nothing to integrate)
+        return 0, empty_arrays(nf)
+    if not _pivots_positive(sys, parent, jtype, axis, spt, c0, R0):
         return 0, empty_arrays(nf)
     n = 0
     for c in order:

@@ -1,0 +1,109 @@
+"""Issue 29's cost ratios: an element of the model vocabulary against the compiled baseline that makes the
+same motion, measured in one process run (ratios count; absolute times on this machine move by 30 %).
+
+    python3 bench/vocabulary.py            # writes bench/VOCABULARY.md
+
+Each case: the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
+call (the Model is built once; the first call assembles and compiles it), the method each ran
+(res.stats["method"]) and the largest difference between the two runs' joint coordinates (the same motion,
+so the difference is the accuracy check of the cheaper formulation).
+"""
+from __future__ import annotations
+
+import statistics
+import sys
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
+import mbdsim as mb  # noqa: E402
+
+REPEAT = 7
+
+
+def carousel(**drive):
+    """Arm driven about z, pendulum hinged at its tip about the arm (1 free DOF), gravity -z."""
+    m = mb.Model("carousel", gravity=(0.0, 0.0, -9.81))
+    arm = m.add_body("arm", 2.0, inertia=(0.002, 0.02, 0.02), position=(0.15, 0, 0))
+    pend = m.add_body("pend", 1.2, inertia=(0.025, 0.025, 1e-3), position=(0.3, 0, -0.25))
+    hub = m.add_revolute("hub", m.ground, arm, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("tip", arm, pend, (0.3, 0, 0), (1, 0, 0))
+    m.add_motion("spin", hub, **drive)
+    return m
+
+
+def slider_crank(**drive):
+    """Zero-DOF slider-crank (r = 0.1 m, l = 0.35 m), crank driven."""
+    r, l_ = 0.1, 0.35
+    m = mb.Model("sc")
+    crank = m.add_body("crank", 1.0, inertia=(1e-4, 1e-3, 1e-3), position=(r / 2, 0, 0))
+    rod = m.add_body("rod", 1.0, inertia=(1e-4, 1e-2, 1e-2), position=(r + l_ / 2, 0, 0))
+    slider = m.add_body("slider", 0.5, inertia=(1e-3, 1e-3, 1e-3), position=(r + l_, 0, 0))
+    o = m.add_revolute("O", m.ground, crank, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("A", crank, rod, (r, 0, 0), (0, 0, 1))
+    m.add_spherical("B", rod, slider, (r + l_, 0, 0))
+    m.add_translational("slide", m.ground, slider, (r + l_, 0, 0), (1, 0, 0))
+    m.add_motion("drive", o, **drive)
+    return m
+
+
+def rod(axial):
+    """The README's rod (2 kg, 1 m) on a pin with a torsion spring, axial inertia `axial` [kg m^2]."""
+    m = mb.Model("rod", gravity=(0.0, -9.81, 0.0))
+    b = m.add_body("rod", 2.0, inertia=(axial, 2.0 / 12, 2.0 / 12), position=(0.5, 0, 0))
+    pin = m.add_revolute("pin", m.ground, b, (0, 0, 0), (0, 0, 1))
+    m.add_torsion_spring("spring", pin, stiffness=5.0)
+    return m
+
+
+def timed(fn):
+    fn()
+    ts = []
+    for _ in range(REPEAT):
+        t0 = time.perf_counter()
+        res = fn()
+        ts.append(time.perf_counter() - t0)
+    return statistics.median(ts), res
+
+
+CASES = [
+    ("velocity driver (carousel, 1 DOF free, 2 s)", lambda: carousel(velocity="18.85"),
+     lambda: carousel(displacement="18.85*t"), "simulate", ("hub", "tip")),
+    ("acceleration driver (carousel)", lambda: carousel(acceleration="8 - 3*t", initial_velocity=1.5),
+     lambda: carousel(displacement="1.5*t + 4*t**2 - t**3/2"), "simulate", ("hub", "tip")),
+    ("velocity driver, STEP ramp (carousel)", lambda: carousel(velocity="STEP(t, 0, 0, 0.5, 18.85)"),
+     lambda: carousel(displacement="18.85*(0.5*((abs(2*t) - abs(2*t - 1) + 1)/2)**3 - 0.25*((abs(2*t) - "
+                                   "abs(2*t - 1) + 1)/2)**4) + 18.85*(t - 0.5 + abs(t - 0.5))/2"),
+     "simulate", ("hub", "tip")),
+    ("velocity driver (slider-crank kinematics, 0 DOF)", lambda: slider_crank(velocity="18.85"),
+     lambda: slider_crank(displacement="18.85*t"), "kinematics", ("O", "slide")),
+    ("slender rod, axial inertia 0 (torsion spring)", lambda: rod(0.0), lambda: rod(1e-6), "simulate", ("pin",)),
+]
+
+
+def main():
+    warnings.simplefilter("ignore")
+    lines = ["# Model vocabulary against its compiled baseline (issue 29)", "",
+             "Written by `python3 bench/vocabulary.py`: median of %d calls after a warm-up, same process." % REPEAT,
+             "", "| case | element | baseline | ratio | element's method | max joint-coordinate difference |",
+             "|---|---|---|---|---|---|"]
+    for name, make, make_base, analysis, joints in CASES:
+        run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01)) if analysis == "simulate" else \
+            (lambda m: mb.kinematics(m, end_time=2.0, output_step=0.01))
+        m, mb_ = make(), make_base()
+        te, re = timed(lambda: run(m))
+        tb, rb = timed(lambda: run(mb_))
+        diff = max(float(np.max(np.abs(re.joint_coordinate(j) - rb.joint_coordinate(j)))) for j in joints)
+        lines.append(f"| {name} | {te * 1e3:.2f} ms | {tb * 1e3:.2f} ms | {te / tb:.2f}x | "
+                     f"{re.stats.get('method', '?')} | {diff:.1e} |")
+        print(lines[-1], flush=True)
+    out = Path(__file__).with_name("VOCABULARY.md")
+    out.write_text("\n".join(lines) + "\n")
+    print("wrote", out)
+
+
+if __name__ == "__main__":
+    main()
