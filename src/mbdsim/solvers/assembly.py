@@ -76,11 +76,19 @@ class AssemblyReport:
         if not self.moved:
             lines.append("  no body moved")
         for name, (dr, da) in self.moved.items():
-            lines.append(f"  moved {name}: {dr:.6g} m, {np.degrees(da):.6g} deg")
+            lines.append(f"  moved {name}: {_tiny(dr):.6g} m, {np.degrees(_tiny(da)):.6g} deg")
         for name, dv in self.velocity_changed.items():
-            lines.append(f"  velocity of {name} changed by {dv:.6g}")
+            lines.append(f"  velocity of {name} changed by {_tiny(dv):.6g}")
         lines += [f"  {e} {f}: given {_fmt(g)}, used {_fmt(u)}" for e, f, g, u in self.changed]
         return "\n".join(lines)
+
+
+REPORT_ZERO = 1e-12   # moves below this [m, rad, m/s or rad/s] are rounding, printed as 0
+
+
+def _tiny(x: float) -> float:
+    """x [m, rad or per s], or 0.0 when |x| < REPORT_ZERO (a rounding residue such as 3.9e-43 deg)."""
+    return 0.0 if abs(x) < REPORT_ZERO else float(x)
 
 
 def _fmt(x):
