@@ -7,6 +7,7 @@ import sys
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -37,6 +38,47 @@ def test_getting_started_examples_run(tmp_path, monkeypatch):
     x = ns["x"]
     assert x.max() - x.min() == pytest.approx(0.2, abs=1e-6)   # stroke = 2 x crank radius
     assert (tmp_path / "stroke.png").exists() and (tmp_path / "slider_crank.html").exists()
+    # the text says what the default method is, and what the minimum it prints is (issue 34)
+    assert ns["dyn"].stats["method"].startswith("auto") and '(`method="auto"` by default' in text
+    assert ns["angle"] == pytest.approx(-np.pi, abs=1e-3) and "lowest" not in text   # the far turning point
+
+
+def _readme_python_blocks():
+    return re.findall(r"```python\n(.*?)```", (ROOT / "README.md").read_text(), re.S)
+
+
+def test_readme_python_blocks_import_what_they_use():
+    for block in _readme_python_blocks():
+        if "mb." in block:
+            assert "import mbdsim as mb" in block, block[:80]
+        if "np." in block:
+            assert "import numpy as np" in block, block[:80]
+
+
+def test_readme_slider_crank_is_not_redundant_and_its_report_prints_no_rounding_residue():
+    """The README's redundancy text matches the behaviour: its initial-conditions slider-crank is not
+    redundant (no warning), and the assembly report prints moves below 1e-12 as 0."""
+    import mbdsim as mb
+    text = (ROOT / "README.md").read_text()
+    assert "reported once" not in text
+    block = next(b for b in _readme_python_blocks() if "slider_crank" in b and "add_translational" in b)
+    ns = {}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mb.RedundantConstraintWarning)
+        exec(compile(block.replace("print(", "str("), "README.md", "exec"), ns)   # noqa: S102 - our own docs
+    report = str(mb.assemble(ns["model"]))
+    assert re.search(r"moved slider: [0-9.]+ m, 0 deg", report), report
+    assert not re.search(r"e-\d\d deg", report), report
+
+
+def test_run_help_states_the_default_tolerance():
+    from typer.testing import CliRunner
+
+    from mbdsim.cli.app import app
+    from mbdsim.solvers.dynamic import DEFAULT_TOL
+    out = " ".join(CliRunner().invoke(app, ["run", "--help"]).output.replace("\u2502", " ").split())
+    rtol = f"{DEFAULT_TOL['auto'][0]:.0e}".replace("e-0", "e-")   # 1e-7
+    assert f"default {rtol} with --method auto" in out, out
 
 
 def _hooks():

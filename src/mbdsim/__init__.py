@@ -7,7 +7,8 @@ with the safe expression parser `parse`.
 """
 from importlib import import_module
 
-from .errors import AssemblyError, MbdsimError, ModelError, ModelFileError, SolverError
+from .errors import (AnalysisInterrupted, AssemblyError, EvaluationError, MbdsimError, ModelError, ModelFileError,
+                     SolverError)
 
 # Public names load their module on first use (PEP 562), so `import mbdsim` stays fast and the solvers,
 # scipy and numba load with the first analysis. One line per name: where it lives.
@@ -29,6 +30,9 @@ _LAZY = {
     "UnstableEquilibriumWarning": ".solvers.static", "linearize": ".solvers.linear",
     "Linearization": ".solvers.linear", "plot": ".plotting", "animate": ".viewer",
     "Study": ".studies", "load_study": ".studies", "plot_study": ".studies", "sensitivity": ".studies",
+    "OutputError": ".studies.measures", "InertiaWarning": ".model._check",
+    "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
+    "IndeterminateReactionWarning": ".system.determinacy",
 }
 
 
@@ -52,7 +56,10 @@ __all__ = [
     "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
-    "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "ExpressionError", "RedundantConstraintWarning",
+    "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",
+    "AnalysisInterrupted", "ExpressionError", "OutputError",
+    "RedundantConstraintWarning", "InitialConditionWarning", "SingularConfigurationWarning", "InertiaWarning",
+    "InitialPenetrationWarning", "MonitorWarning", "IndeterminateReactionWarning",
     "expressions", "functions", "parse",
     "plot", "animate",
     "Study", "load_study", "plot_study", "sensitivity",

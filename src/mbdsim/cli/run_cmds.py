@@ -113,7 +113,9 @@ def run_cmd(
     step: Optional[float] = typer.Option(None, "--step", "-s", metavar="DT", help="Output step in s (default: end/500)."),
     method: Optional[str] = typer.Option(None, "--method", "-m", metavar="M",
                                          help="auto (default), dop853, hht, rk45, radau or bdf."),
-    rtol: Optional[float] = typer.Option(None, "--rtol", metavar="R", help="Relative tolerance (default 1e-8)."),
+    rtol: Optional[float] = typer.Option(None, "--rtol", metavar="R",
+                                         help="Relative tolerance (default 1e-7 with --method auto, the "
+                                         "method's own otherwise)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
                                        help="Write the results table (res.to_dataframe()) to .parquet or .csv "
                                        "as the run goes (.parquet: a Parquet dataset streamed in parts)."),

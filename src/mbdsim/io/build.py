@@ -133,6 +133,8 @@ class Builder:
     # ------------------------------------------------------------------ items
     def build(self):
         s = self.spec
+        self.path = ("ground",)
+        self.add_markers(self.model.ground, s.ground.markers)
         for section, items, fn in (("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
                                    ("joints", s.joints, self.add_joint), ("motions", s.motions, self.add_motion),
                                    ("forces", s.forces, self.add_element),
@@ -178,9 +180,21 @@ class Builder:
         entity = f"joint '{j.name}'"
         if j.type == "point_on_curve":
             return self.add_point_on_curve(entity, j)
-        bi, bj = self.body(entity, "body_i", j.body_i), self.body(entity, "body_j", j.body_j)
+        # a body, or "body.marker" on both sides for a joint between two markers (as the API takes them)
+        bi, bj = self.frame(entity, "body_i", j.body_i), self.frame(entity, "body_j", j.body_j)
         args = [getattr(j, f) for f in JOINT_FIELDS[j.type]]
-        getattr(self.model, JOINT_METHODS[j.type])(j.name, bi, bj, *args)
+        initial = {f: self.joint_values(entity, f, j.type, getattr(j, f), per)
+                   for f, per in (("initial_displacement", ""), ("initial_velocity", "/s"))
+                   if getattr(j, f, None) is not None}
+        getattr(self.model, JOINT_METHODS[j.type])(j.name, bi, bj, *args, **initial)
+
+    def joint_values(self, entity, field, kind, value, per):
+        """Joint coordinates [rad or m, per `per`] from a number or a list (each may carry units); a
+        wrong count is left to the API's message."""
+        units = JOINT_KINDS[kind].units or ("",)
+        if not isinstance(value, list):
+            return self.si(entity, field, value, units[0] + per)
+        return [self.si(entity, field, v, units[min(k, len(units) - 1)] + per) for k, v in enumerate(value)]
 
     def add_constraint(self, c):
         """Coupler, gear or user constraint (issue 11)."""

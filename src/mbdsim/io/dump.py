@@ -47,6 +47,13 @@ def _inertia(J):
     return _vec(np.diag(J)) if np.array_equal(J, np.diag(np.diag(J))) else [_vec(row) for row in J]
 
 
+def _dof(joint, dof, loads=False):
+    """`dof` ("rotation"/"translation") when the joint's kind has another default, else None (left out)."""
+    from ..model.joint_kinds import axis_dofs
+    allowed = axis_dofs(joint.kind, loads)
+    return dof if len(allowed) > 1 and dof != allowed[0] else None
+
+
 def _put(d: dict, key, value, default=None):
     if value is not None and value != default:
         d[key] = value
@@ -94,7 +101,32 @@ def _body(b) -> dict:
     return _put(d, "markers", _markers(b), [])
 
 
+def _joint_values(j, field):
+    """A joint's initial_displacement / initial_velocity as given (a number for one coordinate), else None."""
+    v = getattr(j, field)
+    if v is None:
+        return None
+    return float(v[0]) if j.ncoord == 1 else _vec(v)
+
+
 def _joint(j) -> dict:
+    d = _marker_joint(j) if j.marker_i is not None else _body_joint(j)
+    _put(d, "initial_displacement", _joint_values(j, "initial_displacement"))
+    return _put(d, "initial_velocity", _joint_values(j, "initial_velocity"))
+
+
+def _marker_joint(j) -> dict:
+    """A joint between two markers: "body.marker" as body_i and body_j, no point or axes (as the API)."""
+    refs = []
+    for field, m in (("body_i", j.marker_i), ("body_j", j.marker_j)):
+        if m.body.markers.get(m.name) is not m:
+            raise ModelError(f"joint '{j.name}'", field, "a marker not added to its body (Body.add_marker) "
+                             "cannot be stored in a model file")
+        refs.append(f"{m.body.name}.{m.name}")
+    return _put({"name": j.name, "type": j.kind, "body_i": refs[0], "body_j": refs[1]}, "lead", j.lead)
+
+
+def _body_joint(j) -> dict:
     d = {"name": j.name, "type": j.kind, "body_i": j.body_i.name, "body_j": j.body_j.name, "point": _vec(j.point)}
     if j.kind in ("orientation", "parallel_axes", "perpendicular"):   # primitives without a point
         del d["point"]
@@ -152,7 +184,7 @@ def _motion(m) -> dict:
         d["initial_displacement"] = float(m.initial[0])
         if m.kind == "acceleration":
             d["initial_velocity"] = float(m.initial[1])
-    return _put(d, "dof", m.dof if m.joint.kind == "cylindrical" else None)
+    return _put(d, "dof", _dof(m.joint, m.dof))
 
 
 def _constant(entity, field, value):
@@ -207,7 +239,7 @@ def _element(e) -> dict:
     if isinstance(e, JointForce):
         d = {**head, "type": "joint_force", "joint": e.joint.name,
              "value": _constant(f"joint force '{e.name}'", "value", e.value)}
-        return _put(d, "dof", e.dof if e.joint.kind == "cylindrical" else None)
+        return _put(d, "dof", _dof(e.joint, e.dof, loads=True))
     if isinstance(e, SpringDamper):
         return {**head, "type": "spring_damper", "at_i": _marker_ref(e.marker_i), "at_j": _marker_ref(e.marker_j),
                 "stiffness": e.stiffness, "damping": e.damping, "free_length": e.free_length, "preload": e.preload}
@@ -226,7 +258,7 @@ def _element(e) -> dict:
         _put(d, "lower", e.lower)
         _put(d, "upper", e.upper)
         d.update(stiffness=e.stiffness, exponent=e.exponent, damping=e.damping, penetration=e.penetration)
-        return _put(d, "dof", e.dof if e.joint.kind == "cylindrical" else None)
+        return _put(d, "dof", _dof(e.joint, e.dof, loads=True))
     if isinstance(e, JointFriction):
         d = {**head, "type": "friction", "joint": e.joint.name, "mu_static": e.mu_static, "mu_dynamic": e.mu_dynamic,
              "preload": e.preload}
@@ -239,8 +271,10 @@ def _element(e) -> dict:
 def model_to_dict(model) -> dict:
     """Plain data (SI numbers, expression strings) describing `model` in the model-file schema."""
     bodies = [b for b in model.bodies.values() if not b.is_ground]
-    d = {"name": model.name, "gravity": _vec(model.gravity),
-         "bodies": [_body(b) for b in bodies if not b.is_particle],
+    d = {"name": model.name, "gravity": _vec(model.gravity)}
+    if model.ground.markers:
+        d["ground"] = {"markers": _markers(model.ground)}
+    d |= {"bodies": [_body(b) for b in bodies if not b.is_particle],
          "particles": [_body(b) for b in bodies if b.is_particle],
          "joints": [_joint(j) for j in model.joints.values()]
          + [_path(p) for p in getattr(model, "path_constraints", {}).values()],
@@ -259,8 +293,8 @@ def _constraint(c) -> dict:
         return {"type": "user_constraint", "name": c.name, "expression": c.text}
     (j1, d1), (j2, d2) = c.terms
     d = {"type": c.kind, "name": c.name, "joint_1": j1.name, "joint_2": j2.name, "ratio": c.ratio}
-    _put(d, "dof_1", d1 if j1.kind == "cylindrical" else None)
-    return _put(d, "dof_2", d2 if j2.kind == "cylindrical" else None)
+    _put(d, "dof_1", _dof(j1, d1))
+    return _put(d, "dof_2", _dof(j2, d2))
 
 
 def _sensor(s) -> dict:

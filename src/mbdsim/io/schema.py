@@ -126,6 +126,12 @@ class BodySpec(Spec):
     markers: list[MarkerSpec] = []
 
 
+class GroundSpec(Spec):
+    """The ground body, fixed: only its markers (`model.ground.add_marker` in the API), named "ground.<name>"."""
+
+    markers: list[MarkerSpec] = []
+
+
 class ParticleSpec(Spec):
     name: Name
     mass: Mass
@@ -135,38 +141,65 @@ class ParticleSpec(Spec):
 
 
 # ----------------------------------------------------------------------------- joints
-class _Pair(Spec):
+class JointPair(Spec):
+    """A joint between two bodies (names; point and axes in ground at t = 0) or between two markers
+    ("body.marker" as body_i and body_j: the joint's I and J frames, then point and axes are omitted)."""
+
     name: Name
     body_i: Name
     body_j: Name
 
 
-class AxisJointSpec(_Pair):
-    type: Literal["revolute", "translational", "cylindrical", "inline"]
-    point: V("m")
-    axis: V("")
+# a joint coordinate's start value or rate: a number for a one-coordinate joint, else a list in the order of
+# Result.joint_coordinate; units [rad or m (per s)] by coordinate, converted by mbdsim.io.build
+JointValues = Optional[Union[Raw, Annotated[list[Raw], Field(min_length=1, max_length=3)]]]
 
 
-class SphericalSpec(_Pair):
-    type: Literal["spherical", "atpoint"]
-    point: V("m")
+class Initial(Spec):
+    """initial_displacement [rad or m, from as drawn] and initial_velocity [rad/s or m/s] of the joint
+    coordinates, held at assembly (as the joint methods of the API)."""
+
+    initial_displacement: JointValues = None
+    initial_velocity: JointValues = None
 
 
-class UniversalSpec(_Pair):
+class AxisJointSpec(JointPair, Initial):
+    type: Literal["revolute", "translational", "cylindrical"]
+    point: Optional[V("m")] = None
+    axis: Optional[V("")] = None
+
+
+class InlineSpec(JointPair):
+    type: Literal["inline"]
+    point: Optional[V("m")] = None
+    axis: Optional[V("")] = None
+
+
+class SphericalSpec(JointPair, Initial):
+    type: Literal["spherical"]
+    point: Optional[V("m")] = None
+
+
+class AtPointSpec(JointPair):
+    type: Literal["atpoint"]
+    point: Optional[V("m")] = None
+
+
+class UniversalSpec(JointPair, Initial):
     type: Literal["universal"]
-    point: V("m")
-    axis_i: V("")
-    axis_j: V("")
+    point: Optional[V("m")] = None
+    axis_i: Optional[V("")] = None
+    axis_j: Optional[V("")] = None
 
 
-class PlanarSpec(_Pair):
+class PlanarSpec(JointPair, Initial):
     type: Literal["planar"]
-    point: V("m")
-    normal: V("")
+    point: Optional[V("m")] = None
+    normal: Optional[V("")] = None
     u_axis: Optional[V("")] = None
 
 
-class FixedSpec(_Pair):
+class FixedSpec(JointPair):
     type: Literal["fixed"]
     point: Optional[V("m")] = None
 
@@ -205,7 +238,8 @@ class PointOnCurveSpec(Spec):
 
 from .schema_extra import EXTRA_JOINTS, ConstraintSpec, JointForceSpec, LineForceSpec, SensorSpec  # noqa: E402
 
-JointSpec = Annotated[Union[(AxisJointSpec, SphericalSpec, UniversalSpec, PlanarSpec, FixedSpec, PointOnCurveSpec,
+JointSpec = Annotated[Union[(AxisJointSpec, InlineSpec, SphericalSpec, AtPointSpec, UniversalSpec, PlanarSpec,
+                             FixedSpec, PointOnCurveSpec,
                              *EXTRA_JOINTS)], Field(discriminator="type")]
 
 
@@ -357,6 +391,7 @@ class ModelSpec(Spec):
     name: str = "model"
     gravity: V("m/s**2") = [0.0, 0.0, 0.0]
     planar: Union[bool, V("")] = False     # True: a 2D mechanism in the xy plane (or its plane normal)
+    ground: GroundSpec = GroundSpec()
     bodies: list[BodySpec] = []
     particles: list[ParticleSpec] = []
     joints: list[JointSpec] = []

@@ -6,50 +6,45 @@ from typing import Annotated, Literal, Optional, Union
 
 from pydantic import Field
 
-from .schema import Location, Name, Number, Q, Raw, Spec, V   # imported by schema.py once these exist
+# imported by schema.py once these exist
+from .schema import Initial, JointPair, Location, Name, Number, Q, Raw, Spec, V
 
 
-class _Pair(Spec):
-    name: Name
-    body_i: Name
-    body_j: Name
-
-
-class InplaneSpec(_Pair):
+class InplaneSpec(JointPair):
     type: Literal["inplane"]
-    point: V("m")
-    normal: V("")
+    point: Optional[V("m")] = None
+    normal: Optional[V("")] = None
 
 
-class OrientationSpec(_Pair):
+class OrientationSpec(JointPair):
     type: Literal["orientation"]
 
 
-class ParallelAxesSpec(_Pair):
+class ParallelAxesSpec(JointPair):
     type: Literal["parallel_axes"]
-    axis: V("")
+    axis: Optional[V("")] = None
 
 
-class PerpendicularSpec(_Pair):
+class PerpendicularSpec(JointPair):
     type: Literal["perpendicular"]
-    axis_i: V("")
-    axis_j: V("")
+    axis_i: Optional[V("")] = None
+    axis_j: Optional[V("")] = None
 
 
-class ScrewSpec(_Pair):
-    """Screw joint: lead [m per revolution], positive right-handed."""
+class ScrewSpec(JointPair, Initial):
+    """Screw joint: lead [m per revolution], positive right-handed; its coordinate is the angle [rad]."""
 
     type: Literal["screw"]
-    point: V("m")
-    axis: V("")
+    point: Optional[V("m")] = None
+    axis: Optional[V("")] = None
     lead: Q("m")
 
 
-class ConstantVelocitySpec(_Pair):
+class ConstantVelocitySpec(JointPair):
     type: Literal["constant_velocity"]
-    point: V("m")
-    axis_i: V("")
-    axis_j: V("")
+    point: Optional[V("m")] = None
+    axis_i: Optional[V("")] = None
+    axis_j: Optional[V("")] = None
 
 
 EXTRA_JOINTS = (InplaneSpec, OrientationSpec, ParallelAxesSpec, PerpendicularSpec, ScrewSpec, ConstantVelocitySpec)

@@ -108,8 +108,8 @@ def inertia_matrix(entity: str, value, strict: bool = True) -> np.ndarray:
                          "violate the triangle inequality (I1 + I2 >= I3): no mass distribution has them")
         if strict:
             raise err
-        import warnings
-        warnings.warn(str(err), InertiaWarning, stacklevel=4)
+        from .._userwarn import warn
+        warn(str(err), InertiaWarning)
     return J
 
 

@@ -28,7 +28,8 @@ class JointKind:
     (what a particle as body_j feels); planar_dof: in-plane freedoms left in a planar model (None: it
     depends on the placement); fields: the model-file fields besides name/body_i/body_j, in the order
     of the Model method `add_<name>`; coupled: the axis freedoms a coupler may tie (None: axis_dofs; a
-    screw's slide follows its angle, so only the angle is coupled)."""
+    screw's slide follows its angle, so only the angle is coupled); coord_units: the unit of each joint
+    coordinate where they differ (else `units` derives them from angle / slide)."""
 
     name: str
     dof: int
@@ -42,6 +43,14 @@ class JointKind:
     planar_dof: int | None = None
     coupled: tuple | None = None
     slide: bool = False
+    coord_units: tuple = ()
+
+    @property
+    def units(self) -> tuple:
+        """The SI unit of each joint coordinate ("rad" or "m"), in the order of Result.joint_coordinate."""
+        if self.coord_units:
+            return self.coord_units
+        return ("m",) * self.ncoord if self.slide and not self.angle else ("rad",) * self.ncoord
 
     @property
     def method(self) -> str:
@@ -54,10 +63,11 @@ JOINT_KINDS: dict[str, JointKind] = {k.name: k for k in (
     JointKind("revolute", 1, 1, 3, ("point", "axis"), "angle [rad]", (ROT,), True, True, 1),
     JointKind("translational", 1, 1, 2, ("point", "axis"), "slide [m]", (TRA,), True, False, 1, slide=True),
     JointKind("cylindrical", 2, 2, 2, ("point", "axis"), "(angle [rad], slide [m])", (ROT, TRA), True, True,
-              slide=True),
+              slide=True, coord_units=("rad", "m")),
     JointKind("spherical", 3, 3, 3, ("point",), _ROTVEC, planar_dof=1),
     JointKind("universal", 2, 3, 3, ("point", "axis_i", "axis_j"), _ROTVEC),
-    JointKind("planar", 3, 3, 1, ("point", "normal", "u_axis"), "(u [m], v [m], angle [rad])", planar_dof=3),
+    JointKind("planar", 3, 3, 1, ("point", "normal", "u_axis"), "(u [m], v [m], angle [rad])", planar_dof=3,
+              coord_units=("m", "m", "rad")),
     JointKind("fixed", 0, 0, 3, ("point",), planar_dof=0),
     # joint primitives (Adams JPRIM): no joint coordinates
     JointKind("inline", 4, 0, 2, ("point", "axis")),

@@ -21,7 +21,7 @@ the value; `Result.diagnostics` keeps the history.
 """
 from __future__ import annotations
 
-import warnings
+from .._userwarn import warn
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -219,8 +219,8 @@ def _exceed(diag, t, quantity, element, value, tol):
     if any(x["quantity"] == quantity and x["element"] == element for x in diag.exceedances):
         return
     diag.exceedances.append({"time": t, "quantity": quantity, "element": element, "value": value, "tolerance": tol})
-    warnings.warn(f"{element}: {quantity.replace('_', ' ')} {value:.3g} exceeds the tolerance {tol:.3g} first at "
-                  f"t = {t:.9g} s", MonitorWarning, stacklevel=4)
+    warn(f"{element}: {quantity.replace('_', ' ')} {value:.3g} exceeds the tolerance {tol:.3g} first at "
+         f"t = {t:.9g} s", MonitorWarning)
 
 
 def monitor(res, diag: Diagnostics | None = None, first: bool = True) -> Diagnostics:

@@ -271,7 +271,7 @@ class Result:
         return cache[key].copy()
 
     def _flagged(self, joint, on, frame, which):
-        import warnings
+        from .._userwarn import warn
         from ..system.determinacy import IndeterminateReactionWarning, ReactionArray
         value = self._reaction(joint, on, frame)[which]
         ind = self.reaction_determinacy(joint, on, frame)[:, 3 * which:3 * which + 3]
@@ -279,9 +279,9 @@ class Result:
         if ind.any():
             name = getattr(joint, "name", joint)
             comps = [("F" if which == 0 else "T") + "xyz"[k] for k in range(3) if ind[:, k].any()]
-            warnings.warn(f"joint '{name}': reaction components {', '.join(comps)} are indeterminate (redundant "
-                          "constraints): the values are the minimum-norm split, not determined by the rigid model",
-                          IndeterminateReactionWarning, stacklevel=3)
+            warn(f"joint '{name}': reaction components {', '.join(comps)} are indeterminate (redundant "
+                 "constraints): the values are the minimum-norm split, not determined by the rigid model",
+                 IndeterminateReactionWarning)
         return out
 
     def _reaction(self, joint, on, frame):

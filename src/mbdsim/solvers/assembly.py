@@ -8,6 +8,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._userwarn import warn
 from .._blas import blas_single_thread
 from ..errors import AssemblyError
 from ..system.assemble import System, assemble_system
@@ -75,11 +76,19 @@ class AssemblyReport:
         if not self.moved:
             lines.append("  no body moved")
         for name, (dr, da) in self.moved.items():
-            lines.append(f"  moved {name}: {dr:.6g} m, {np.degrees(da):.6g} deg")
+            lines.append(f"  moved {name}: {_tiny(dr):.6g} m, {np.degrees(_tiny(da)):.6g} deg")
         for name, dv in self.velocity_changed.items():
-            lines.append(f"  velocity of {name} changed by {dv:.6g}")
+            lines.append(f"  velocity of {name} changed by {_tiny(dv):.6g}")
         lines += [f"  {e} {f}: given {_fmt(g)}, used {_fmt(u)}" for e, f, g, u in self.changed]
         return "\n".join(lines)
+
+
+REPORT_ZERO = 1e-12   # moves below this [m, rad, m/s or rad/s] are rounding, printed as 0
+
+
+def _tiny(x: float) -> float:
+    """x [m, rad or per s], or 0.0 when |x| < REPORT_ZERO (a rounding residue such as 3.9e-43 deg)."""
+    return 0.0 if abs(x) < REPORT_ZERO else float(x)
 
 
 def _fmt(x):
@@ -121,7 +130,7 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         kept = sys.derived["assembly"] = (key, report, [(w.message, w.category) for w in caught])
     _, report, issued = kept
     for message, category in issued:
-        warnings.warn(message, category, stacklevel=3)
+        warn(message, category)
     return dataclasses.replace(report, system=sys, q=report.q.copy(), v=report.v.copy())
 
 
@@ -145,10 +154,10 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         from .planar import planar_redundancy
         redundant, planar_note = planar_redundancy(sys, q, J, rows)
     if redundant:
-        warnings.warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
-                      f"joints involved: {', '.join(redundant)}. The dynamics use an independent subset; "
-                      "indeterminate reaction components are returned as the minimum-norm solution.",
-                      RedundantConstraintWarning, stacklevel=3)
+        warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
+             f"joints involved: {', '.join(redundant)}. The dynamics use an independent subset; "
+             "indeterminate reaction components are returned as the minimum-norm solution.",
+             RedundantConstraintWarning)
     if v0 is sys.v0:
         v, vchanged = velocities(sys, q, t, rows, terms)
         changed += vchanged
@@ -157,9 +166,9 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         v = project_velocities(sys, q, v0, t, rows)
         vmoved = _vchanged(sys, v0, v)
     if changed:
-        warnings.warn("initial values not consistent with the joints and drivers were changed (kinetic-"
-                      "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)}"
-                                                  for e, f, g, u in changed), InitialConditionWarning, stacklevel=3)
+        warn("initial values not consistent with the joints and drivers were changed (kinetic-"
+             "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)}"
+                                         for e, f, g, u in changed), InitialConditionWarning)
     phi = terms[0][rows_all]
     notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
     notes += [planar_note] if planar_note else []

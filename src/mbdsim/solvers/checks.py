@@ -11,9 +11,9 @@ At the assembled state, for every sphere-plane / sphere-sphere contact with dept
 """
 from __future__ import annotations
 
-import warnings
 
 
+from .._userwarn import warn
 from ..errors import ModelError
 
 INITIAL_PENETRATION_FACTOR = 10.0
@@ -45,6 +45,6 @@ def check_initial_contacts(sys, q, v) -> None:
                              f"the sphere radius {radius:.6g} m: move the bodies apart")
         if depth > INITIAL_PENETRATION_FACTOR * el.penetration:
             energy = el.stiffness * depth ** (el.exponent + 1) / (el.exponent + 1)
-            warnings.warn(f"{entity}.initial_gap: the shapes start {depth:.6g} m inside each other (more than "
-                          f"{INITIAL_PENETRATION_FACTOR:g} x its penetration {el.penetration:g} m), storing "
-                          f"{energy:.6g} J of contact energy at t = 0", InitialPenetrationWarning, stacklevel=3)
+            warn(f"{entity}.initial_gap: the shapes start {depth:.6g} m inside each other (more than "
+                 f"{INITIAL_PENETRATION_FACTOR:g} x its penetration {el.penetration:g} m), storing "
+                 f"{energy:.6g} J of contact energy at t = 0", InitialPenetrationWarning)

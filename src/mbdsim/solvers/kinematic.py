@@ -5,10 +5,10 @@ reactions from the equations of motion phi_q^T lambda_ = Q - M vd (minimum norm 
 """
 from __future__ import annotations
 
-import warnings
 
 import numpy as np
 
+from .._userwarn import warn
 from .._blas import blas_single_thread
 from ..errors import AssemblyError, ModelError
 from ..results.result import Result
@@ -174,11 +174,10 @@ def _warn_singular(records):
             passages.append([r])
     for g in passages:
         worst = min(g, key=lambda r: r["conditioning"])
-        warnings.warn(f"singular configuration (dead centre, toggle or bifurcation) at t = {worst['time']:.9g} s: "
-                      f"the constraint Jacobian with drivers is nearly rank deficient (conditioning "
-                      f"{worst['conditioning']:.3g}); joints involved: {', '.join(worst['joints'])}. The analysis "
-                      "keeps the branch by continuity; see res.stats['singular']", SingularConfigurationWarning,
-                      stacklevel=3)
+        warn(f"singular configuration (dead centre, toggle or bifurcation) at t = {worst['time']:.9g} s: "
+             f"the constraint Jacobian with drivers is nearly rank deficient (conditioning "
+             f"{worst['conditioning']:.3g}); joints involved: {', '.join(worst['joints'])}. The analysis "
+             "keeps the branch by continuity; see res.stats['singular']", SingularConfigurationWarning)
 
 
 def check_model(model):

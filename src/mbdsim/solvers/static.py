@@ -23,11 +23,11 @@ equilibrium (the pendulum exactly upright) is returned as it is, flagged unstabl
 """
 from __future__ import annotations
 
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from .._userwarn import warn
 from .._blas import blas_single_thread
 from ..errors import SolverError
 from ..results.result import Result
@@ -279,10 +279,10 @@ def _summary(sol) -> str:
 def _warn_unstable(sols):
     bad = [s for s in sols if s.unstable]
     if bad:
-        warnings.warn(f"unstable static equilibrium at t = {bad[0].t:.9g} s"
-                      f"{f' (and {len(bad) - 1} more times)' if len(bad) > 1 else ''}: negative stiffness along "
-                      + " | ".join(bad[0].unstable) + ". Start from a perturbed configuration to reach a stable one.",
-                      UnstableEquilibriumWarning, stacklevel=3)
+        warn(f"unstable static equilibrium at t = {bad[0].t:.9g} s"
+             f"{f' (and {len(bad) - 1} more times)' if len(bad) > 1 else ''}: negative stiffness along "
+             + " | ".join(bad[0].unstable) + ". Start from a perturbed configuration to reach a stable one.",
+             UnstableEquilibriumWarning)
 
 
 def _arrays(sys, sols):

@@ -15,7 +15,7 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
-import warnings
+from .._userwarn import warn
 
 import numpy as np
 
@@ -252,10 +252,10 @@ def _warn_particle_offset(jt, g):
         return
     for particle, s in ((jt.body_i, g.s_i), (jt.body_j, g.s_j)):
         if particle.is_particle and np.linalg.norm(s) > 1e-9:
-            warnings.warn(f"joint '{jt.name}': its point is {np.linalg.norm(s):.6g} m from particle "
-                          f"'{particle.name}', which has no rotation, so the particle is held at a fixed "
-                          "offset from the joint point (it cannot swing about it); use a rigid body (e.g. a "
-                          "massless link) to make a pendulum", UserWarning, stacklevel=4)
+            warn(f"joint '{jt.name}': its point is {np.linalg.norm(s):.6g} m from particle "
+                 f"'{particle.name}', which has no rotation, so the particle is held at a fixed "
+                 "offset from the joint point (it cannot swing about it); use a rigid body (e.g. a "
+                 "massless link) to make a pendulum", UserWarning)
 
 
 def _placed(rows, g):
