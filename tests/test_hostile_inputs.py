@@ -1,0 +1,76 @@
+"""Issue 35, never corrupt or lose data, never hang: resuming a checkpoint of another model, overwriting
+files mbdsim did not write, outputs further apart than the write interval, a raising progress callback,
+and model files that are not regular files or are too large. (Unit strings with unbounded powers and
+runs asking for unbounded work are in the bad-input catalogue, tests/bad_inputs.)"""
+import os
+import subprocess
+import sys
+import threading
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+import mbdsim as mb
+from mbdsim.cli.app import app
+from mbdsim.errors import EvaluationError, ModelError, ModelFileError
+from mbdsim.results import stream as results_stream
+
+SRC = str(Path(mb.__file__).resolve().parents[1])
+
+
+def oscillator(k=100.0, mass=1.0):
+    m = mb.Model("osc", gravity=(0.0, 0.0, 0.0))
+    b = m.add_body("b", mass, inertia=(0.01, 0.01, 0.01), position=(1.0, 0.0, 0.0))
+    m.add_translational("s", m.ground, b, (0, 0, 0), (1, 0, 0))
+    m.add_spring_damper("k", (b, (0, 0, 0)), (m.ground, (0, 0, 0)), stiffness=k, free_length=0.5)
+    return m
+
+
+# ----------------------------------------------------------------------------- 1. resume of another model
+def test_resume_refuses_a_checkpoint_of_another_model(tmp_path):
+    out = tmp_path / "run.parquet"
+    assert mb.simulate(oscillator(100.0), 0.5, 0.01, out=out).success
+    with pytest.raises(ModelError) as err:   # same names, sizes, initial state and settings: other stiffness
+        mb.simulate(oscillator(400.0), 0.5, 0.01, out=out, resume=True)
+    assert (err.value.entity, err.value.field) == ("simulate", "resume")
+    assert "another model" in str(err.value) and "'k'" in str(err.value) and "body" not in str(err.value)
+    with pytest.raises(ModelError, match="body 'b'"):
+        mb.simulate(oscillator(100.0, mass=2.0), 0.5, 0.01, out=out, resume=True)
+    res = mb.simulate(oscillator(100.0), 0.5, 0.01, out=out, resume=True)   # the same model resumes
+    assert res.success
+
+
+MODEL = """
+import mbdsim as mb
+
+def push(t, state):
+    return (0.1 * t, 0.0, 0.0)
+
+def model(gain):
+    m = mb.Model("osc", gravity=(0.0, 0.0, 0.0))
+    b = m.add_body("b", 1.0, inertia=(0.01, 0.01, 0.01), position=(1.0, 0.0, 0.0))
+    m.add_translational("s", m.ground, b, (0, 0, 0), (1, 0, 0))
+    m.add_force("f", (b, (0, 0, 0)), lambda t, s: (gain * t, 0.0, 0.0))
+    m.add_force("g", (b, (0, 0, 0)), push)
+    return m
+"""
+
+
+def test_model_digests_are_portable_and_see_python_functions(tmp_path):
+    (tmp_path / "osc_model.py").write_text(MODEL)
+    code = ("import sys, json; sys.path[:0] = [{src!r}, {here!r}]; import osc_model; "
+            "from mbdsim.system.fingerprint import model_digests; "
+            "print(json.dumps(model_digests(osc_model.model({gain}))))")
+
+    def digests(gain):
+        out = subprocess.run([sys.executable, "-c", code.format(src=SRC, here=str(tmp_path), gain=gain)],
+                             capture_output=True, text=True, timeout=300, check=True).stdout
+        import json
+        return json.loads(out)
+    a, b, c = digests(1.0), digests(1.0), digests(2.0)
+    assert a == b   # two processes, the same model: the same digests (functions by value, not identity)
+    assert [k for k in a if a[k] != c[k]] == ["force 'f'"]   # a closure value changed: that force only
