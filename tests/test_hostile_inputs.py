@@ -74,3 +74,37 @@ def test_model_digests_are_portable_and_see_python_functions(tmp_path):
     a, b, c = digests(1.0), digests(1.0), digests(2.0)
     assert a == b   # two processes, the same model: the same digests (functions by value, not identity)
     assert [k for k in a if a[k] != c[k]] == ["force 'f'"]   # a closure value changed: that force only
+
+
+# ----------------------------------------------------------------------------- 2. foreign files at out=
+@pytest.mark.parametrize("name", ["foreign.parquet", "foreign.csv"])
+def test_out_refuses_a_file_mbdsim_did_not_write(tmp_path, name):
+    path = tmp_path / name
+    df = pd.DataFrame({"a": [1.0, 2.0], "b": [3.0, 4.0]})
+    df.to_parquet(path) if name.endswith(".parquet") else df.to_csv(path, index=False)
+    before = path.read_bytes()
+    for method in (None, "hht"):   # the streamed writer and the whole-file writer
+        with pytest.raises(ModelError) as err:
+            mb.simulate(oscillator(), 0.2, 0.01, method=method, out=path)
+        assert err.value.field == "out" and "not written by mbdsim" in str(err.value)
+        assert path.read_bytes() == before
+
+
+def test_out_replaces_files_mbdsim_wrote(tmp_path):
+    m = oscillator()
+    for name in ("r.csv", "r.parquet"):
+        path = tmp_path / name
+        for _ in range(2):   # written, then replaced by the whole-file writer
+            res = mb.simulate(m, 0.2, 0.01, method="hht", out=path)
+            assert res.success
+        df = pd.read_csv(path) if name.endswith(".csv") else pd.read_parquet(path)
+        assert len(df) == 21 and list(df.columns) == list(res.to_dataframe().columns)
+    res = mb.simulate(m, 0.2, 0.01, out=tmp_path / "r.parquet")   # the streamed writer replaces it too
+    assert res.success and (tmp_path / "r.parquet").is_dir() and len(pd.read_parquet(tmp_path / "r.parquet")) == 21
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="no FIFOs")
+def test_out_refuses_a_fifo(tmp_path):
+    os.mkfifo(tmp_path / "r.csv")
+    with pytest.raises(ModelError, match="not a regular file"):
+        mb.simulate(oscillator(), 0.2, 0.01, out=tmp_path / "r.csv")

@@ -55,9 +55,10 @@ def prepare(out, resume: bool) -> Path:
         path = Path(out)
     except TypeError:
         raise ModelError("simulate", "out", f"expected a path, got {out!r}") from None
-    if path.exists() and not path.is_dir():
+    if os.path.lexists(path) and not path.is_dir():
         if resume:
             raise ModelError("simulate", "out", f"{str(path)!r} is a file, not a run directory to resume")
+        results_stream.check_replaceable(path)   # a results file mbdsim wrote may be replaced, nothing else
         path.unlink()
     if path.is_dir():
         foreign = [p.name for p in path.iterdir() if not _ours(p.name)]
