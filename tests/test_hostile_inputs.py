@@ -108,3 +108,16 @@ def test_out_refuses_a_fifo(tmp_path):
     os.mkfifo(tmp_path / "r.csv")
     with pytest.raises(ModelError, match="not a regular file"):
         mb.simulate(oscillator(), 0.2, 0.01, out=tmp_path / "r.csv")
+
+
+# ----------------------------------------------------------------------------- 3. sparse outputs, streamed
+def test_streamed_outputs_further_apart_than_the_write_interval(tmp_path, monkeypatch):
+    monkeypatch.setattr(results_stream, "WRITE_INTERVAL", 0.0)   # every return to Python is "past due"
+    m = oscillator()
+    # max_step: ~40000 steps, the step loop returns to Python every 12800 steps, between outputs
+    res = mb.simulate(m, 4.0, 2.0, max_step=1e-4, out=tmp_path / "sp.parquet")
+    assert res.success, res.message
+    df = pd.read_parquet(tmp_path / "sp.parquet")
+    assert np.array_equal(df["time [s]"].to_numpy(), [0.0, 2.0, 4.0])
+    ref = mb.simulate(m, 4.0, 2.0, max_step=1e-4)
+    assert np.allclose(df["b.x [m]"].to_numpy(), ref.q[:, 0], atol=1e-6)

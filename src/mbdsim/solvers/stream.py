@@ -230,8 +230,9 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                 iout = got
                 if progress is not None:
                     progress(float(st[0]))
-                if time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
-                    break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part)
+                if iout > 1 and time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
+                    break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part, with
+                    # at least one new output: outputs further apart than that are written as they come)
         except KeyboardInterrupt:
             status = INTERRUPTED
         tout = np.asarray(times[g0:g0 + iout], float)
