@@ -121,3 +121,49 @@ def test_streamed_outputs_further_apart_than_the_write_interval(tmp_path, monkey
     assert np.array_equal(df["time [s]"].to_numpy(), [0.0, 2.0, 4.0])
     ref = mb.simulate(m, 4.0, 2.0, max_step=1e-4)
     assert np.allclose(df["b.x [m]"].to_numpy(), ref.q[:, 0], atol=1e-6)
+
+
+# ----------------------------------------------------------------------------- 4. raising progress callback
+class Raiser:
+    def __init__(self, after):
+        self.calls, self.after = 0, after
+
+    def __call__(self, t):
+        self.calls += 1
+        if self.calls > self.after:
+            raise RuntimeError("bar broke")
+
+
+def _check_failed(res, path=None):
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert res.error.field == "progress" and "progress callback raised RuntimeError: bar broke" in str(res.error)
+    assert len(res.time) >= 1 and res.time[0] == 0.0
+    if path is not None:
+        df = pd.read_parquet(path) if path.suffix == ".parquet" else pd.read_csv(path)
+        assert len(df) >= 1 and df["time [s]"].iloc[0] == 0.0
+
+
+@pytest.mark.parametrize("method", [None, "hht"])
+def test_a_raising_progress_callback_ends_the_run_keeping_outputs(tmp_path, method):
+    m = oscillator()
+    _check_failed(mb.simulate(m, 30.0, 0.001, method=method, max_step=1e-3, progress=Raiser(1)))
+    path = tmp_path / "r.csv"
+    _check_failed(mb.simulate(m, 30.0, 0.001, method=method, max_step=1e-3, progress=Raiser(1), out=path), path)
+
+
+def test_a_raising_progress_callback_ends_a_streamed_run(tmp_path, monkeypatch):
+    from mbdsim.solvers import stream
+    monkeypatch.setattr(stream, "CHUNK_ROWS", 100)
+    path = tmp_path / "r.parquet"
+    res = mb.simulate(oscillator(), 2.0, 0.001, max_step=1e-3, progress=Raiser(3), out=path)
+    _check_failed(res, path)
+    assert res.time[-1] < 2.0
+
+
+def test_a_raising_progress_callback_ends_a_kinematic_run():
+    m = mb.Model("crank", gravity=(0.0, 0.0, 0.0))
+    b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(0.5, 0.0, 0.0))
+    m.add_revolute("pin", m.ground, b, (0, 0, 0), (0, 0, 1))
+    m.add_motion("d", "pin", displacement="t")
+    res = mb.kinematics(m, 1.0, 0.1, progress=Raiser(2))
+    _check_failed(res)

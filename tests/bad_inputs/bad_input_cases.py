@@ -172,6 +172,9 @@ API_CASES = [
     ("kin-free-dof", _kin(1.0, 0.1), ModelError, "model 'base'", "motions"),
     ("kin-start-string", _kin(1.0, 0.1, start_time="a"), ModelError, "simulate", "start_time"),
     ("kin-step-budget", _kin(1e6, 1e-6), ModelError, "simulate", "output_step"),
+    # issue 35: unbounded work and bad callbacks refused before any work
+    ("sim-progress-not-callable", _sim(1.0, progress=5), ModelError, "simulate", "progress"),
+    ("kin-progress-not-callable", _kin(1.0, 0.1, progress="bar"), ModelError, "kinematics", "progress"),
 ]
 
 BASE_FILE = {

@@ -26,19 +26,37 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import EvaluationError, ModelError
 
 WRITE_INTERVAL = 2.0          # s of wall time between two writes, at least
 SUFFIXES = (".parquet", ".csv")
 MARKER = {b"mbdsim": b"results"}   # Parquet schema metadata of every table mbdsim writes
 
 
+class ProgressError(EvaluationError):
+    """The user's progress callback raised: the analysis ends with success=False and this in res.error,
+    keeping every output before it."""
+
+
+def check_progress(progress, entity: str) -> None:
+    """ModelError naming `entity`.progress unless progress is None or callable (checked before any work)."""
+    if progress is not None and not callable(progress):
+        raise ModelError(entity, "progress", f"expected a callable progress(t) or None, got {progress!r}")
+
+
 def notify(progress, t, build=None) -> None:
     """Tell `progress` (None, a callable of t [s], or a RunMonitor) the time reached and, for a RunMonitor,
-    offer `build` (a zero-argument callable returning the Result of the outputs so far)."""
+    offer `build` (a zero-argument callable returning the Result of the outputs so far). An exception
+    from the callback is raised as a ProgressError (the solvers end the run with it, outputs kept)."""
     if progress is None:
         return
-    progress(float(t))
+    try:
+        progress(float(t))
+    except ProgressError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any failure of the user's callback ends the run, named
+        raise ProgressError("analysis", "progress", f"the progress callback raised {type(exc).__name__}: {exc}",
+                            time=float(t)) from exc
     offer = getattr(progress, "offer", None)
     if offer is not None and build is not None:
         offer(build)
@@ -146,8 +164,7 @@ class RunMonitor:
     progress(t) and hands the outputs so far to a ResultFile."""
 
     def __init__(self, progress, file: ResultFile, entity="simulate"):
-        if progress is not None and not callable(progress):
-            raise ModelError(entity, "progress", f"expected a callable progress(t), got {progress!r}")
+        check_progress(progress, entity)
         self.progress, self.file = progress, file
 
     def __call__(self, t) -> None:
@@ -161,6 +178,7 @@ class RunMonitor:
 def run_writing(run, progress, out, entity):
     """`run(progress)` (an analysis taking a progress argument) with its results written to `out` as it goes
     (None: just run it). The final file is the complete Result's table, also when the run stopped early."""
+    check_progress(progress, entity)
     if out is None:
         return run(progress)
     file = ResultFile(out, entity)

@@ -63,7 +63,9 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
-    progress: optional callable progress(t) receiving the simulated time reached [s] now and then.
+    progress: optional callable progress(t) receiving the simulated time reached [s] now and then (not
+    callable: ModelError before any work; an exception it raises ends the run like any failure below,
+    res.error a ProgressError naming analysis.progress).
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
     element, field and time (EvaluationError, SolverError, AnalysisInterrupted), the Result holding
@@ -82,9 +84,10 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     each warns (MonitorWarning naming time, quantity and element) and `res.diagnostics` keeps the history
     (mbdsim.results.diagnostics)."""
     from ..results.diagnostics import monitor as run_monitors
-    from ..results.stream import run_writing
+    from ..results.stream import check_progress, run_writing
     if not isinstance(resume, bool):
         raise ModelError("simulate", "resume", f"expected True or False, got {resume!r}")
+    check_progress(progress, "simulate")
     res = None
     if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith(".parquet") and \
             (method is None or str(method).lower() in ("auto",) + COMPILED_METHODS) and USE_COMPILED:

@@ -167,7 +167,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
     from . import fastdop
-    from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers, initial_step
+    from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import INTERRUPTED
     if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
         from ..system.compiled import NotCompiled
@@ -228,13 +228,14 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                     Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
                     continue
                 iout = got
-                if progress is not None:
-                    progress(float(st[0]))
+                results_stream.notify(progress, st[0])
                 if iout > 1 and time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
                     break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part, with
                     # at least one new output: outputs further apart than that are written as they come)
         except KeyboardInterrupt:
             status = INTERRUPTED
+        except results_stream.ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
+            status, run.progress_error = PROGRESS_FAILED, exc
         tout = np.asarray(times[g0:g0 + iout], float)
         i1 = g0 + iout
         rows = Y[:iout]
@@ -260,7 +261,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             if kept is not None:
                 kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
             cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-            error = cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
+            error = run.progress_error or cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
