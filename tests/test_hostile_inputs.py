@@ -167,3 +167,14 @@ def test_a_raising_progress_callback_ends_a_kinematic_run():
     m.add_motion("d", "pin", displacement="t")
     res = mb.kinematics(m, 1.0, 0.1, progress=Raiser(2))
     _check_failed(res)
+
+
+# ----------------------------------------------------------------------------- 5. unit strings in study values
+def test_study_values_with_unbounded_unit_powers_are_refused_at_once():
+    from mbdsim.studies.design import to_si_value
+    t0 = time.monotonic()
+    with pytest.raises(ModelError) as err:
+        to_si_value("1 kg**9**9**9", "mass")
+    assert (err.value.entity, err.value.field) == ("study parameter 'mass'", "values")
+    assert "double precision" in str(err.value) and time.monotonic() - t0 < 5.0
+    assert to_si_value("150 mm", "x") == pytest.approx(0.15)

@@ -223,4 +223,8 @@ FILE_CASES = [
     ("file-gravity-short", ("gravity", [0, -9.81]), ModelFileError, "model", "gravity"),
     ("file-gravity-text", ("gravity", "down"), ModelFileError, "model", "gravity"),
     ("file-top-typo", ("bodys", []), ModelFileError, "model", "bodys"),
+    # issue 35: unit strings are evaluated in bounded (float) arithmetic: no hang, no bare OverflowError
+    ("file-mass-power-tower", ("bodies.0.mass", "9**9**9 kg"), ModelFileError, R, "mass"),
+    ("file-mass-power-overflow", ("bodies.0.mass", "2**10000 kg"), ModelFileError, R, "mass"),
+    ("file-stiffness-unit-power", ("forces.0.stiffness", "1 N/m**9**9**9"), ModelFileError, K, "stiffness"),
 ]
