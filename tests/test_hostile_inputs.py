@@ -178,3 +178,41 @@ def test_study_values_with_unbounded_unit_powers_are_refused_at_once():
     assert (err.value.entity, err.value.field) == ("study parameter 'mass'", "values")
     assert "double precision" in str(err.value) and time.monotonic() - t0 < 5.0
     assert to_si_value("150 mm", "x") == pytest.approx(0.15)
+
+
+# ----------------------------------------------------------------------------- 6. model files
+def _load_within(path, seconds=20.0):
+    """load_model(path) in a thread: (the exception it raised, elapsed s); fails if it has not returned."""
+    box = {}
+
+    def go():
+        t0 = time.monotonic()
+        try:
+            mb.load_model(path)
+        except Exception as exc:  # noqa: BLE001
+            box["exc"] = exc
+        box["dt"] = time.monotonic() - t0
+    th = threading.Thread(target=go, daemon=True)
+    th.start()
+    th.join(seconds)
+    assert not th.is_alive(), f"load_model({path}) hung"
+    return box.get("exc"), box["dt"]
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo") or not os.path.exists("/dev/zero"), reason="POSIX only")
+def test_model_files_that_are_not_regular_or_too_large_are_refused(tmp_path):
+    os.mkfifo(tmp_path / "fifo.yaml")
+    (tmp_path / "zero.yaml").symlink_to("/dev/zero")
+    with open(tmp_path / "big.yaml", "wb") as fh:   # sparse: 100 MB without the disk space
+        fh.truncate(100 * 2**20)
+    (tmp_path / "dir.yaml").mkdir()
+    for name, words in [("fifo.yaml", "FIFO"), ("zero.yaml", "device"), ("big.yaml", "20 MB"),
+                        ("dir.yaml", "directory")]:
+        exc, dt = _load_within(tmp_path / name)
+        assert isinstance(exc, ModelFileError) and (exc.entity, exc.field) == ("file", "path"), exc
+        assert name in str(exc) and words in str(exc) and dt < 5.0
+    runner = CliRunner()
+    for name in ("fifo.yaml", "zero.yaml"):
+        r = runner.invoke(app, ["run", str(tmp_path / name), "--end", "1"])
+        text = " ".join(r.output.split())   # (rich wraps lines)
+        assert r.exit_code == 2 and "does not exist" not in text and "not a regular file" in text
