@@ -216,3 +216,21 @@ def test_model_files_that_are_not_regular_or_too_large_are_refused(tmp_path):
         r = runner.invoke(app, ["run", str(tmp_path / name), "--end", "1"])
         text = " ".join(r.output.split())   # (rich wraps lines)
         assert r.exit_code == 2 and "does not exist" not in text and "not a regular file" in text
+
+
+# ----------------------------------------------------------------------------- 7. unbounded work
+def test_python_methods_stop_after_the_step_budget(monkeypatch):
+    from mbdsim.solvers import driver
+    monkeypatch.setattr(driver, "MAX_STEPS", 40)   # (1e7 by default, as the compiled integrator)
+    res = mb.simulate(oscillator(), 1e12, method="hht")
+    assert not res.success and "step budget exhausted (40 steps)" in res.message
+    assert len(res.time) >= 1 and res.time[0] == 0.0
+
+
+def test_budget_errors_give_the_numbers():
+    with pytest.raises(ModelError, match=r"1e\+14 steps \(more than 1e\+09\)") as err:
+        mb.simulate(oscillator(), 1e12, max_step=1e-2)
+    assert (err.value.entity, err.value.field) == ("simulate", "max_step")
+    with pytest.raises(ModelError, match=r"1e\+14 output times \(more than 1e\+08\)") as err:
+        mb.simulate(oscillator(), 1e12, 1e-2, out="never-written.parquet")
+    assert err.value.field == "output_step" and not os.path.exists("never-written.parquet")

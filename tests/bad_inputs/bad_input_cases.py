@@ -175,6 +175,10 @@ API_CASES = [
     # issue 35: unbounded work and bad callbacks refused before any work
     ("sim-progress-not-callable", _sim(1.0, progress=5), ModelError, "simulate", "progress"),
     ("kin-progress-not-callable", _kin(1.0, 0.1, progress="bar"), ModelError, "kinematics", "progress"),
+    ("sim-max-step-budget", _sim(1.0, max_step=1e-10), ModelError, "simulate", "max_step"),
+    ("sim-end-1e12-max-step", _sim(1e12, max_step=1e-2), ModelError, "simulate", "max_step"),
+    ("sim-outputs-budget-streamed", _sim(1e12, 1e-2, out="run.parquet"), ModelError, "simulate", "output_step"),
+    ("sim-outputs-budget-csv", _sim(1e9, 1.0, out="run.csv"), ModelError, "simulate", "output_step"),
 ]
 
 BASE_FILE = {
