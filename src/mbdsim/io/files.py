@@ -142,34 +142,27 @@ def read_bytes(path: Path, limit: int | None = None) -> bytes:
     except FileNotFoundError:
         raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it does not exist", source) from None
     except IsADirectoryError:
-        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is a directory, not a regular file", source) from None
-    st = os.fstat(fd)
-    with os.fdopen(fd, "rb", closefd=True) if stat.S_ISREG(st.st_mode) else _Closing(fd) as fh:
+        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is a directory, not a regular file",
+                             source) from None
+    try:
+        st = os.fstat(fd)
         if not stat.S_ISREG(st.st_mode):
             what = "a directory" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode) else \
-                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "not a regular file"
-            raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is {what}, not a regular file", source)
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file"
+            raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is {what}, not a regular file",
+                                 source)
         if st.st_size > limit:
             raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it has {st.st_size / 2**20:.1f} MB, "
                                  f"more than the {limit / 2**20:g} MB a model file may have", source)
+    except BaseException:
+        os.close(fd)
+        raise
+    with os.fdopen(fd, "rb") as fh:
         data = fh.read(limit + 1)
     if len(data) > limit:   # (grown since the check)
         raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is larger than the "
                              f"{limit / 2**20:g} MB a model file may have", source)
     return data
-
-
-class _Closing:
-    """Closes a descriptor that is not read (a directory's, a FIFO's) on leaving the block."""
-
-    def __init__(self, fd):
-        self.fd = fd
-
-    def __enter__(self):
-        return self
-
-    def __exit__(self, *exc):
-        os.close(self.fd)
 
 
 def write(data: dict, path) -> Path:
