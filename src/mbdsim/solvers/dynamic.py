@@ -266,13 +266,13 @@ def _check_budget(model, t0, t1, step, max_step=None, in_memory=True):
         n = span / float(step) + 1
     except (TypeError, ValueError, ZeroDivisionError):
         return   # time_grid names the bad argument
-    if np.isfinite(n) and n > MAX_OUTPUTS:
-        raise ModelError("simulate", "output_step", f"{span:g} s every {float(step):g} s would be {n:.3g} output "
-                         f"times (more than {MAX_OUTPUTS:.0e}); use a larger output_step or a shorter run")
     per_sample = 8 * (19 * len(model.bodies) + 6 * (len(model.joints) + len(model.motions)) + 1)
     if in_memory and np.isfinite(n) and n * per_sample > RESULT_BUDGET:
         raise ModelError("simulate", "output_step", f"{n:.3g} output times would need {n * per_sample / 2**30:.3g} "
                          f"GiB of results (more than {RESULT_BUDGET / 2**30:g} GiB); use a larger output_step")
+    if np.isfinite(n) and n > MAX_OUTPUTS:
+        raise ModelError("simulate", "output_step", f"{span:g} s every {float(step):g} s would be {n:.3g} output "
+                         f"times (more than {MAX_OUTPUTS:.0e}); use a larger output_step or a shorter run")
 
 
 def _number(field, value) -> float:
