@@ -9,7 +9,7 @@ assembly.  The walk costs about a microsecond per field (0.35 ms for the chain o
 `model_digests` is the portable variant that a streamed run's checkpoint keeps (mbdsim.solvers.stream): the
 same walk with Python functions by their module, qualified name, bytecode, constants, defaults and
 closure values instead of their identity (so the same model built in another process has the same
-digests), one digest per entity ("body 'rod'", "spring 'k'", ...; another entity it refers to counts by
+digests; module globals a function reads are not included), one digest per entity ("body 'rod'", "spring 'k'", ...; another entity it refers to counts by
 name) and one for the rest of the model ("model": name, gravity, ...), so that a mismatch names what
 differs."""
 from __future__ import annotations
