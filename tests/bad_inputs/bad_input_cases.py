@@ -172,6 +172,13 @@ API_CASES = [
     ("kin-free-dof", _kin(1.0, 0.1), ModelError, "model 'base'", "motions"),
     ("kin-start-string", _kin(1.0, 0.1, start_time="a"), ModelError, "simulate", "start_time"),
     ("kin-step-budget", _kin(1e6, 1e-6), ModelError, "simulate", "output_step"),
+    # issue 35: unbounded work and bad callbacks refused before any work
+    ("sim-progress-not-callable", _sim(1.0, progress=5), ModelError, "simulate", "progress"),
+    ("kin-progress-not-callable", _kin(1.0, 0.1, progress="bar"), ModelError, "kinematics", "progress"),
+    ("sim-max-step-budget", _sim(1.0, max_step=1e-10), ModelError, "simulate", "max_step"),
+    ("sim-end-1e12-max-step", _sim(1e12, max_step=1e-2), ModelError, "simulate", "max_step"),
+    ("sim-outputs-budget-streamed", _sim(1e12, 1e-2, out="run.parquet"), ModelError, "simulate", "output_step"),
+    ("sim-outputs-budget-csv", _sim(1e9, 1.0, out="run.csv"), ModelError, "simulate", "output_step"),
 ]
 
 BASE_FILE = {
@@ -220,4 +227,8 @@ FILE_CASES = [
     ("file-gravity-short", ("gravity", [0, -9.81]), ModelFileError, "model", "gravity"),
     ("file-gravity-text", ("gravity", "down"), ModelFileError, "model", "gravity"),
     ("file-top-typo", ("bodys", []), ModelFileError, "model", "bodys"),
+    # issue 35: unit strings are evaluated in bounded (float) arithmetic: no hang, no bare OverflowError
+    ("file-mass-power-tower", ("bodies.0.mass", "9**9**9 kg"), ModelFileError, R, "mass"),
+    ("file-mass-power-overflow", ("bodies.0.mass", "2**10000 kg"), ModelFileError, R, "mass"),
+    ("file-stiffness-unit-power", ("forces.0.stiffness", "1 N/m**9**9**9"), ModelFileError, K, "stiffness"),
 ]

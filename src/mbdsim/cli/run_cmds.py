@@ -18,6 +18,7 @@ rich, pydantic and pandas load when a command runs, so ``mbdsim --help`` stays f
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 import warnings
@@ -71,7 +72,7 @@ def _guard(fn, debug: bool):
 
 def _load(path: Path):
     import mbdsim as mb
-    if not path.is_file():
+    if not os.path.lexists(path):   # anything else (a FIFO, a device, too large) is refused by load_model
         _fail(f"model file {str(path)!r} does not exist", EXIT_BAD_INPUT)
     return mb.load_model(path)
 

@@ -11,6 +11,7 @@ Exit status: 0 at least one run succeeded, 1 none did, 2 bad study or model file
 """
 from __future__ import annotations
 
+import os
 import time
 from pathlib import Path
 from typing import Optional
@@ -78,7 +79,7 @@ def study_cmd(
     Exit status: 0 at least one run succeeded, 1 none did, 2 bad study or model file, 130 interrupted."""
     def go():
         import mbdsim as mb
-        if not study_file.is_file():
+        if not os.path.lexists(study_file):   # anything else (a FIFO, too large) is refused by load_study
             _fail(f"study file {str(study_file)!r} does not exist", EXIT_BAD_INPUT)
         if scheduler is not None and workers is not None:
             _fail("give --workers (a local cluster) or --scheduler (a running one), not both", EXIT_BAD_INPUT)

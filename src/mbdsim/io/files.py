@@ -4,14 +4,22 @@ YAML is composed into a node tree first: every key's line is recorded (for error
 other than the plain YAML types (``!!python/object``, ``!custom``...) and duplicate keys are refused,
 and only then is the tree turned into plain data by the safe constructor.  Nothing in a model file
 can run code.
+
+Only a regular file of at most MAX_BYTES (20 MB; model files are kilobytes) is read: a FIFO, a device
+(a link to /dev/zero), a directory or a larger file is refused before reading, naming the file (opened
+non-blocking and checked on the open descriptor, so a FIFO never blocks and a file swapped after the
+check is still caught; at most MAX_BYTES + 1 bytes are ever read).
 """
 from __future__ import annotations
 
 import json
+import os
+import stat
 from pathlib import Path
 
 from ..errors import ModelFileError
 
+MAX_BYTES = 20 * 2**20   # largest model or study file read
 PLAIN_TAGS = {f"tag:yaml.org,2002:{t}" for t in ("str", "int", "float", "bool", "null", "map", "seq")}
 YAML_SUFFIXES, JSON_SUFFIXES = (".yaml", ".yml"), (".json",)
 
@@ -116,11 +124,45 @@ def read(path) -> tuple:
     kind = file_kind(path)
     source = path.name
     try:
-        text = path.read_text(encoding="utf-8")
+        text = read_bytes(path).decode("utf-8")
     except (OSError, UnicodeDecodeError) as exc:
         raise ModelFileError("file", "path", f"cannot read {str(path)!r}: {exc}", source) from None
     data, marks = (parse_yaml if kind == "yaml" else parse_json)(text, source)
     return data, marks, source
+
+
+def read_bytes(path: Path, limit: int | None = None) -> bytes:
+    """The bytes of the regular file `path` (at most `limit`, default MAX_BYTES), else ModelFileError
+    naming it: missing, not a regular file (FIFO, device, directory) or larger than the limit. OSError
+    for other failures to read."""
+    limit = MAX_BYTES if limit is None else limit
+    source = path.name
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))   # a FIFO opens without a writer
+    except FileNotFoundError:
+        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it does not exist", source) from None
+    except IsADirectoryError:
+        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is a directory, not a regular file",
+                             source) from None
+    try:
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode):
+            what = "a directory" if stat.S_ISDIR(st.st_mode) else "a FIFO" if stat.S_ISFIFO(st.st_mode) else \
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else "a special file"
+            raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is {what}, not a regular file",
+                                 source)
+        if st.st_size > limit:
+            raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it has {st.st_size / 2**20:.1f} MB, "
+                                 f"more than the {limit / 2**20:g} MB a model file may have", source)
+    except BaseException:
+        os.close(fd)
+        raise
+    with os.fdopen(fd, "rb") as fh:
+        data = fh.read(limit + 1)
+    if len(data) > limit:   # (grown since the check)
+        raise ModelFileError("file", "path", f"cannot read {str(path)!r}: it is larger than the "
+                             f"{limit / 2**20:g} MB a model file may have", source)
+    return data
 
 
 def write(data: dict, path) -> Path:

@@ -4,14 +4,23 @@ One pint ``UnitRegistry`` is created on first use (pint is imported only when a 
 bare number is taken as SI already.  Every conversion checks the dimension against the field's SI
 unit, so "2 kg" for a length is an error naming the field.  Angles are dimensionless in pint:
 "30 deg" converts to 0.5236 rad, a bare number is in radians.
+
+pint evaluates the arithmetic of a string ("2*3 kg", "m**2") in Python numbers, and integer powers are
+exact and unbounded ("9**9**9 kg" would run for ever, "2**10000 kg" overflows on conversion): every
+integer literal is handed to pint as a float (`bounded`), so any arithmetic is double precision and a
+result out of range is a UnitError at once; strings are at most MAX_CHARS characters.
 """
 from __future__ import annotations
 
 import math
 import numbers
+import re
 from functools import lru_cache
 
-__all__ = ["UnitError", "registry", "to_si", "dimension_name"]
+__all__ = ["UnitError", "registry", "to_si", "dimension_name", "bounded"]
+
+MAX_CHARS = 200   # characters of a quantity string, at most
+_INTEGER = re.compile(r"(?<![\w.])(\d+)(?![\w.])")   # an integer literal (not part of 1.5, 1e3, m2, 0x1)
 
 # SI units of the fields of a model file and the words used for them in messages.
 DIMENSION_NAMES = {
@@ -37,6 +46,12 @@ def registry():
         return pint.UnitRegistry(autoconvert_offset_to_baseunit=True)
 
 
+def bounded(text: str) -> str:
+    """`text` with every integer literal written as a float ("9**9**9 kg" -> "9.0**9.0**9.0 kg"), so that
+    pint's evaluation is bounded: floats overflow (an error) where integer powers would grow for ever."""
+    return _INTEGER.sub(r"\1.0", text)
+
+
 def dimension_name(unit: str) -> str:
     """'a length [m]' for unit 'm' (used in error messages)."""
     what = DIMENSION_NAMES.get(unit, "a quantity")
@@ -48,7 +63,9 @@ def _convert(text: str, unit: str) -> float:
     ureg = registry()
     import pint
     try:
-        q = ureg.Quantity(text)
+        q = ureg.Quantity(bounded(text))
+    except OverflowError:
+        raise UnitError(f"{text!r} is out of the range of double precision numbers") from None
     except Exception as exc:  # noqa: BLE001 - pint's own parser (never eval) fails in many ways on garbage
         detail = f": {exc}" if str(exc) else ""
         raise UnitError(f"cannot read {text!r} as a number with units{detail}") from None
@@ -60,6 +77,8 @@ def _convert(text: str, unit: str) -> float:
         raise UnitError(f"{text!r} is not {dimension_name(unit)}: its dimension is {got}")
     try:
         x = float(q.to(target.units).magnitude)
+    except OverflowError:
+        raise UnitError(f"{text!r} is out of the range of double precision numbers") from None
     except pint.errors.PintError as exc:
         raise UnitError(f"cannot convert {text!r} to {unit or 'a pure number'}: {exc}") from None
     if not math.isfinite(x):
@@ -79,8 +98,8 @@ def to_si(value, unit: str) -> float:
             raise UnitError(f"must be finite, got {value!r}")
         return x
     if isinstance(value, str):
-        if len(value) > 200:
-            raise UnitError(f"a quantity string is at most 200 characters, got {len(value)}")
+        if len(value) > MAX_CHARS:
+            raise UnitError(f"a quantity string is at most {MAX_CHARS} characters, got {len(value)}")
         try:
             x = float(value)   # a bare number written as a string is SI too
         except ValueError:

@@ -10,6 +10,11 @@ with everything up to the last write, readable with pandas; the column names and
 `to_dataframe()` (continuous angles and quaternion signs need the samples before them, hence rewriting
 the whole table instead of appending independent chunks).
 
+An existing `out` file is replaced only when mbdsim wrote it (`ours`): a Parquet file carrying the
+"mbdsim" schema metadata key that `write_parquet` sets, or a table (.parquet or .csv) whose header is one
+of mbdsim's (first column "time [s]", every column "name [unit]"); any other file, or anything that is
+not a regular file, is refused with a ModelError naming `out` before the run starts.
+
 Solvers report through `notify(progress, t, build)`: `progress(t)` for the user's callback, and, when
 `progress` is a RunMonitor, `build()` (a Result of the outputs so far) is called only when a write is due.
 """
@@ -21,18 +26,37 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import ModelError
+from ..errors import EvaluationError, ModelError
 
 WRITE_INTERVAL = 2.0          # s of wall time between two writes, at least
 SUFFIXES = (".parquet", ".csv")
+MARKER = {b"mbdsim": b"results"}   # Parquet schema metadata of every table mbdsim writes
+
+
+class ProgressError(EvaluationError):
+    """The user's progress callback raised: the analysis ends with success=False and this in res.error,
+    keeping every output before it."""
+
+
+def check_progress(progress, entity: str) -> None:
+    """ModelError naming `entity`.progress unless progress is None or callable (checked before any work)."""
+    if progress is not None and not callable(progress):
+        raise ModelError(entity, "progress", f"expected a callable progress(t) or None, got {progress!r}")
 
 
 def notify(progress, t, build=None) -> None:
     """Tell `progress` (None, a callable of t [s], or a RunMonitor) the time reached and, for a RunMonitor,
-    offer `build` (a zero-argument callable returning the Result of the outputs so far)."""
+    offer `build` (a zero-argument callable returning the Result of the outputs so far). An exception
+    from the callback is raised as a ProgressError (the solvers end the run with it, outputs kept)."""
     if progress is None:
         return
-    progress(float(t))
+    try:
+        progress(float(t))
+    except ProgressError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - any failure of the user's callback ends the run, named
+        raise ProgressError("analysis", "progress", f"the progress callback raised {type(exc).__name__}: {exc}",
+                            time=float(t)) from exc
     offer = getattr(progress, "offer", None)
     if offer is not None and build is not None:
         offer(build)
@@ -51,7 +75,43 @@ def write_parquet(cols: dict, path) -> None:
             raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
         arrays.append(pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)]))
     # float columns: dictionary pages only cost memory (~4 MB) and space (nearly every value is distinct)
-    pq.write_table(pa.Table.from_arrays(arrays, names=list(cols)), path, use_dictionary=False)
+    table = pa.Table.from_arrays(arrays, names=list(cols)).replace_schema_metadata(MARKER)
+    pq.write_table(table, path, use_dictionary=False)
+
+
+def _mbdsim_header(names) -> bool:
+    """Column names of an mbdsim table: "time [s]" first, every one "name [unit]"."""
+    names = list(names)
+    return bool(names) and names[0] == "time [s]" and all(" [" in n and n.endswith("]") for n in names)
+
+
+def ours(path: Path) -> bool:
+    """Whether the regular file `path` is a results table mbdsim wrote (see the module docstring)."""
+    try:
+        if path.suffix.lower() == ".parquet":
+            import pyarrow.parquet as pq
+            schema = pq.read_schema(path)
+            return (schema.metadata or {}).get(b"mbdsim") == MARKER[b"mbdsim"] or _mbdsim_header(schema.names)
+        if path.suffix.lower() == ".csv":
+            with open(path, encoding="utf-8", errors="replace", newline="") as fh:
+                import csv
+                header = next(csv.reader([fh.readline(65536)]), [])
+            return _mbdsim_header(header)
+    except Exception:  # noqa: BLE001 - unreadable or not a table: not ours
+        return False
+    return False
+
+
+def check_replaceable(path: Path, entity: str = "simulate") -> None:
+    """ModelError when `path` exists and is not a results file mbdsim wrote (a foreign file, a directory
+    that is not a run's, a FIFO or device): nothing the user made is overwritten."""
+    if not os.path.lexists(path) or path.is_dir():
+        return
+    if path.is_symlink() or not path.is_file():
+        raise ModelError(entity, "out", f"{str(path)!r} exists and is not a regular file; choose a new path")
+    if not ours(path):
+        raise ModelError(entity, "out", f"{str(path)!r} exists and was not written by mbdsim (not one of its "
+                         "results tables); choose a new path or remove the file")
 
 
 class ResultFile:
@@ -66,6 +126,7 @@ class ResultFile:
             raise ModelError(entity, "out", f"{str(self.path)!r}: expected a .parquet or .csv file")
         if self.path.is_dir():
             raise ModelError(entity, "out", f"{str(self.path)!r} is a directory")
+        check_replaceable(self.path, entity)
         self.last, self.cost, self.build, self.writes = time.monotonic(), 0.0, None, 0
 
     def offer(self, build) -> None:
@@ -103,8 +164,7 @@ class RunMonitor:
     progress(t) and hands the outputs so far to a ResultFile."""
 
     def __init__(self, progress, file: ResultFile, entity="simulate"):
-        if progress is not None and not callable(progress):
-            raise ModelError(entity, "progress", f"expected a callable progress(t), got {progress!r}")
+        check_progress(progress, entity)
         self.progress, self.file = progress, file
 
     def __call__(self, t) -> None:
@@ -118,6 +178,7 @@ class RunMonitor:
 def run_writing(run, progress, out, entity):
     """`run(progress)` (an analysis taking a progress argument) with its results written to `out` as it goes
     (None: just run it). The final file is the complete Result's table, also when the run stopped early."""
+    check_progress(progress, entity)
     if out is None:
         return run(progress)
     file = ResultFile(out, entity)

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import AnalysisInterrupted, MbdsimError, SolverError
 from ..results.result import Result
-from ..results.stream import notify
+from ..results.stream import ProgressError, notify
 from ..system.compiled import Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
@@ -30,6 +30,7 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
              MAX_STEPS: "step budget exhausted (max_steps)",
              STIFF: "the model is stiff for an explicit method",
              INTERRUPTED: "interrupted (KeyboardInterrupt)"}
+PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.progress_error)
 CHUNK = 256
 CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand
 
@@ -48,6 +49,7 @@ class CompiledRun:
         self.stiff_check = bool(stiff_check)
         self.sensors = list(getattr(sys.model, "sensors", {}).values())   # watched by the kernel (fastdop.run)
         self.sensor_events = []
+        self.progress_error = None   # the ProgressError that ended the run (status PROGRESS_FAILED)
 
     def integrate(self, t0, y0, tout, progress=None, checkpoints=False, partial=None):
         """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
@@ -89,6 +91,8 @@ class CompiledRun:
                 notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
+        except ProgressError as exc:   # the same for a raising progress callback
+            status, self.progress_error = PROGRESS_FAILED, exc
         self._take_events()
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
@@ -280,7 +284,8 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
         stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
         message, status = f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s", 0
     if status != 0:
-        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed")
+        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed",
+                                 run.progress_error)
         success = False
     stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
@@ -290,19 +295,21 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     return res
 
 
-def failure(sys, rep, status, t_fail, y_fail, t_done, fallback):
+def failure(sys, rep, status, t_fail, y_fail, t_done, fallback, error=None):
     """(error, message) of a compiled run that ended with kernel status `status` at t_fail [s] in state
     y_fail = [q, v]: a SolverError naming the time and the joints nearest to dependent rows (or
-    AnalysisInterrupted for Ctrl-C), and the Result's message with the last output time of t_done [s];
-    `fallback`: the text for a status without a message of its own."""
+    AnalysisInterrupted for Ctrl-C; `error` itself when given, e.g. the ProgressError of status
+    PROGRESS_FAILED), and the Result's message with the last output time of t_done [s]; `fallback`: the
+    text for a status without a message of its own."""
     from .common import _weak_joints
-    try:
-        joints = [] if status == INTERRUPTED else _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail,
-                                                               rep.rows)
-    except (MbdsimError, np.linalg.LinAlgError, ValueError):
-        joints = []
-    cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-    error = cls(_MESSAGES.get(status, fallback), time=float(t_fail), joints=joints, state=y_fail[:sys.nq])
+    if error is None:
+        try:
+            joints = [] if status in (INTERRUPTED, PROGRESS_FAILED) else \
+                _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail, rep.rows)
+        except (MbdsimError, np.linalg.LinAlgError, ValueError):
+            joints = []
+        cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
+        error = cls(_MESSAGES.get(status, fallback), time=float(t_fail), joints=joints, state=y_fail[:sys.nq])
     last = f"{t_done[-1]:.9g}" if len(t_done) else "none"
     return error, f"{error}; last good output at t = {last} s"
 

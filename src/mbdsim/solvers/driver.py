@@ -29,8 +29,11 @@ from typing import Any, Callable
 
 import numpy as np
 
+from ..errors import SolverError
 from ..results.stream import notify
 from .common import analysis_error
+
+MAX_STEPS = 10_000_000   # steps of one run, at most (as the compiled integrator's max_steps)
 
 
 @dataclass
@@ -46,15 +49,20 @@ class Step:
     data: Any = None
 
 
-def drive(stepper, sys, rep, times, events, progress=None):
+def drive(stepper, sys, rep, times, events, progress=None, max_steps=None):
     """Run `stepper` over the output grid `times` [s] from the assembled state `rep`, with the switching
     functions of `events` (an EventTracker already started at t0); returns the Result (success=False with
-    every output before a failure, the failure in res.error)."""
+    every output before a failure, the failure in res.error; a SolverError after max_steps steps, default
+    MAX_STEPS as the compiled integrator's budget, so that a run over an enormous span ends)."""
     t_end = float(times[-1])
     out = [stepper.first()]
     nxt, success, message, error = 1, True, "ok", None
+    taken, max_steps = 0, MAX_STEPS if max_steps is None else max_steps
     try:
         while stepper.t < t_end - 1e-14 * max(1.0, abs(t_end)):
+            taken += 1
+            if taken > max_steps:
+                raise SolverError(f"step budget exhausted ({max_steps} steps)", time=float(stepper.t))
             step = stepper.step()
             hit = events.check(step.t_old, step.t_new, step.dense)
             event = False

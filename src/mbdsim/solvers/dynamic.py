@@ -63,11 +63,16 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
-    progress: optional callable progress(t) receiving the simulated time reached [s] now and then.
+    progress: optional callable progress(t) receiving the simulated time reached [s] now and then (not
+    callable: ModelError before any work; an exception it raises ends the run like any failure below,
+    res.error a ProgressError naming analysis.progress).
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
     element, field and time (EvaluationError, SolverError, AnalysisInterrupted), the Result holding
-    every output before it; bad arguments raise ModelError before any work.
+    every output before it; bad arguments raise ModelError before any work, and so do runs asking for
+    unbounded work: more than MAX_OUTPUTS (1e8) output times, or (end_time - start_time) / max_step over
+    MAX_STEP_COUNT (1e9) steps (ModelError naming output_step or max_step, with the numbers). Every
+    method stops after 1e7 steps (the compiled max_steps, driver.MAX_STEPS) with success=False.
     out: optional path of a .parquet or .csv file written while the run goes, so that an interrupted or
     killed run leaves what it computed. A ".parquet" path on the compiled DOP853 (method "auto" or
     "dop853" on a model the kernels carry) is a Parquet dataset directory streamed in parts as they are
@@ -82,9 +87,10 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     each warns (MonitorWarning naming time, quantity and element) and `res.diagnostics` keeps the history
     (mbdsim.results.diagnostics)."""
     from ..results.diagnostics import monitor as run_monitors
-    from ..results.stream import run_writing
+    from ..results.stream import check_progress, run_writing
     if not isinstance(resume, bool):
         raise ModelError("simulate", "resume", f"expected True or False, got {resume!r}")
+    check_progress(progress, "simulate")
     res = None
     if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith(".parquet") and \
             (method is None or str(method).lower() in ("auto",) + COMPILED_METHODS) and USE_COMPILED:
@@ -130,8 +136,7 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     user_atol = None if atol is None else _positive("atol", atol)
     max_step = None if max_step is None else _positive("max_step", max_step, finite=False)
     start_time = _number("start_time", start_time)
-    if out is None:
-        _check_budget(model, start_time, end_time, output_step)
+    _check_budget(model, start_time, end_time, output_step, max_step, in_memory=out is None)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
@@ -240,20 +245,34 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
 HHT_RTOL_FLOOR = 1e-10     # HHT's Newton iterations converge to ~1e-12: its error estimate means nothing below
 RTOL_FLOOR = 1e-14          # relative tolerances below this cannot be met in double precision
 RESULT_BUDGET = 4 * 2**30   # bytes of output arrays an analysis may allocate
+MAX_OUTPUTS = 1e8           # output times of one analysis, at most (streamed to disk too)
+MAX_STEP_COUNT = 1e9        # steps that max_step may force on a run ((end - start) / max_step), at most
 
 
-def _check_budget(model, t0, t1, step):
-    """ModelError naming output_step when the output arrays would exceed RESULT_BUDGET (checked before any
-    allocation, from the model's size: 7 coordinates, 12 velocity variables and accelerations per body and
-    6 multipliers per joint or motion per sample)."""
+def _check_budget(model, t0, t1, step, max_step=None, in_memory=True):
+    """ModelError before any work when the analysis asks for unbounded work: more than MAX_OUTPUTS output
+    times (naming output_step), more than MAX_STEP_COUNT steps forced by max_step (naming max_step), or,
+    in memory (in_memory), output arrays over RESULT_BUDGET (from the model's size: 7 coordinates, 12
+    velocity variables and accelerations per body and 6 multipliers per joint or motion per sample)."""
     try:
-        n = (float(t1) - t0) / float(step) + 1
+        span = float(t1) - t0
+    except (TypeError, ValueError):
+        return   # time_grid names the bad argument
+    if max_step is not None and np.isfinite(span) and span > 0 and span / max_step > MAX_STEP_COUNT:
+        raise ModelError("simulate", "max_step", f"max_step = {max_step:g} s over {span:g} s would need at least "
+                         f"{span / max_step:.3g} steps (more than {MAX_STEP_COUNT:.0e}); use a larger max_step "
+                         "or a shorter run")
+    try:
+        n = span / float(step) + 1
     except (TypeError, ValueError, ZeroDivisionError):
         return   # time_grid names the bad argument
     per_sample = 8 * (19 * len(model.bodies) + 6 * (len(model.joints) + len(model.motions)) + 1)
-    if np.isfinite(n) and n * per_sample > RESULT_BUDGET:
+    if in_memory and np.isfinite(n) and n * per_sample > RESULT_BUDGET:
         raise ModelError("simulate", "output_step", f"{n:.3g} output times would need {n * per_sample / 2**30:.3g} "
                          f"GiB of results (more than {RESULT_BUDGET / 2**30:g} GiB); use a larger output_step")
+    if np.isfinite(n) and n > MAX_OUTPUTS:
+        raise ModelError("simulate", "output_step", f"{span:g} s every {float(step):g} s would be {n:.3g} output "
+                         f"times (more than {MAX_OUTPUTS:.0e}); use a larger output_step or a shorter run")
 
 
 def _number(field, value) -> float:

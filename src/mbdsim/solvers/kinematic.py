@@ -38,8 +38,9 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
                progress: Progress = None, out: PathLike | None = None) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
 
-    progress: optional callable progress(t) receiving the time reached [s] after each sample; Ctrl-C
-    returns the partial Result (success=False). out: optional .parquet / .csv path that
+    progress: optional callable progress(t) receiving the time reached [s] after each sample; Ctrl-C or
+    an exception it raises returns the partial Result (success=False; res.error a ProgressError naming
+    analysis.progress), a non-callable is a ModelError before any work. out: optional .parquet / .csv path that
     `res.to_dataframe()` is written to while the run goes and at the end (see mbdsim.results.stream).
 
     The conditioning of the constraint Jacobian (with drivers, columns weighted by the bodies' masses
@@ -56,7 +57,7 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
 
 
 def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
-    from ..results.stream import notify
+    from ..results.stream import ProgressError, notify
     from ..system.assemble import assemble_system
     from .dynamic import _check_budget, _number
     check_model(model)
@@ -70,8 +71,12 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
     times = time_grid(start_time, end_time, output_step)
     fast = _compiled_sweep(sys, rep, times)
     if fast is not None:
-        for t in fast.time:
-            notify(progress, t)
+        try:
+            for t in fast.time:
+                notify(progress, t)
+        except ProgressError as exc:   # every output is solved already: kept, the run marked failed
+            fast.success, fast.status, fast.error = False, -1, exc
+            fast.message = f"{exc}; last good state at t = {fast.time[-1]:.9g} s"
         return fast
     sf = state_factory(sys)
     mon = Monitor(sys, rep.rows)
@@ -97,7 +102,11 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
         if cond >= SINGULAR_TOL:
             anchor = state
         _continue_angles(sys, state)
-        notify(progress, t, lambda n=len(out): _result(sys, out[:n], None, True, "partial (run in progress)"))
+        try:
+            notify(progress, t, lambda n=len(out): _result(sys, out[:n], None, True, "partial (run in progress)"))
+        except ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
+            success, error, message = False, exc, f"{exc}; last good state at t = {t:.9g} s"
+            break
     _warn_singular(records)
     singular = np.array(flags, dtype=bool)
     ev = lambda ts: _evaluate(sys, out, singular, ts, sf)  # noqa: E731

@@ -16,10 +16,10 @@ import numpy as np
 
 from ..errors import SolverError
 from ..results.result import Result
-from ..results.stream import notify
+from ..results.stream import ProgressError, notify
 from ..system.compiled import Work, compile_system
 from . import fastdyn, fastkin
-from .compiled_run import CHUNK, _MESSAGES, _full_multipliers, failure, residual_check
+from .compiled_run import CHUNK, PROGRESS_FAILED, _MESSAGES, _full_multipliers, failure, residual_check
 from .fastdyn import INTERRUPTED, OK
 
 PROJ_TOL = 1e-12   # Newton tolerance on max |phi| [m or rad], as the compiled integrator's projection
@@ -34,6 +34,7 @@ class KinematicRun:
         self.cm = compile_system(sys, rep.rows, (rep.q, rep.v))
         self.work = Work.for_model(self.cm)
         self.stats = np.zeros(6, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
+        self.progress_error = None   # the ProgressError that ended the sweep (status PROGRESS_FAILED)
 
     @property
     def joint_space(self) -> bool:
@@ -75,6 +76,8 @@ class KinematicRun:
                        (lambda n=iout: partial(Y, VD, LAM, MN, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
+        except ProgressError as exc:   # the same for a raising progress callback
+            status, self.progress_error = PROGRESS_FAILED, exc
         return Y, VD, LAM, MN, iout, status, float(st[0]), np.concatenate([q, v])
 
     def multipliers(self, times, Y, VD, LAM, MN):
@@ -144,7 +147,8 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
         return None
     success, message, error = True, "ok", None
     if status != OK:
-        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "kinematic solve failed")
+        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "kinematic solve failed",
+                                 run.progress_error)
         success = False
     s = run.stats
     stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,

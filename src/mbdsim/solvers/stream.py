@@ -16,7 +16,9 @@ Memory is bounded by one chunk whatever the run's length (bench/stream_memory.py
 run calls are loaded: the starting step is computed here around the loaded rhs kernel).
 
 `resume=True` reloads the checkpoint (the run's settings and assembled initial state must match, checked
-by a fingerprint) and continues with exactly the carried state: the compiled step loop returns to Python
+by a fingerprint, and so must the model's content: a digest of every entity's numbers, expressions and
+functions, system.fingerprint.model_digests; a mismatch is a ModelError naming the entities that differ)
+and continues with exactly the carried state: the compiled step loop returns to Python
 at every chunk boundary in an uninterrupted run too, so a resumed run is bit-identical to an
 uninterrupted one.
 
@@ -53,9 +55,10 @@ def prepare(out, resume: bool) -> Path:
         path = Path(out)
     except TypeError:
         raise ModelError("simulate", "out", f"expected a path, got {out!r}") from None
-    if path.exists() and not path.is_dir():
+    if os.path.lexists(path) and not path.is_dir():
         if resume:
             raise ModelError("simulate", "out", f"{str(path)!r} is a file, not a run directory to resume")
+        results_stream.check_replaceable(path)   # a results file mbdsim wrote may be replaced, nothing else
         path.unlink()
     if path.is_dir():
         foreign = [p.name for p in path.iterdir() if not _ours(p.name)]
@@ -164,7 +167,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
     from . import fastdop
-    from .compiled_run import _MESSAGES, CHUNK, CompiledRun, _full_multipliers, initial_step
+    from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import INTERRUPTED
     if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
         from ..system.compiled import NotCompiled
@@ -174,7 +177,9 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     a, w = run.cm.arrays(), run.work.arrays()
     y0 = np.concatenate([rep.q, rep.v])
     fp = fingerprint(sys, rep, times, rtol, atol, max_step)
-    state = _load_checkpoint(path, fp) if resume else None
+    from ..system.fingerprint import model_digests
+    digests = model_digests(sys.model)
+    state = _load_checkpoint(path, fp, digests) if resume else None
     if state is None:
         for p in path.iterdir():
             p.unlink()
@@ -185,7 +190,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
         st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
         chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
-        _write_meta(path, fp, times, rtol, atol)
+        _write_meta(path, fp, times, rtol, atol, digests)
     else:
         chunk, i0, st, y, f, stats, ylast, prev_row = state
         run.stats[:] = stats
@@ -223,12 +228,14 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                     Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
                     continue
                 iout = got
-                if progress is not None:
-                    progress(float(st[0]))
-                if time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
-                    break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part)
+                results_stream.notify(progress, st[0])
+                if iout > 1 and time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
+                    break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part, with
+                    # at least one new output: outputs further apart than that are written as they come)
         except KeyboardInterrupt:
             status = INTERRUPTED
+        except results_stream.ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
+            status, run.progress_error = PROGRESS_FAILED, exc
         tout = np.asarray(times[g0:g0 + iout], float)
         i1 = g0 + iout
         rows = Y[:iout]
@@ -254,13 +261,13 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             if kept is not None:
                 kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
             cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-            error = cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
+            error = run.progress_error or cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
         prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
-        _save_checkpoint(path, fp, chunk, i0, st, y, f, run.stats, ylast, prev_row)
+        _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row)
     ts, rows, acc = last
     if kept is not None and state is None and len(kept) > 1:   # every output fits: the Result holds them all
         ts, rows = np.concatenate([k[0] for k in kept]), np.concatenate([k[1] for k in kept])
@@ -281,33 +288,50 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     return res
 
 
-def _write_meta(path, fp, times, rtol, atol):
+def _write_meta(path, fp, times, rtol, atol, digests):
     meta = {"fingerprint": fp, "start_time": float(times[0]), "end_time": float(times[-1]), "outputs": len(times),
-            "rtol": rtol, "atol": atol, "chunk_rows": CHUNK_ROWS}
+            "rtol": rtol, "atol": atol, "chunk_rows": CHUNK_ROWS, "model": digests}
     _atomic(path / META, lambda p: p.write_text(json.dumps(meta, indent=1)))
 
 
-def _save_checkpoint(path, fp, chunk, i0, st, y, f, stats, ylast, prev_row):
+def _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, stats, ylast, prev_row):
     def write(p):
         with open(p, "wb") as fh:
-            np.savez(fh, fingerprint=np.array(fp), chunk=chunk, i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
+            np.savez(fh, fingerprint=np.array(fp), model=np.array(json.dumps(digests, sort_keys=True)), chunk=chunk,
+                     i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
                      row=np.array(list(prev_row.values()), float), columns=np.array(list(prev_row)))
     _atomic(path / CHECKPOINT, write)
 
 
-def _load_checkpoint(path, fp):
+def _load_checkpoint(path, fp, digests):
     """The carried state of the last completed chunk, None when there is none; ModelError when it belongs
-    to another run (other settings or model)."""
+    to another run (other settings or another model: the entities whose content differs are named)."""
     file = path / CHECKPOINT
     if not file.exists():
         return None
     with np.load(file) as z:
+        theirs = json.loads(str(z["model"])) if "model" in z.files else None
+        differ = _differences(theirs, digests)
+        if differ:
+            raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} was written by another model "
+                             f"({differ}); run without resume to start afresh")
         if str(z["fingerprint"]) != fp:
-            raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (model, "
-                             "times or tolerances differ); run without resume to start afresh")
+            raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (times, "
+                             "tolerances or initial state differ); run without resume to start afresh")
         prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
                 z["ylast"].copy(), prev)
+
+
+def _differences(theirs, ours) -> str:
+    """What differs between the checkpoint's model digests and this model's, in words ('' when nothing)."""
+    if theirs is None:
+        return "the checkpoint has no model digest: written by an older mbdsim"
+    changed = [k for k in ours if k in theirs and theirs[k] != ours[k]]
+    added, missing = [k for k in ours if k not in theirs], [k for k in theirs if k not in ours]
+    words = [f"{', '.join(v[:5])}{' ...' if len(v) > 5 else ''} {what}" for v, what in
+             ((changed, "differ" if len(changed) > 1 else "differs"), (added, "added"), (missing, "missing")) if v]
+    return "; ".join(words)
 
 
 # ----------------------------------------------------------------------------- in-memory fallback

@@ -60,7 +60,7 @@ def to_si_value(value, name: str, unit: str | None = None):
     `unit` applies to bare numbers ("mm": 150 -> 0.15).  Raises ModelError naming the parameter."""
     if isinstance(value, bool):
         raise ModelError(_entity(name), "values", f"expected a number or a quantity, got {value!r}")
-    from ..io.units import registry
+    from ..io.units import bounded, registry
     if isinstance(value, (int, float, np.integer, np.floating)):
         if unit is None:
             return float(value)
@@ -72,8 +72,11 @@ def to_si_value(value, name: str, unit: str | None = None):
         return value          # an expression string, e.g. a motion "2*pi*t"
     ureg = registry()
     rest = m.group(2)
-    try:
-        units = ureg.parse_units(rest) if rest else ureg.dimensionless
+    try:   # bounded: integer powers in the units ("kg**9**9**9") evaluated as floats, an error at once
+        units = ureg.parse_units(bounded(rest)) if rest else ureg.dimensionless
+    except OverflowError:
+        raise ModelError(_entity(name), "values", f"{value!r} is out of the range of double precision "
+                         "numbers") from None
     except Exception:  # noqa: BLE001 - pint fails in many ways: the string is not a quantity
         return value
     return float(ureg.Quantity(float(m.group(1)), units).to_base_units().magnitude)
