@@ -88,6 +88,14 @@ class Result:
         vd, lam = fn()
         self._vd, self._lambda = np.atleast_2d(vd), np.atleast_2d(lam)
 
+    def inject_frames(self, fr) -> None:
+        """Use Frames `fr` (with a sample axis) already computed for this Result's (q, v) instead of
+        computing them on first use (solvers.pyloads hands over the compiled kernels' frames); they get
+        the sample times (time-dependent element measures) and the angles continued by this Result."""
+        fr.t = self.time
+        fr.angle = lambda jt: jm.one_axis(self, jt)[0]
+        self._fr = fr
+
     @property
     def frames(self):
         """Body frames of the samples (mbdsim.system.frames.Frames); the acceleration terms (rdd, alpha)
@@ -96,9 +104,7 @@ class Result:
             fr = body_frames(self.system, self.q, self.v)
             if self._vd is not None or self._accelerations is not None:
                 fr = _LazyFrames(fr, self)
-            self._fr = fr
-            fr.t = self.time   # sample times, for time-dependent element measures
-            fr.angle = lambda jt: jm.one_axis(self, jt)[0]   # angles continued by this Result (elements)
+            self.inject_frames(fr)
         return self._fr
 
     def at(self, t: float | ArrayLike) -> "Result":

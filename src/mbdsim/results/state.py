@@ -10,10 +10,12 @@ from ..model.joint_kinds import is_angle
 class State:
     """Measures of a single instant (t [s]); methods mirror Result but return one sample (no time axis)."""
 
-    def __init__(self, system, t, q, v):
+    def __init__(self, system, t, q, v, frames=None):
         from .result import Result
         self.t = float(t)
         self._res = Result(system, [t], q[None, :], v[None, :], None, None)
+        if frames is not None:   # the frames of (q, v) already computed (the compiled kernels' own)
+            self._res.inject_frames(frames)
 
     @property
     def time(self) -> float:

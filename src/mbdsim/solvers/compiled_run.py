@@ -18,9 +18,9 @@ from ..results.stream import ProgressError, notify
 from ..system.compiled import Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
-from . import fastdop, fastdyn, minnorm
+from . import fastdop, fastdyn, minnorm, pyloads
 from .sensors import SensorEvent
-from .fastdyn import INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
+from .fastdyn import CALLBACK_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
              PROJECTION: "projection onto the constraints does not converge",
@@ -29,8 +29,8 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
                         "or a discontinuity)",
              MAX_STEPS: "step budget exhausted (max_steps)",
              STIFF: "the model is stiff for an explicit method",
-             INTERRUPTED: "interrupted (KeyboardInterrupt)"}
-PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.progress_error)
+             INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load written as a Python callable failed"}
+PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.run_error)
 CHUNK = 256
 CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand
 
@@ -42,6 +42,7 @@ class CompiledRun:
         self.sys, self.rows = sys, rows
         self.cm = compile_system(sys, rows, state)
         self.work = Work.for_model(self.cm)
+        self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.rtol, self.atol = float(rtol), float(atol)
         self.max_step = np.inf if not max_step else float(max_step)
         self.max_steps = int(max_steps)
@@ -49,7 +50,7 @@ class CompiledRun:
         self.stiff_check = bool(stiff_check)
         self.sensors = list(getattr(sys.model, "sensors", {}).values())   # watched by the kernel (fastdop.run)
         self.sensor_events = []
-        self.progress_error = None   # the ProgressError that ended the run (status PROGRESS_FAILED)
+        self.run_error = None   # the error that ended the run (a raising progress callback or load callable)
 
     def integrate(self, t0, y0, tout, progress=None, checkpoints=False, partial=None):
         """Output states (Y, n_written, status, t_fail, y_last) from the consistent state y0 at t0 over
@@ -92,7 +93,8 @@ class CompiledRun:
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
         except ProgressError as exc:   # the same for a raising progress callback
-            status, self.progress_error = PROGRESS_FAILED, exc
+            status, self.run_error = PROGRESS_FAILED, exc
+        status, self.run_error = pyloads.settle(self.pyloads, status, self.run_error)
         self._take_events()
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
@@ -285,7 +287,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
         message, status = f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s", 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed",
-                                 run.progress_error)
+                                 run.run_error)
         success = False
     stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
@@ -304,7 +306,7 @@ def failure(sys, rep, status, t_fail, y_fail, t_done, fallback, error=None):
     from .common import _weak_joints
     if error is None:
         try:
-            joints = [] if status in (INTERRUPTED, PROGRESS_FAILED) else \
+            joints = [] if status in (INTERRUPTED, PROGRESS_FAILED, CALLBACK_FAILED) else \
                 _weak_joints(sys, y_fail[:sys.nq], y_fail[sys.nq:], t_fail, rep.rows)
         except (MbdsimError, np.linalg.LinAlgError, ValueError):
             joints = []

@@ -21,7 +21,7 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
 from . import fasttree
-from .fastdyn import (MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
+from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
                       read_state, rhs, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
@@ -311,6 +311,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             K[0, i] = f[i]
         ok = _stages(cm, wk, co, t, h, y, K, ys, ynew)
         stats[2] += N_STAGES
+        if not ok and wk[46][1][1] != 0:   # a Python-callable load raised: no smaller step helps
+            st[0], st[1] = t, h
+            return CALLBACK_FAILED, iout
         err = np.inf
         if ok:
             e5, e3 = 0.0, 0.0

@@ -27,8 +27,10 @@ from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
 from . import fasttree
+from .pycall import call_address
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
+CALLBACK_FAILED = 11   # a Python-callable load raised (solvers.pyloads keeps the error); 8-10: fastdop
 
 
 @njit(cache=True, _nrt=False)
@@ -46,9 +48,10 @@ def drivers_at(cm, wk, t):
 
 @njit(cache=True, _nrt=False)
 def loads_into(cm, wk, t, y, r, A, rd, w, F):
-    """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings and the
+    """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings, the
     loads written as expressions (system.exprloads_kernel; at time t [s], y: the joint-coordinate state on
-    the tree path) into F."""
+    the tree path), contacts and the loads written as Python callables (the callback of solvers.pyloads,
+    reading the frames r, A, rd, w, which must be the work arrays wk[0:4]) into F."""
     loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
                  cm[29], r, A, rd, w, F)
     if cm[36].shape[0]:
@@ -59,6 +62,13 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
     if cm[44][0].shape[0]:
         ct = cm[44]
         contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F)
+    ext = wk[46]
+    if ext[1][0] != 0:   # loads written as Python callables (solvers.pyloads), from the frames in wk
+        if call_address(ext[1][0], t) != 0:
+            ext[1][1] = 1
+        for f in range(1, F.shape[0]):
+            for k in range(6):
+                F[f, k] += ext[0][f, k]
 
 
 @njit(cache=True, _nrt=False)

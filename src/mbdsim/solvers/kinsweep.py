@@ -18,7 +18,7 @@ from ..errors import SolverError
 from ..results.result import Result
 from ..results.stream import ProgressError, notify
 from ..system.compiled import Work, compile_system
-from . import fastdyn, fastkin
+from . import fastdyn, fastkin, pyloads
 from .compiled_run import CHUNK, PROGRESS_FAILED, _MESSAGES, _full_multipliers, failure, residual_check
 from .fastdyn import INTERRUPTED, OK
 
@@ -33,8 +33,9 @@ class KinematicRun:
         self.sys, self.rows = sys, rep.rows
         self.cm = compile_system(sys, rep.rows, (rep.q, rep.v))
         self.work = Work.for_model(self.cm)
+        self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.stats = np.zeros(6, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
-        self.progress_error = None   # the ProgressError that ended the sweep (status PROGRESS_FAILED)
+        self.run_error = None   # the error that ended the sweep (a raising progress callback or load callable)
 
     @property
     def joint_space(self) -> bool:
@@ -77,7 +78,8 @@ class KinematicRun:
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
             status = INTERRUPTED
         except ProgressError as exc:   # the same for a raising progress callback
-            status, self.progress_error = PROGRESS_FAILED, exc
+            status, self.run_error = PROGRESS_FAILED, exc
+        status, self.run_error = pyloads.settle(self.pyloads, status, self.run_error)
         return Y, VD, LAM, MN, iout, status, float(st[0]), np.concatenate([q, v])
 
     def multipliers(self, times, Y, VD, LAM, MN):
@@ -148,7 +150,7 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     success, message, error = True, "ok", None
     if status != OK:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "kinematic solve failed",
-                                 run.progress_error)
+                                 run.run_error)
         success = False
     s = run.stats
     stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,

@@ -166,7 +166,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
-    from . import fastdop
+    from . import fastdop, pyloads
     from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import INTERRUPTED
     if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
@@ -235,7 +235,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         except KeyboardInterrupt:
             status = INTERRUPTED
         except results_stream.ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
-            status, run.progress_error = PROGRESS_FAILED, exc
+            status, run.run_error = PROGRESS_FAILED, exc
+        status, run.run_error = pyloads.settle(run.pyloads, status, run.run_error)
         tout = np.asarray(times[g0:g0 + iout], float)
         i1 = g0 + iout
         rows = Y[:iout]
@@ -261,7 +262,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             if kept is not None:
                 kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
             cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-            error = run.progress_error or cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
+            error = run.run_error or cls(_MESSAGES.get(status, "integration failed"), time=float(st[0]))
             break
         if kept is not None:
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))

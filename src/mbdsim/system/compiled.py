@@ -79,6 +79,8 @@ class CompiledModel:
     exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
     ex_stack: int = 4         # stack size of their programs
     contacts: tuple = ()      # sphere-sphere / sphere-plane contacts (`_contacts`), arrays()[44]
+    python_loads: tuple = ()  # names of the loads written as Python callables (t, state): evaluated by
+    #                           the callback of solvers.pyloads from inside the kernels (Work slot 46)
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -123,7 +125,10 @@ class Work:
               z(6), z((nf, 3)), z((2, 3, 3))),
              exprloads_pack.work(cm.exprloads, cm.ex_stack),   # 44: expression loads' x and stack
              # 45: minimum-norm multipliers through the square LU (solvers.kkt_square): C, S, y
-             (z((max(n_dep, 1), max(nv, 1))), z((max(n_dep, 1), max(n_dep, 1))), z(max(n_dep, nv, 1))))
+             (z((max(n_dep, 1), max(nv, 1))), z((max(n_dep, 1), max(n_dep, 1))), z(max(n_dep, nv, 1))),
+             # 46: loads written as Python callables (solvers.pyloads): their loads (nf, 6) and
+             # [callback address (0: none), failed flag]
+             (z((nf, 6)), np.zeros(2, np.int64)))
         return cls(a)
 
     def arrays(self) -> tuple:
@@ -180,18 +185,30 @@ def _driver_programs(fns):
     return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size)
 
 
+def python_loads(sys) -> tuple:
+    """Names of the force elements whose value is a Python callable (t, state): a Force or Torque given as
+    one callable, an expression vector with a callable component, a line or joint force with a callable
+    magnitude/value. The compiled kernels call them back (solvers.pyloads) instead of packing them."""
+    out = []
+    for e in sys.model.forces.values():
+        v = getattr(e, "force", getattr(e, "torque", getattr(e, "magnitude", getattr(e, "value", None))))
+        parts = getattr(v, "components", (v,))
+        if isinstance(e, (Force, Torque) + exprloads_pack.LOAD_TYPES) and any(callable(c) for c in parts):
+            out.append(e.name)
+    return tuple(out)
+
+
 def _loads(sys):
     """Constant point forces and torques, spring-dampers and bushings as arrays (expression loads, torsion
     springs and stops are packed by exprloads_pack, contacts by `_contacts`); NotCompiled for anything
     else."""
     pf, sp, bu = [], [], []
+    skip = python_loads(sys)
     for e in sys.model.forces.values():
-        if isinstance(e, exprloads_pack.EXPR_TYPES):
-            continue   # packed by exprloads_pack
+        if isinstance(e, exprloads_pack.EXPR_TYPES) or e.name in skip:
+            continue   # packed by exprloads_pack, or called back (solvers.pyloads)
         if isinstance(e, (Force, Torque)):
             vec = e.force if isinstance(e, Force) else e.torque
-            if callable(vec):
-                raise NotCompiled(f"load '{e.name}' is a Python callable")
             ff, R = (0, np.eye(3)) if e.frame is None else (lambda x: (x[0], x[2]))(locate(sys, e.frame))
             s = e.s_B if isinstance(e, Force) else np.zeros(3)
             pf.append((sys.fid[e.body], s, np.asarray(vec, float), ff, R, isinstance(e, Torque)))
@@ -259,7 +276,8 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         jointtree.tree_arrays(sys, rows, *state)
     if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
         dense = 2   # zero DOF: the independent rows' Jacobian is square (solvers.kkt_square)
-    exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES)]
+    pyl = python_loads(sys)
+    exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES) and e.name not in pyl]
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
     ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \
         (exprloads_pack.empty(), 4)
@@ -270,4 +288,4 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys))
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), pyl)

@@ -23,6 +23,7 @@ from .measures import locate
 # packed here: loads written as expressions, and torsion springs and stops as the joint torque or force
 # expressions of `torsion_expression` and `stop_expression`
 EXPR_TYPES = (ExprForce, ExprTorque, LineForce, JointForce, TorsionSpring, Stop)
+LOAD_TYPES = (ExprForce, ExprTorque, LineForce, JointForce)   # the ones whose values may be Python callables
 
 
 def _coordinate_expression(text, joint, dof) -> LoadExpr:

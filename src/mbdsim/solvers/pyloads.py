@@ -1,0 +1,95 @@
+"""Loads written as Python callables (t, state), evaluated from inside the compiled step loop (issue 29).
+
+`attach(sys, cm, work)` wraps the model's callable loads (`system.compiled.python_loads`) in one ctypes
+callback `int64 f(double t)` whose address goes into the work arrays (slot 46); the kernels' `loads_into`
+calls it at every evaluation of the loads (solvers.pycall). The callback reads the frames the kernel has
+just computed (r, A, rd, w: work slots 0-3, ground axes), rebuilds the absolute state [q, v] from them
+(one compiled call, `fasttree.to_maximal`), hands the user's callable a light `State` of that one instant
+(its frames injected, so nothing is recomputed; `results.state.State`), and writes the generalized loads
+of the callables (the same evaluators as the reference path: `system.force_elements`) into work slot
+46[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
+
+A callable that raises, or returns a non-finite or malformed value, is caught here (a ctypes callback
+cannot raise into the kernel): the callback returns 1, the kernel ends the run with CALLBACK_FAILED, and
+`error` keeps the EvaluationError naming the load, field and time (a KeyboardInterrupt stays a
+KeyboardInterrupt, reported as an interrupted run).
+"""
+from __future__ import annotations
+
+import ctypes
+
+import numpy as np
+
+from ..errors import EvaluationError, MbdsimError
+from ..results.state import State
+from ..system.force_elements import evaluator
+from ..system.frames import Frames
+from . import fasttree
+
+_CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_double)
+
+
+class PythonLoads:
+    """The callback of one run's work arrays (keep this object alive as long as the kernels may call it)."""
+
+    def __init__(self, sys, cm, work):
+        wk = work.arrays()
+        self.sys, self.cm, self.wk = sys, cm, wk
+        self.elems = [sys.model.forces[n] for n in cm.python_loads]
+        self.F, self.ctl = wk[46][0], wk[46][1]
+        self.y = np.zeros(sys.nq + sys.nv)
+        self.calls, self.error, self.interrupted = 0, None, False
+        self._callback = _CALLBACK(self._call)
+        self.ctl[0] = ctypes.cast(self._callback, ctypes.c_void_p).value
+        self.ctl[1] = 0
+        # the velocity slots of each frame (frame f's six load slots are v[vadr[f]: vadr[f] + 6]; particles 3)
+        self.slots = [(f, int(a), 6 if sys.frame_rigid[f] else 3) for f, a in enumerate(sys.frame_v_adr) if a >= 0]
+
+    def state(self, t) -> tuple[State, Frames]:
+        """The light State of the kernel's current frames at t [s] (absolute [q, v] rebuilt from them) and
+        the single-instant Frames the evaluators take."""
+        sys, cm, wk = self.sys, self.cm, self.wk
+        r, A, rd, w = wk[0].copy(), wk[1].copy(), wk[2].copy(), wk[3].copy()
+        fasttree.to_maximal(cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid, r, A, rd, w,
+                            self.y, self.y[:0])
+        q, v = self.y[:sys.nq].copy(), self.y[sys.nq:].copy()
+        return State(sys, t, q, v, Frames(r[None], A[None], rd[None], w[None])), Frames(r, A, rd, w, t=t, q=q, v=v)
+
+    def _call(self, t):
+        self.calls += 1
+        try:
+            state, fr = self.state(t)
+            Q = np.zeros(self.sys.nv)
+            for e in self.elems:
+                Q += evaluator(e).generalized(self.sys, fr, e, t, state)
+            if not np.all(np.isfinite(Q)):
+                bad = next(e for e in self.elems if not np.all(np.isfinite(
+                    evaluator(e).generalized(self.sys, fr, e, t, state))))
+                raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
+            for f, a, n in self.slots:
+                self.F[f, :n] = Q[a:a + n]
+            return 0
+        except KeyboardInterrupt:
+            self.interrupted = True
+        except MbdsimError as exc:
+            self.error = exc
+        except Exception as exc:  # noqa: BLE001 - user code: reported with the load's name
+            name = self.elems[0].name if len(self.elems) == 1 else ", ".join(e.name for e in self.elems)
+            self.error = EvaluationError(f"load '{name}'", "value", f"{type(exc).__name__}: {exc}", time=float(t))
+        self.F[:] = np.nan
+        self.ctl[1] = 1
+        return 1
+
+
+def settle(pyl, status, error):
+    """(status, error) of a kernel run that ended with `status`: CALLBACK_FAILED with the load's error
+    (or INTERRUPTED for a Ctrl-C inside the callable) when the callback `pyl` failed."""
+    from .fastdyn import CALLBACK_FAILED, INTERRUPTED
+    if pyl is None or not pyl.ctl[1] or status == 0 or error is not None:
+        return status, error
+    return (INTERRUPTED, None) if pyl.interrupted else (CALLBACK_FAILED, pyl.error)
+
+
+def attach(sys, cm, work) -> PythonLoads | None:
+    """The callback of the model's Python-callable loads set into `work` (None when it has none)."""
+    return PythonLoads(sys, cm, work) if cm.python_loads else None
