@@ -41,7 +41,7 @@ FAC_MIN, FAC_MAX = 0.2, 10.0   # step-size change bounds per step (scipy's; Hair
 # stability-limited steps of stiff models from the stiffness test, tests/test_compiled_core.py)
 # `run` returns to Python (progress, Ctrl-C) after this many state entries x right-hand-side evaluations
 # (rejected steps included): a fraction of a second for any model size
-EVALS_PER_RETURN = 4_000_000
+EVALS_PER_RETURN = 1_000_000
 COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
 

@@ -143,7 +143,8 @@ def _reselect(cm, wk):
     positions: the first pivots of the pivoted Cholesky factorisation of all their Schur complement (the
     best conditioned independent subset, greedily), then factor with them. A loop carried on a turning
     body needs this: which of its rows are dependent changes with the turn (a four-bar's out-of-plane
-    rows in ground axes). Where even the best subset stays nearly dependent (a change point of the
+    rows in ground axes). Where all loop rows lose rank (a change point of the mechanism) the rows in use
+    are kept. Where even the best subset stays nearly dependent (a change point of the
     mechanism) the re-selection threshold wk[47][0] drops below its ratio, so that the factorisations
     near it are not re-selected again; it returns to nominal once the ratio has recovered."""
     cand, sel, lim = cm[45], wk[46], wk[47]
@@ -151,8 +152,9 @@ def _reselect(cm, wk):
     if not _kkt(cm, wk, cand):
         return False
     perm = wk[41]
-    for k in range(n):
-        sel[k] = cand[perm[1 + k]]
+    if perm[0] >= n:   # (all loop rows losing rank too is a change point: the rows in use are kept)
+        for k in range(n):
+            sel[k] = cand[perm[1 + k]]
     if not _kkt(cm, wk, sel):
         return False
     ratio = loop_ratio(wk, n)
