@@ -362,10 +362,11 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
     rows, so that the determinate components are exact. All samples in one compiled call with r x r and
     d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm), the SVD pseudo-inverse where
-    the rows are dependent at the sample's configuration too (a change point)."""
+    the rows are dependent at the sample's configuration too (a change point) or where the kernel solved
+    for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`)."""
     if len(rows) == sys.nc or not len(times):
         return LAM
-    J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows`
+    J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows` unless re-selected
     rows = np.asarray(rows, dtype=np.int64)
     key = ("dependent rows", rows.tobytes())
     dep = sys.derived.get(key)
@@ -376,8 +377,9 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     LAM = np.ascontiguousarray(LAM, dtype=float)
     out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
     minnorm.min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
+    bad |= np.any(LAM[:, dep] != 0.0, axis=1)   # the kernel re-selected its loop rows (fastdyn._reselect)
     if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
-        load = np.einsum("nri,nr->ni", J[bad][:, rows], LAM[bad][:, rows])
+        load = np.einsum("nri,nr->ni", J[bad], LAM[bad])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
         out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
     keep_jacobians(sys, out, J)   # the reactions read from these multipliers reuse their Jacobians

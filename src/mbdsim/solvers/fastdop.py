@@ -4,8 +4,11 @@ The whole step loop runs in compiled code: stages (the O(N) equations of motion 
 error norm, step-size control, coordinate projection after every accepted step, the outputs at the
 requested times (dense output, then projection; accelerations and multipliers after the run, on
 demand: `outputs_at`) and the model's expression sensors (`_watch`: crossings located on the step's
-dense output). Python is re-entered only when a chunk of outputs is written, when the sensor event
-buffer is full, at a sensor's stop, at the end, or on failure. The Butcher tableau is scipy's
+dense output). Python is re-entered only when a chunk of outputs is written, after a bounded amount of work
+(EVALS_PER_RETURN: Ctrl-C within a fraction of a second), when the sensor event buffer is full, at a
+sensor's stop, at the end, or on failure; every loop inside is bounded (the step size shrinks
+geometrically on rejection down to the round-off limit, TINY_STEP; projections take at most 12 Newton
+steps, PROJECTION). The Butcher tableau is scipy's
 (`scipy.integrate._ivp.dop853_coefficients`); the control follows scipy's `DOP853`: error norm
 |h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2)) with scale atol + rtol max(|y_old|, |y_new|), safety 0.9,
 factor limits 0.2..10, exponent -1/8.
@@ -36,6 +39,9 @@ N_STAGES = _c.N_STAGES
 STIFF_RATIO = 5.0
 FAC_MIN, FAC_MAX = 0.2, 10.0   # step-size change bounds per step (scipy's; Hairer's 1/3..6 hid the
 # stability-limited steps of stiff models from the stiffness test, tests/test_compiled_core.py)
+# `run` returns to Python (progress, Ctrl-C) after this many state entries x right-hand-side evaluations
+# (rejected steps included): a fraction of a second for any model size
+EVALS_PER_RETURN = 1_000_000
 COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguousarray(_c.C),
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
 
@@ -287,10 +293,16 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             _sensor_g(cm, wk, t, y, sc[3], wk[44][2])
     n_sensors = wk[44][2].shape[0] if watch else 0
     written = 0
-    steps0 = stats[0]
+    steps0, nfev0 = stats[0], stats[2]
+    budget = max(EVALS_PER_RETURN // max(n, 1), 20 * N_STAGES)
     rejected = False
     eps = 2.220446049250313e-16
     while iout < tout.shape[0]:
+        if stats[2] - nfev0 >= budget:
+            break   # back to Python now and then (progress, Ctrl-C), rejected steps counted too
+        if not (h > 0.0 and np.isfinite(h)):   # (a step size that is not a number would never shrink)
+            st[0], st[1] = t, h
+            return TINY_STEP, iout
         if stats[0] >= max_steps:
             st[0], st[1] = t, h
             return MAX_STEPS, iout
@@ -311,7 +323,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             K[0, i] = f[i]
         ok = _stages(cm, wk, co, t, h, y, K, ys, ynew)
         stats[2] += N_STAGES
-        if not ok and wk[46][1][1] != 0:   # a Python-callable load raised: no smaller step helps
+        if not ok and wk[48][1][1] != 0:   # a Python-callable load raised: no smaller step helps
             st[0], st[1] = t, h
             return CALLBACK_FAILED, iout
         err = np.inf

@@ -62,7 +62,7 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
     if cm[44][0].shape[0]:
         ct = cm[44]
         contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F)
-    ext = wk[46]
+    ext = wk[48]
     if ext[1][0] != 0:   # loads written as Python callables (solvers.pyloads), from the frames in wk
         if call_address(ext[1][0], t) != 0:
             ext[1][1] = 1
@@ -107,15 +107,69 @@ def residuals(cm, wk, times, Y, idx, rows, val, arg):
 def _factor(cm, wk):
     """Factor the augmented matrix at the rows in wk: dense LU (dims[4] = 1, singular body masses), the
     square Jacobian's LU (dims[4] = 2, zero-DOF models, `kkt_square`; the tree instead where it declines)
-    or the tree elimination of `kkt_tree`. False if singular."""
+    or the tree elimination of `kkt_tree` over the loop rows in use (wk[46]), re-selected (`_reselect`)
+    when they have turned (nearly) dependent. False if singular."""
     if cm[31][4] == 1:
         return dense_factor(wk[5], cm[12], cm[13], cm[7], cm[32], wk[32], wk[33])
     if cm[31][4] == 2 and square_factor(wk[5], cm[12], cm[13], cm[5], cm[6], cm[32], wk[32], wk[33]):
         return True
+    sel, lim = wk[46], wk[47]
+    if not _kkt(cm, wk, sel):
+        return False
+    if cm[45].shape[0] <= sel.shape[0]:
+        return True
+    ratio = loop_ratio(wk, sel.shape[0])
+    if ratio >= lim[1]:
+        lim[0] = lim[1]
+        return True
+    if ratio >= lim[0]:
+        return True
+    return _reselect(cm, wk)
+
+
+@njit(cache=True, _nrt=False)
+def _kkt(cm, wk, loop_rows):
     t = cm[30]
-    return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], t[8],
+    return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], loop_rows,
                       wk[9], wk[10], wk[11], wk[12], wk[13], wk[14], wk[15], wk[16], wk[17], wk[18],
                       wk[20], wk[21], wk[37], wk[38], wk[40], wk[41])
+
+
+@njit(cache=True, _nrt=False)
+def loop_ratio(wk, n):
+    """Smallest over largest pivot of the loop rows' Schur complement in the factorisation in wk (n loop
+    rows; `kkt_tree.pivoted_chol`, whose pivots do not increase): 0 when rows were left out, 1 for none."""
+    if n == 0:
+        return 1.0
+    if wk[41][0] < n:
+        return 0.0
+    LK = wk[18]
+    return (LK[0, 0, 0] / LK[0, n - 1, n - 1]) ** 2
+
+
+@njit(cache=True, _nrt=False)
+def _reselect(cm, wk):
+    """Choose the loop rows in use (wk[46]) anew among all loop rows of the tree (cm[45]) at the current
+    positions: the first pivots of the pivoted Cholesky factorisation of all their Schur complement (the
+    best conditioned independent subset, greedily), then factor with them. A loop carried on a turning
+    body needs this: which of its rows are dependent changes with the turn (a four-bar's out-of-plane
+    rows in ground axes). Where all loop rows lose rank (a change point of the mechanism) the rows in use
+    are kept. Where even the best subset stays nearly dependent (a change point of the
+    mechanism) the re-selection threshold wk[47][0] drops below its ratio, so that the factorisations
+    near it are not re-selected again; it returns to nominal once the ratio has recovered."""
+    cand, sel, lim = cm[45], wk[46], wk[47]
+    n = sel.shape[0]
+    if not _kkt(cm, wk, cand):
+        return False
+    perm = wk[41]
+    if perm[0] >= n:   # (all loop rows losing rank too is a change point: the rows in use are kept)
+        for k in range(n):
+            sel[k] = cand[perm[1 + k]]
+    if not _kkt(cm, wk, sel):
+        return False
+    ratio = loop_ratio(wk, n)
+    lim[0] = lim[1] if ratio >= lim[1] else 1e-2 * ratio
+    return True
 
 
 @njit(cache=True, _nrt=False)
@@ -127,7 +181,7 @@ def _solve(cm, wk, F, c_rows, x6, lam):
         square_solve(cm[32], cm[5], cm[6], cm[7], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
         return
     t = cm[30]
-    kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], t[8], wk[9], wk[10], wk[11], wk[12],
+    kkt_solve(wk[5], cm[12], cm[13], t[0], t[1], t[3], t[4], t[5], wk[46], wk[9], wk[10], wk[11], wk[12],
               wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[21], F, c_rows, x6, lam, wk[38], wk[41])
 
 
@@ -137,7 +191,7 @@ def rows_dropped(cm, wk):
     Cholesky at a change point, where the constraints do not determine the rates)."""
     if cm[31][4] == 1 or (cm[31][4] == 2 and wk[33][cm[32].shape[0]] == 1):
         return False
-    return wk[41][0] < cm[30][8].shape[0]
+    return wk[41][0] < wk[46].shape[0]
 
 
 @njit(cache=True, _nrt=False)
@@ -326,7 +380,7 @@ def newton_positions(cm, wk, t, q, v, tol):
     q returned. Returns (status: OK, NONFINITE (a residual not finite), SINGULAR (a factorisation
     failed) or PROJECTION (no convergence); the sum over the steps of the largest six-slot component
     [m or rad]; the number of factorisations)."""
-    active = cm[32]
+    active, sel = cm[32], wk[46]
     x6, zero6, lam, c = wk[25], wk[27], wk[26], wk[29]
     normalize_into(cm, q)
     for f in range(zero6.shape[0]):
@@ -336,8 +390,8 @@ def newton_positions(cm, wk, t, q, v, tol):
     for it in range(12):
         _constraints(cm, wk, t, q, v)   # phi and the Jacobian do not depend on v; nu, gamma are at (q, v)
         res = 0.0
-        for i in range(active.shape[0]):
-            r = abs(wk[4][active[i]])
+        for i in range(active.shape[0] + sel.shape[0]):   # the rows solved for (loop rows re-selected)
+            r = abs(wk[4][active[i]] if i < active.shape[0] else wk[4][sel[i - active.shape[0]]])
             if not np.isfinite(r):
                 return NONFINITE, size, nfactor
             res = max(res, r)
@@ -390,8 +444,9 @@ def project_velocities(cm, wk, v, refactor=True):
     v6 = wk[30]
     _to6(cm, v, v6)
     Jc, bi, bj, nu = wk[5], cm[12], cm[13], wk[6]
-    for i in range(active.shape[0]):
-        row = active[i]
+    sel = wk[46]
+    for i in range(active.shape[0] + sel.shape[0]):   # the rows solved for (loop rows re-selected)
+        row = active[i] if i < active.shape[0] else sel[i - active.shape[0]]
         c[row] = nu[row] - _row_dot(Jc, bi, bj, row, v6)
     _solve(cm, wk, zero6, c, x6, lam)
     vadr, rigid = cm[5], cm[6]

@@ -19,7 +19,8 @@ Jacobian's LU, `min_norm_at`: small zero-DOF models, `kkt_square`).
 A sub-step is retried at half length when the Newton iteration fails, when it turns any body by more
 than MAX_TURN, or when its correction is large against the predicted motion (a guard against
 converging to another assembly branch); below a step of HMIN_REL |t| the failure is returned (lock-up:
-no configuration satisfies the constraints, or a singular one).
+no configuration satisfies the constraints, or a singular one), and so it is after MAX_FORCED sub-steps
+in a row accepted at that length only (no progress) or MAX_SUBSTEPS in one `advance` (every loop bounded).
 """
 from __future__ import annotations
 
@@ -35,6 +36,8 @@ MAX_TURN = 0.1        # rad: largest predicted rotation of a body in one sub-ste
 CORR_REL = 0.25       # a Newton correction above CORR_REL x the predicted increment (+ CORR_ABS) ...
 CORR_ABS = 1e-6       # ... [m or rad, largest slot] halves the sub-step (branch guard)
 HMIN_REL = 1e-12      # smallest sub-step [s] relative to max(1, |t|)
+MAX_FORCED = 64       # sub-steps in a row accepted only because they are at HMIN_REL: no progress, PROJECTION
+MAX_SUBSTEPS = 1_000_000   # sub-steps (retries included) of one `advance`: beyond, PROJECTION (bounded)
 # stats (int64): 0 outputs solved, 1 sub-steps accepted, 2 sub-steps retried, 3 projections,
 # 4 factorisations, 5 solved configurations where the factorisation dropped dependent loop rows
 # (`kkt_tree.pivoted_chol`: a change point or a lock-up, where the constraints do not determine the
@@ -52,7 +55,12 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     rigid = cm[6]
     t, h, hp = st[0], st[1], st[2]
     status = OK
+    forced, tries = 0, 0
     while t1 - t > 1e-14 * max(1.0, abs(t1)):
+        tries += 1
+        if tries > MAX_SUBSTEPS or forced > MAX_FORCED or not h > 0.0:
+            st[0], st[1], st[2] = t, h, hp
+            return PROJECTION
         hmin = HMIN_REL * max(1.0, abs(t))
         h = min(h, t1 - t)
         if t1 - t - h <= 1e-14 * max(1.0, abs(t1)):
@@ -92,6 +100,7 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
         if status == OK:
             status = accelerations(cm, wk, t + h, q, v, q, vd, lam, False)
         if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):
+            forced = 0 if size <= CORR_REL * inc + CORR_ABS else forced + 1
             t += h
             stats[1] += 1
             for f in range(a6.shape[0]):

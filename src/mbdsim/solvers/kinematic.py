@@ -138,11 +138,12 @@ def _compiled_sweep(sys, rep, times):
         from ..system.metrics import position_metric
         scale = 1.0 / np.sqrt(position_metric(sys))
         block = max(1, 2**22 // max(1, sys.nc * sys.nv))   # samples per batch: Jacobians of <= 32 MB at a time
+        r = len(rep.rows)   # the rank the rows must keep: that of all rows (the kernel re-selects its own)
         for k in range(0, len(res.time), block):
-            J = jacobians(sys, res.q[k:k + block])[:, rep.rows, :] * scale
+            J = jacobians(sys, res.q[k:k + block]) * scale
             J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
             sv = np.linalg.svd(J, compute_uv=False)
-            if np.any(sv.min(axis=1) < SINGULAR_TOL * np.maximum(sv.max(axis=1), 1e-300)):
+            if np.any(sv[:, r - 1] < SINGULAR_TOL * np.maximum(sv[:, 0], 1e-300)):
                 return None
     res.stats = {"method": "kinematic (compiled sweep)", "singular": [],
                  **{k: res.stats[k] for k in ("steps", "substeps", "factorizations", "projections", "assembly")}}
@@ -150,23 +151,26 @@ def _compiled_sweep(sys, rep, times):
 
 
 class Monitor:
-    """Conditioning (smallest / largest singular value) of the constraint Jacobian rows `rows`, its columns
-    weighted by 1/sqrt of the position metric and its rows normalised, and the joints/motions of the
+    """Conditioning of the constraint Jacobian (its columns weighted by 1/sqrt of the position metric and
+    its rows normalised): the r-th over the largest singular value of all its rows in force, r the number
+    of independent rows `rows` (which rows are dependent may change along the motion, as for a loop carried
+    on a turning body; only a loss of rank is a singular configuration), and the joints/motions of the
     weakest direction."""
 
     def __init__(self, sys, rows):
         from ..system.metrics import position_metric
-        self.sys, self.rows = sys, rows
+        self.sys, self.rank = sys, len(rows)
+        self.rows = np.union1d(rows, np.setdiff1d(np.arange(sys.nc), sys.lock_rows)).astype(int)
         self.scale = 1.0 / np.sqrt(position_metric(sys))
 
     def __call__(self, q, t):
         sys = self.sys
-        if sys.nv > DENSE_LIMIT or not len(self.rows):
+        if sys.nv > DENSE_LIMIT or not self.rank:
             return 1.0, []
         J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][self.rows] * self.scale
         J = J / np.maximum(np.linalg.norm(J, axis=1, keepdims=True), 1e-300)
         u, sv, _ = np.linalg.svd(J, full_matrices=False)
-        k = int(np.argmin(sv))
+        k = self.rank - 1
         weak = np.abs(u[:, k])
         names = list(dict.fromkeys(sys.row_owner[self.rows[i]] for i in np.argsort(-weak)
                                    if weak[i] > 0.2 * weak.max()))

@@ -2,10 +2,10 @@
 
 A load written as a Python callable (t, state) cannot be compiled, but it need not send the whole run to
 the Python path: `solvers.pyloads` wraps the model's callables in one ctypes callback `int64 f(double t)`
-and stores its address in the work arrays (`Work.arrays()[46][1][0]`). The kernels' `loads_into` calls
+and stores its address in the work arrays (`Work.arrays()[48][1][0]`). The kernels' `loads_into` calls
 it through this intrinsic (an indirect call: about 1 us plus the Python work), after the frames of the
 current state are in the work arrays; the callback writes the generalized loads into the work array
-`[46][0]` (six slots per frame) and returns 0, or a non-zero status when the callable failed. Address 0
+`[48][0]` (six slots per frame) and returns 0, or a non-zero status when the callable failed. Address 0
 means no callback (nothing is called). The intrinsic is inlined into its caller, so the cached kernels
 keep working: only the address is run-time data.
 """

@@ -1,13 +1,13 @@
 """Loads written as Python callables (t, state), evaluated from inside the compiled step loop (issue 29).
 
 `attach(sys, cm, work)` wraps the model's callable loads (`system.compiled.python_loads`) in one ctypes
-callback `int64 f(double t)` whose address goes into the work arrays (slot 46); the kernels' `loads_into`
+callback `int64 f(double t)` whose address goes into the work arrays (slot 48); the kernels' `loads_into`
 calls it at every evaluation of the loads (solvers.pycall). The callback reads the frames the kernel has
 just computed (r, A, rd, w: work slots 0-3, ground axes), rebuilds the absolute state [q, v] from them
 (one compiled call, `fasttree.to_maximal`), hands the user's callable a light `State` of that one instant
 (its frames injected, so nothing is recomputed; `results.state.State`), and writes the generalized loads
 of the callables (the same evaluators as the reference path: `system.force_elements`) into work slot
-46[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
+48[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
 
 A callable that raises, or returns a non-finite or malformed value, is caught here (a ctypes callback
 cannot raise into the kernel): the callback returns 1, the kernel ends the run with CALLBACK_FAILED, and
@@ -36,7 +36,7 @@ class PythonLoads:
         wk = work.arrays()
         self.sys, self.cm, self.wk = sys, cm, wk
         self.elems = [sys.model.forces[n] for n in cm.python_loads]
-        self.F, self.ctl = wk[46][0], wk[46][1]
+        self.F, self.ctl = wk[48][0], wk[48][1]
         self.y = np.zeros(sys.nq + sys.nv)
         self.calls, self.error, self.interrupted = 0, None, False
         self._callback = _CALLBACK(self._call)

@@ -8,7 +8,7 @@ MuJoCo's mjModel / Pinocchio's Model. Everything that changes during a run lives
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -22,6 +22,10 @@ from .topology import Topology, system_topology
 # LU of the square Jacobian (solvers.kkt_square): 1.5 us against 3.4 us for the tree elimination at
 # nv = 18 (slider-crank); the LU grows as nv^3, the tree linearly
 SQUARE_MAX = 24
+# the tree elimination re-selects its loop rows (solvers.fastdyn._factor) when the smallest pivot of the
+# loop rows' Schur complement falls below this fraction of the largest (the selected rows nearly dependent:
+# a loop carried on a turning body, whose out-of-plane rows change with the turn)
+RESELECT_RATIO = 1e-6
 
 
 USE_TREE = True   # trees of revolute/translational/fixed joints in joint coordinates (False: absolute only)
@@ -79,8 +83,11 @@ class CompiledModel:
     exprloads: tuple = ()     # loads written as expressions (system.exprloads_pack), arrays()[43]
     ex_stack: int = 4         # stack size of their programs
     contacts: tuple = ()      # sphere-sphere / sphere-plane contacts (`_contacts`), arrays()[44]
+    # arrays()[45]: the loop rows the kernel may select from (all loop rows of the spanning tree;
+    # `fastdyn._factor` re-selects among them when the rows in use turn dependent as the configuration changes)
+    cand: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     python_loads: tuple = ()  # names of the loads written as Python callables (t, state): evaluated by
-    #                           the callback of solvers.pyloads from inside the kernels (Work slot 46)
+    #                           the callback of solvers.pyloads from inside the kernels (Work slot 48)
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -93,7 +100,7 @@ class CompiledModel:
                 # 33, 34: the rows' vectors and parameters as `kernels.rows_kernel` takes them (33 is 14
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
-                *self.bushings, self.tree, self.exprloads, self.contacts)
+                *self.bushings, self.tree, self.exprloads, self.contacts, self.cand)
 
 
 @dataclass
@@ -110,7 +117,7 @@ class Work:
         nk = 6 * (nf - 1) + len(cm.active) if dense == 1 else (nv if dense == 2 else 1)
         n_dep = nc - len(cm.active) if dense == 2 else 0   # dependent rows of a square model
         t = cm.topo
-        nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), 1)
+        nblk, nl = max(len(t.blk_child), 1), max(len(t.loop_rows), len(cm.cand), 1)
         nd = len(cm.start) // 3
         z = np.zeros
         # 31: unused (the second tree solve's loads before kkt_solve's loop correction), kept empty so
@@ -126,7 +133,10 @@ class Work:
              exprloads_pack.work(cm.exprloads, cm.ex_stack),   # 44: expression loads' x and stack
              # 45: minimum-norm multipliers through the square LU (solvers.kkt_square): C, S, y
              (z((max(n_dep, 1), max(nv, 1))), z((max(n_dep, 1), max(n_dep, 1))), z(max(n_dep, nv, 1))),
-             # 46: loads written as Python callables (solvers.pyloads): their loads (nf, 6) and
+             # 46: the loop rows in use (from the compiled selection; `fastdyn._factor` re-selects them),
+             # 47: (the pivot ratio below which it re-selects, its nominal value RESELECT_RATIO)
+             np.array(t.loop_rows, dtype=np.int64), np.full(2, RESELECT_RATIO),
+             # 48: loads written as Python callables (solvers.pyloads): their loads (nf, 6) and
              # [callback address (0: none), failed flag]
              (z((nf, 6)), np.zeros(2, np.int64)))
         return cls(a)
@@ -281,11 +291,23 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
     ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \
         (exprloads_pack.empty(), 4)
+    topo = system_topology(sys, rows)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
                          sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),
                          sys.rigid_fid.astype(np.int64), sys.frame_v_adr.astype(np.int64),
                          sys.frame_rigid.astype(np.bool_), M6, np.asarray(sys.model.gravity, float),
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
-                         system_topology(sys, rows), np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), pyl)
+                         topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl)
+
+
+def _candidates(sys, topo) -> np.ndarray:
+    """All loop rows of the spanning tree (`topology._full_topology`) when `topo`, the topology of the
+    selected rows, has the same tree rows (the tree-first selection of system.rows.independent_rows),
+    else the selected loop rows only (no re-selection)."""
+    from .topology import _full_topology
+    full = _full_topology(sys)
+    if full is None or not np.array_equal(np.sort(full.blk_rows), np.sort(topo.blk_rows)):
+        return np.asarray(topo.loop_rows, dtype=np.int64).copy()
+    return np.asarray(full.loop_rows, dtype=np.int64).copy()
