@@ -23,7 +23,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import Optional
+from typing import List, Optional
 
 import typer
 
@@ -32,6 +32,17 @@ OUT_SUFFIXES = (".parquet", ".csv")
 
 MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml or .json).")
 DEBUG_OPT = typer.Option(False, "--debug", help="Show the Python traceback of an error.")
+ALL_MARKERS_OPT = typer.Option(False, "--markers", help="Add every marker's columns to --out: "
+                               "<body>.<marker>.x [m] .y .z, orientation, velocity, acceleration.")
+MARKER_OPT = typer.Option(None, "--marker", metavar="NAME", show_default=False,
+                          help="Add this marker's columns to --out (name, or body.marker); repeat it or give "
+                          "a list: --marker tip,coupler.B.")
+
+
+def _markers(every: bool, names):
+    """The `markers` argument of the analyses from --markers / --marker (exit 2 without --out)."""
+    picked = [n for raw in names or () for n in str(raw).replace(" ", "").split(",") if n]
+    return True if every else (picked or False)
 
 
 def _console():
@@ -122,11 +133,15 @@ def run_cmd(
                                        "as the run goes (.parquet: a Parquet dataset streamed in parts)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run streamed to --out (.parquet) from its "
                                                         "last checkpoint (bit-identical to an uninterrupted run)."),
+    every_marker: bool = ALL_MARKERS_OPT,
+    marker: Optional[List[str]] = MARKER_OPT,
     debug: bool = DEBUG_OPT,
 ) -> None:
     """Simulate a model file and print a summary; optionally write the results table.
 
     Example: mbdsim run examples/slider_crank.yaml --end 2 --step 0.01 --out results.parquet
+
+    With --markers (or --marker NAME) the table has marker columns, e.g. rod.tip.y [m] for mbdsim plot.
 
     Exit status: 0 ok, 1 analysis failed, 2 bad input or model file, 130 interrupted."""
     if out is not None and out.suffix.lower() not in OUT_SUFFIXES:
@@ -136,30 +151,26 @@ def run_cmd(
     stream = out is not None and out.suffix.lower() == ".parquet"
     if resume and not stream:
         _fail("--resume needs --out FILE.parquet (the streamed run to continue)", EXIT_BAD_INPUT)
-    _guard(lambda: _run(model, end, step, method, rtol, out, stream, resume), debug)
+    markers = _markers(every_marker, marker)
+    if markers is not False and out is None:
+        _fail("--markers / --marker add columns to the results table: give --out FILE", EXIT_BAD_INPUT)
+    _guard(lambda: _run(model, end, step, method, rtol, out, stream, resume, markers), debug)
 
 
-def _run(path, end, step, method, rtol, out, stream=False, resume=False):
+def _run(path, end, step, method, rtol, out, stream=False, resume=False, markers=False):
     import mbdsim as mb
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from mbdsim.errors import AnalysisInterrupted
     from mbdsim.io.summary import summarize
     m = _load(path)
-    if _kernels_cold():
-        _console().print("note: first run of this mbdsim version: compiling its numba kernels (once, cached "
-                         "on disk; a few minutes on a slow machine)")
+    _note_cold()
     summary = summarize(m)
     dof, n_redundant, redundant = _rank_dof(m)
-    console = _console()
     t0 = time.perf_counter()
-    with warnings.catch_warnings(), Progress(TextColumn(f"simulating {m.name}"), BarColumn(), TextColumn("t = {task.completed:.4g} s"),
-                  TimeElapsedColumn(), console=console, transient=True) as bar:
+    with warnings.catch_warnings(), _bar(f"simulating {m.name}", end) as bar:
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)   # reported in the summary
-        task = bar.add_task("run", total=end)
         res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol, out=_writable(out),
-                          progress=lambda t: bar.update(task, completed=min(float(t), end)), resume=resume)
-        bar.update(task, completed=float(res.time[-1]))
+                          progress=bar, resume=resume, markers=markers)
     wall = time.perf_counter() - t0
     stats = res.stats or {}
     rows = [("model", f"{m.name} ({path})"), *_mobility(summary, dof, n_redundant, redundant),
@@ -174,6 +185,18 @@ def _run(path, end, step, method, rtol, out, stream=False, resume=False):
     if not res.success:
         interrupted = "KeyboardInterrupt" in str(getattr(res, "error", ""))
         raise typer.Exit(EXIT_INTERRUPTED if interrupted else EXIT_FAILED)
+
+
+def _bar(label: str, end: float):
+    """The progress bar of a run from 0 to end [s] on stderr (mbdsim._progress; nothing outside a terminal)."""
+    from mbdsim._progress import ProgressBar
+    return ProgressBar(label, 0.0, end, console=_console())
+
+
+def _note_cold() -> None:
+    if _kernels_cold():
+        _console().print("note: first run of this mbdsim version: compiling its numba kernels (once, cached "
+                         "on disk; a few minutes on a slow machine)")
 
 
 def _kernels_cold() -> bool:

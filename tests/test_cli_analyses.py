@@ -1,0 +1,152 @@
+"""`mbdsim kinematics / statics / modes` and `run --markers`: numbers against closed forms, results files,
+exit codes (0 ok, 1 failed, 2 bad input) and one-line errors without tracebacks."""
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from typer.testing import CliRunner
+
+from mbdsim.cli.app import app
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+runner = CliRunner()
+G = 9.81
+
+
+def invoke(*args):
+    return runner.invoke(app, [str(a) for a in args])
+
+
+def flat(r) -> str:
+    return " ".join(r.output.split())
+
+
+def test_modes_of_the_pendulum_match_the_small_oscillation_frequency(tmp_path):
+    """Rod 1 kg, 1 m on a pin at its end: f = sqrt(m g c / I_pin) / (2 pi), c = 0.5 m, I_pin = 1/12 + 1/4."""
+    out = tmp_path / "modes.csv"
+    r = invoke("modes", EXAMPLES / "pendulum.yaml", "--out", out)
+    assert r.exit_code == 0, r.output
+    f = np.sqrt(1.0 * G * 0.5 / (1 / 12 + 0.25)) / (2 * np.pi)        # 0.610521 Hz
+    df = pd.read_csv(out)
+    assert list(df.columns)[:4] == ["mode", "frequency [Hz]", "damped frequency [Hz]", "damping ratio [-]"]
+    assert len(df) == 1 and df["frequency [Hz]"][0] == pytest.approx(f, rel=1e-6)
+    assert df["damping ratio [-]"][0] == pytest.approx(0.0, abs=1e-9)
+    assert f"{f:.6g}" in r.output and "frequency [Hz]" in r.output
+    r = invoke("modes", EXAMPLES / "pendulum.yaml", "--at", "initial", "--out", out)   # replaces its own table
+    assert r.exit_code == 0, r.output
+    assert pd.read_csv(out)["frequency [Hz]"][0] == pytest.approx(f, rel=1e-5)
+
+
+def test_modes_of_the_spring_mass_chain_match_the_matrix_eigenproblem(tmp_path):
+    """Vertical modes of three masses (1, 2, 0.5 kg) on 500 N/m springs with 2 N s/m dampers: eigenvalues of
+    [[0, I], [-M^-1 K, -M^-1 C]] (independent of gravity: linear springs along the chain)."""
+    out = tmp_path / "modes.parquet"
+    r = invoke("modes", EXAMPLES / "spring_mass_chain.yaml", "--out", out)
+    assert r.exit_code == 0, r.output
+    k, c = 500.0, 2.0
+    S = np.array([[2, -1, 0], [-1, 2, -1], [0, -1, 1]], float)
+    Mi = np.diag(1 / np.array([1.0, 2.0, 0.5]))
+    A = np.block([[np.zeros((3, 3)), np.eye(3)], [-Mi @ (k * S), -Mi @ (c * S)]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 0]
+    want = np.sort(np.abs(lam)) / (2 * np.pi)
+    zeta = -lam.real / np.abs(lam)
+    df = pd.read_parquet(out)
+    damped = df[df["damping ratio [-]"] > 1e-6]          # the lateral modes are undamped (dampers act along)
+    assert np.allclose(np.sort(damped["frequency [Hz]"]), want, rtol=1e-5)
+    assert np.allclose(np.sort(damped["damping ratio [-]"]), np.sort(zeta), rtol=1e-4)
+
+
+def test_statics_of_the_spring_mass_chain_sags_by_the_hanging_weights(tmp_path):
+    out = tmp_path / "eq.csv"
+    r = invoke("statics", EXAMPLES / "spring_mass_chain.yaml", "--out", out)
+    assert r.exit_code == 0, r.output
+    assert "stable" in r.output and "yes" in r.output
+    df = pd.read_csv(out)
+    k = 500.0
+    assert len(df) == 1
+    assert df["m1.y [m]"][0] == pytest.approx(-0.25 - 3.5 * G / k, abs=1e-8)
+    assert df["m2.y [m]"][0] == pytest.approx(-0.50 - 6.0 * G / k, abs=1e-8)
+    assert df["m3.y [m]"][0] == pytest.approx(-0.75 - 6.5 * G / k, abs=1e-8)   # 0.12753 m below its start
+    assert "-0.87753" in r.output                                              # the printed configuration
+
+
+def _slider_x(t):
+    th = 2 * np.pi * t          # x = r cos(th) + sqrt(l^2 - r^2 sin^2(th)), r 0.2, l 0.4
+    return 0.2 * np.cos(th) + np.sqrt(0.16 - 0.04 * np.sin(th) ** 2)
+
+
+def test_statics_end_is_the_quasi_static_analysis(tmp_path):
+    out = tmp_path / "qs.parquet"
+    r = invoke("statics", EXAMPLES / "slider_crank.yaml", "--end", 0.5, "--step", 0.05, "--out", out)
+    assert r.exit_code == 0, r.output
+    df = pd.read_parquet(out)
+    assert len(df) == 11 and "quasi-static" in r.output
+    assert np.allclose(df["slider.x [m]"], _slider_x(df["time [s]"].to_numpy()), atol=1e-8)
+    assert "drive.effort [N m]" in df.columns
+
+
+def test_kinematics_with_a_marker_then_plot_it(tmp_path):
+    """Four-bar: the coupler's point B stays 0.5 m from the crank pin A and sqrt(0.17) m from the rocker
+    pivot O4 (0.4, 0); --marker puts coupler.B in the table, and `mbdsim plot` draws it."""
+    out, png = tmp_path / "kin.csv", tmp_path / "b.png"
+    r = invoke("kinematics", EXAMPLES / "four_bar.yaml", "--end", 1, "--step", 0.01, "--out", out, "--marker", "B")
+    assert r.exit_code == 0, r.output
+    assert "success" in r.output and "True" in r.output
+    df = pd.read_csv(out)
+    t, bx, by = df["time [s]"].to_numpy(), df["coupler.B.x [m]"].to_numpy(), df["coupler.B.y [m]"].to_numpy()
+    th = np.pi / 2 + 2 * np.pi * t
+    ax, ay = 0.1 * np.cos(th), 0.1 * np.sin(th)
+    assert len(df) == 101
+    assert np.allclose(np.hypot(bx - ax, by - ay), 0.5, atol=1e-8)
+    assert np.allclose(np.hypot(bx - 0.4, by), np.sqrt(0.17), atol=1e-8)
+    r = invoke("plot", out, "coupler.B.y", "-o", png)
+    assert r.exit_code == 0, r.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_run_markers_adds_every_marker_and_plot_reads_it(tmp_path):
+    out, png = tmp_path / "run.parquet", tmp_path / "tip.png"
+    r = invoke("run", EXAMPLES / "pendulum.yaml", "--end", 0.5, "--step", 0.01, "--out", out, "--markers")
+    assert r.exit_code == 0, r.output
+    df = pd.read_parquet(out)
+    tip = df[["rod.tip.x [m]", "rod.tip.y [m]"]].to_numpy()
+    cm = df[["rod.x [m]", "rod.y [m]"]].to_numpy()
+    assert np.allclose(tip, 2 * cm, atol=1e-9)          # the tip is twice as far from the pin as the centre
+    r = invoke("plot", out, "rod.tip.y", "-o", png)
+    assert r.exit_code == 0, r.output
+
+
+@pytest.mark.parametrize("args, words", [
+    (["kinematics", EXAMPLES / "pendulum.yaml", "--end", 1], "1 DOF remain free"),
+    (["kinematics", "absent.yaml", "--end", 1], "does not exist"),
+    (["kinematics", EXAMPLES / "four_bar.yaml", "--end", 1, "--out", "k.txt"], "expected a .parquet or .csv"),
+    (["kinematics", EXAMPLES / "four_bar.yaml", "--end", 0], "--end must be > 0"),
+    (["kinematics", EXAMPLES / "four_bar.yaml", "--end", 1, "--marker", "B"], "give --out FILE"),
+    (["statics", EXAMPLES / "four_bar.yaml", "--step", 0.1], "--step needs --end"),
+    (["statics", EXAMPLES / "four_bar.yaml", "--out", "s.json"], "expected a .parquet or .csv"),
+    (["modes", EXAMPLES / "pendulum.yaml", "--at", "top"], "--at: expected 'equilibrium' or 'initial'"),
+    (["modes", ROOT / "tests" / "bad_models" / "unknown_body.yaml"], "joint 'pin'.body_j"),
+])
+def test_bad_input_exits_2_with_one_clear_line(args, words):
+    r = invoke(*args)
+    assert r.exit_code == 2, r.output
+    assert words in flat(r) and "Traceback" not in r.output
+
+
+def test_unknown_marker_names_the_field_and_the_markers(tmp_path):
+    r = invoke("run", EXAMPLES / "four_bar.yaml", "--end", 0.1, "--out", tmp_path / "r.csv", "--marker", "C")
+    assert r.exit_code == 2, r.output
+    assert "simulate.markers: 'C' names no marker; markers: coupler.B" in flat(r)
+    assert not (tmp_path / "r.csv").exists()
+
+
+def test_foreign_out_files_are_not_replaced(tmp_path):
+    mine = tmp_path / "notes.csv"
+    mine.write_text("my,own\n1,2\n")
+    for cmd in (["modes", EXAMPLES / "pendulum.yaml"], ["statics", EXAMPLES / "spring_mass_chain.yaml"]):
+        r = invoke(*cmd, "--out", mine)
+        assert r.exit_code == 2, r.output
+        assert "notes.csv" in flat(r) and mine.read_text() == "my,own\n1,2\n"
