@@ -89,7 +89,7 @@ def test_statics_end_is_the_quasi_static_analysis(tmp_path):
 
 
 def test_kinematics_with_a_marker_then_plot_it(tmp_path):
-    """Four-bar: the coupler's point B stays 0.5 m from the crank pin A and sqrt(0.17) m from the rocker
+    """Four-bar: the coupler's point B stays sqrt(0.18) m from the crank pin A and sqrt(0.17) m from the rocker
     pivot O4 (0.4, 0); --marker puts coupler.B in the table, and `mbdsim plot` draws it."""
     out, png = tmp_path / "kin.csv", tmp_path / "b.png"
     r = invoke("kinematics", EXAMPLES / "four_bar.yaml", "--end", 1, "--step", 0.01, "--out", out, "--marker", "B")
@@ -100,7 +100,7 @@ def test_kinematics_with_a_marker_then_plot_it(tmp_path):
     th = np.pi / 2 + 2 * np.pi * t
     ax, ay = 0.1 * np.cos(th), 0.1 * np.sin(th)
     assert len(df) == 101
-    assert np.allclose(np.hypot(bx - ax, by - ay), 0.5, atol=1e-8)
+    assert np.allclose(np.hypot(bx - ax, by - ay), np.sqrt(0.18), atol=1e-8)
     assert np.allclose(np.hypot(bx - 0.4, by), np.sqrt(0.17), atol=1e-8)
     r = invoke("plot", out, "coupler.B.y", "-o", png)
     assert r.exit_code == 0, r.output
