@@ -150,3 +150,30 @@ def test_foreign_out_files_are_not_replaced(tmp_path):
         r = invoke(*cmd, "--out", mine)
         assert r.exit_code == 2, r.output
         assert "notes.csv" in flat(r) and mine.read_text() == "my,own\n1,2\n"
+
+
+def test_help_of_the_analyses_has_examples_and_units():
+    for cmd in ("kinematics", "statics", "modes"):
+        text = flat(invoke(cmd, "--help"))
+        assert "Example: mbdsim " + cmd in text and "Exit status" in text
+    assert "[Hz]" in flat(invoke("modes", "--help"))
+    assert "--marker" in flat(invoke("run", "--help"))
+
+
+def test_marker_columns_by_name_in_python():
+    """to_dataframe(markers=...): True every marker, or names ("B" or "coupler.B"); unknown names and
+    other values are ModelErrors naming the field."""
+    import mbdsim as mb
+    m = mb.load_model(EXAMPLES / "four_bar.yaml")
+    res = mb.kinematics(m, end_time=0.1, output_step=0.05)
+    for sel in (True, ["B"], "coupler.B"):
+        cols = [c for c in res.to_dataframe(markers=sel).columns if c.startswith("coupler.B.")]
+        assert cols[:3] == ["coupler.B.x [m]", "coupler.B.y [m]", "coupler.B.z [m]"]
+    assert not any(c.startswith("coupler.B.") for c in res.to_dataframe().columns)
+    with pytest.raises(mb.ModelError, match="'Q' names no marker; markers: coupler.B"):
+        res.to_dataframe(markers=["Q"])
+    with pytest.raises(mb.ModelError, match="markers: expected True, False or a list"):
+        res.to_dataframe(markers=3)
+    with pytest.raises(mb.ModelError, match="kinematics.markers"):
+        mb.kinematics(m, end_time=0.1, out="never.csv", markers=["Q"])
+    assert not Path("never.csv").exists()
