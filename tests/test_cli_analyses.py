@@ -70,7 +70,7 @@ def test_statics_of_the_spring_mass_chain_sags_by_the_hanging_weights(tmp_path):
     assert df["m1.y [m]"][0] == pytest.approx(-0.25 - 3.5 * G / k, abs=1e-8)
     assert df["m2.y [m]"][0] == pytest.approx(-0.50 - 6.0 * G / k, abs=1e-8)
     assert df["m3.y [m]"][0] == pytest.approx(-0.75 - 6.5 * G / k, abs=1e-8)   # 0.12753 m below its start
-    assert "-0.87753" in r.output                                              # the printed configuration
+    assert "-0.87753" in r.output and "y [m]" in r.output                      # the printed configuration
 
 
 def _slider_x(t):
@@ -150,6 +150,12 @@ def test_foreign_out_files_are_not_replaced(tmp_path):
         r = invoke(*cmd, "--out", mine)
         assert r.exit_code == 2, r.output
         assert "notes.csv" in flat(r) and mine.read_text() == "my,own\n1,2\n"
+
+
+def test_modes_of_a_fully_driven_model_say_there_are_none(tmp_path):
+    r = invoke("modes", EXAMPLES / "four_bar.yaml", "--out", tmp_path / "m.csv")
+    assert r.exit_code == 0, r.output
+    assert "no free coordinates" in flat(r) and len(pd.read_csv(tmp_path / "m.csv")) == 0
 
 
 def test_help_of_the_analyses_has_examples_and_units():

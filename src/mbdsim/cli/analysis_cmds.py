@@ -45,10 +45,12 @@ def _check_span(end: Optional[float], step: Optional[float]) -> None:
         _fail(f"--step must be > 0, got {step!r}", EXIT_BAD_INPUT)
 
 
-def _finish(res, rows, title, out) -> None:
-    """Print the summary table; exit 130 for an interrupted run, 1 for a failed one."""
+def _finish(res, rows, title, out, then=None) -> None:
+    """Print the summary table (and then(), when given); exit 130 for an interrupted run, 1 for a failed one."""
     from mbdsim.errors import AnalysisInterrupted
     _print_table(title, rows)
+    if then is not None:
+        then()
     if out is not None:
         _console().print(f"results: {out} ({len(res.time)} rows)")
     if isinstance(getattr(res, "error", None), AnalysisInterrupted) or "KeyboardInterrupt" in str(
@@ -123,8 +125,8 @@ def statics_cmd(
 
     Example: mbdsim statics examples/spring_mass_chain.yaml --out eq.csv
 
-    Exit status: 0 ok (a stable equilibrium, or every quasi-static one found), 1 analysis failed (no
-    equilibrium), 2 bad input or model file, 130 interrupted."""
+    Exit status: 0 ok (an equilibrium found at every time; the table says whether it is stable), 1 analysis
+    failed (no equilibrium), 2 bad input or model file, 130 interrupted."""
     _check_out(out)
     _check_span(end, step)
     if step is not None and end is None:
@@ -166,9 +168,7 @@ def _statics(path, end, step, out):
             file.write(res)
         except OSError as exc:
             _fail(f"cannot write {str(out)!r}: {exc}", EXIT_FAILED)
-    if end is None:
-        _print_positions(res)
-    _finish(res, rows, f"mbdsim statics: {m.name}", out)
+    _finish(res, rows, f"mbdsim statics: {m.name}", out, (lambda: _print_positions(res)) if end is None else None)
 
 
 def _print_positions(res) -> None:
@@ -230,8 +230,11 @@ def _modes(path, at, out):
     point = "static equilibrium" if at == "equilibrium" else "initial state"
     rows = [(str(r[0]), f"{r[1]:.6g}", f"{r[2]:.6g}", "rigid" if math.isnan(r[3]) else f"{r[3]:.4g}",
              _eig(r[4], r[5])) for r in df.itertuples(index=False)]
-    _print_table(f"modes of {m.name} ({point}, t = {lin.t:g} s, {lin.dof} coordinates)",
-                 rows, ("mode", "frequency [Hz]", "damped [Hz]", "damping ratio", "eigenvalue [rad/s]"))
+    if lin.dof == 0:
+        _console().print(f"{m.name}: no free coordinates (every degree of freedom is driven): no modes")
+    else:
+        _print_table(f"modes of {m.name} ({point}, t = {lin.t:g} s, {lin.dof} coordinates)",
+                     rows, ("mode", "frequency [Hz]", "damped [Hz]", "damping ratio", "eigenvalue [rad/s]"))
     if out is not None:
         try:
             out.parent.mkdir(parents=True, exist_ok=True)
@@ -242,6 +245,8 @@ def _modes(path, at, out):
 
 
 def _eig(re_: float, im: float) -> str:
+    """'a + bj' [rad/s], a real part at round-off level (1e-12 of the magnitude) shown as 0."""
+    re_ = 0.0 if abs(re_) <= 1e-12 * math.hypot(re_, im) else re_
     return f"{re_:.6g}" if im == 0 else f"{re_:.6g} {'+' if im > 0 else '-'} {abs(im):.6g}j"
 
 

@@ -225,12 +225,13 @@ def _writable(out: Optional[Path]) -> Optional[Path]:
 
 def _print_table(title, rows, headers=("", "")):
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
-    t = Table(title=title, show_header=any(headers), header_style="bold")
-    for h in headers:
-        t.add_column(h)
+    t = Table(title=escape(title), show_header=any(headers), header_style="bold")
+    for h in headers:                 # plain text: "x [m]" is not rich markup
+        t.add_column(escape(h))
     for r in rows:
-        t.add_row(*r)
+        t.add_row(*(escape(str(c)) for c in r))
     Console(highlight=False, width=None if sys.stdout.isatty() else 120).print(t)
 
 
