@@ -183,3 +183,31 @@ def test_marker_columns_by_name_in_python():
     with pytest.raises(mb.ModelError, match="kinematics.markers"):
         mb.kinematics(m, end_time=0.1, out="never.csv", markers=["Q"])
     assert not Path("never.csv").exists()
+
+
+LOCKED = (ROOT / "tests" / "test_io_cli.py").read_text().split('LOCKED = """')[1].split('"""')[0]
+
+
+def test_a_kinematic_lock_up_exits_1_keeping_the_samples_before_it(tmp_path):
+    """Crank 0.3 m, rod 0.2 m: the slider-crank locks where sin(theta) = 2/3, t = asin(2/3) / (2 pi)."""
+    p, out = tmp_path / "locked.yaml", tmp_path / "k.csv"
+    p.write_text(LOCKED)
+    r = invoke("kinematics", p, "--end", 0.5, "--step", 0.001, "--out", out)
+    assert r.exit_code == 1, r.output
+    assert "Traceback" not in r.output and "False" in r.output
+    t = pd.read_csv(out)["time [s]"].to_numpy()
+    assert t[-1] == pytest.approx(np.arcsin(2 / 3) / (2 * np.pi), abs=2e-3)
+
+
+@pytest.mark.parametrize("cmd, api", [(["kinematics", "four_bar.yaml", "--end", 1], "kinematics"),
+                                      (["statics", "spring_mass_chain.yaml"], "equilibrium"),
+                                      (["statics", "slider_crank.yaml", "--end", 1], "quasi_static"),
+                                      (["modes", "pendulum.yaml"], "linearize")])
+def test_interrupt_exits_130(monkeypatch, cmd, api):
+    import mbdsim as mb
+
+    def interrupted(*args, **kwargs):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(mb, api, interrupted)
+    r = invoke(cmd[0], EXAMPLES / cmd[1], *cmd[2:])
+    assert r.exit_code == 130 and "interrupted" in r.output

@@ -2,12 +2,14 @@
 
 Commands::
 
-    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--resume] [--debug]
+    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--resume]
+               [--markers | --marker NAME...] [--debug]
 
 ``--out`` is written while the run goes, so an interrupted or killed run leaves a readable file with what it
 computed: a .parquet output of the compiled core is a Parquet dataset streamed in parts with checkpoints
 (bounded memory; ``--resume`` continues it bit-identically, see mbdsim.solvers.stream), otherwise the file
-is rewritten every few seconds, atomically (mbdsim.results.stream).
+is rewritten every few seconds, atomically (mbdsim.results.stream). ``--markers`` (every marker) or
+``--marker NAME`` add marker columns to it ("<body>.<marker>.x [m]" ..., results.export.marker_targets).
     mbdsim info MODEL [--debug]
     mbdsim schema [--out schema.json]
 
