@@ -117,6 +117,8 @@ def test_run_markers_adds_every_marker_and_plot_reads_it(tmp_path):
     assert np.allclose(tip, 2 * cm, atol=1e-9)          # the tip is twice as far from the pin as the centre
     r = invoke("plot", out, "rod.tip.y", "-o", png)
     assert r.exit_code == 0, r.output
+    r = invoke("kinematics", EXAMPLES / "slider_crank.yaml", "--end", 0.1, "--out", tmp_path / "k.csv", "--markers")
+    assert r.exit_code == 0 and "has no markers" in flat(r)
 
 
 @pytest.mark.parametrize("args, words", [

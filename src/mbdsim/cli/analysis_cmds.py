@@ -27,7 +27,7 @@ import typer
 
 from .run_cmds import (ALL_MARKERS_OPT, DEBUG_OPT, EXIT_BAD_INPUT, EXIT_FAILED, EXIT_INTERRUPTED, MARKER_OPT,
                        MODEL_ARG, OUT_SUFFIXES, _bar, _console, _fail, _guard, _load, _markers, _note_cold,
-                       _print_table, _rank_dof, _writable)
+                       _note_markers, _print_table, _rank_dof, _writable)
 
 MODES_COLUMNS = ("mode", "frequency [Hz]", "damped frequency [Hz]", "damping ratio [-]", "eigenvalue.real [rad/s]",
                  "eigenvalue.imag [rad/s]")
@@ -91,6 +91,7 @@ def _kinematics(path, end, step, out, markers):
     import mbdsim as mb
     m = _load(path)
     _note_cold()
+    _note_markers(m, markers)
     dof, n_redundant, redundant = _rank_dof(m)
     t0 = time.perf_counter()
     with warnings.catch_warnings(), _bar(f"kinematics of {m.name}", end) as bar:

@@ -47,6 +47,13 @@ def _markers(every: bool, names):
     return True if every else (picked or False)
 
 
+def _note_markers(model, markers) -> None:
+    """Say so when --markers finds no marker in the model (the table then has none)."""
+    if markers is True and not any(b.markers for b in model.bodies.values()):
+        _console().print(f"note: --markers: model {model.name!r} has no markers (add them under a body's "
+                         "'markers:' in the model file)")
+
+
 def _console():
     from rich.console import Console
     return Console(stderr=True, highlight=False, width=None if sys.stderr.isatty() else 120)
@@ -166,6 +173,7 @@ def _run(path, end, step, method, rtol, out, stream=False, resume=False, markers
     from mbdsim.io.summary import summarize
     m = _load(path)
     _note_cold()
+    _note_markers(m, markers)
     summary = summarize(m)
     dof, n_redundant, redundant = _rank_dof(m)
     t0 = time.perf_counter()
