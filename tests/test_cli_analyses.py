@@ -213,3 +213,14 @@ def test_interrupt_exits_130(monkeypatch, cmd, api):
     monkeypatch.setattr(mb, api, interrupted)
     r = invoke(cmd[0], EXAMPLES / cmd[1], *cmd[2:])
     assert r.exit_code == 130 and "interrupted" in r.output
+
+
+def test_resuming_a_streamed_run_keeps_its_marker_columns(tmp_path):
+    """The checkpoint's fingerprint covers the marker columns: the same selection resumes, another is refused."""
+    import mbdsim as mb
+    m, out = mb.load_model(EXAMPLES / "pendulum.yaml"), tmp_path / "r.parquet"
+    mb.simulate(m, end_time=0.5, output_step=0.01, out=out, markers=["tip"])
+    again = mb.simulate(m, end_time=0.5, output_step=0.01, out=out, markers=["rod.tip"], resume=True)
+    assert again.success and "rod.tip.y [m]" in pd.read_parquet(out).columns
+    with pytest.raises(mb.ModelError, match="marker columns differ"):
+        mb.simulate(m, end_time=0.5, output_step=0.01, out=out, resume=True)

@@ -64,7 +64,8 @@ def _finish(res, rows, title, out, then=None) -> None:
 def kinematics_cmd(
     model: Path = MODEL_ARG,
     end: float = typer.Option(..., "--end", "-e", metavar="T", help="End time in s."),
-    step: Optional[float] = typer.Option(None, "--step", "-s", metavar="DT", help="Output step in s (default: end/500)."),
+    step: Optional[float] = typer.Option(None, "--step", "-s", metavar="DT",
+                                         help="Output step in s (default: end/500)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",
                                        help="Write the results table (res.to_dataframe()) to .parquet or .csv "
                                        "as the run goes."),
@@ -114,7 +115,8 @@ def _kinematics(path, end, step, out, markers):
 def statics_cmd(
     model: Path = MODEL_ARG,
     end: Optional[float] = typer.Option(None, "--end", "-e", metavar="T",
-                                        help="Quasi-static analysis from 0 to T s (default: one equilibrium at t = 0)."),
+                                        help="Quasi-static analysis from 0 to T s (default: one equilibrium at "
+                                        "t = 0)."),
     step: Optional[float] = typer.Option(None, "--step", "-s", metavar="DT",
                                          help="Output step in s of the quasi-static analysis (default: end/500)."),
     out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="FILE",

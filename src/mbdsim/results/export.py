@@ -149,7 +149,8 @@ def marker_targets(bodies, markers, entity="to_dataframe"):
     try:
         names = list(names)
     except TypeError:
-        raise ModelError(entity, "markers", f"expected True, False or a list of marker names, got {markers!r}") from None
+        raise ModelError(entity, "markers",
+                         f"expected True, False or a list of marker names, got {markers!r}") from None
     out = []
     for name in names:
         hits = [t for t in every if isinstance(name, str) and (t[0] == name or t[1].name == name)]

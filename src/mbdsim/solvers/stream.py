@@ -322,7 +322,7 @@ def _load_checkpoint(path, fp, digests):
                              f"({differ}); run without resume to start afresh")
         if str(z["fingerprint"]) != fp:
             raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (times, "
-                             "tolerances or initial state differ); run without resume to start afresh")
+                             "tolerances, initial state or marker columns differ); run without resume to start afresh")
         prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
                 z["ylast"].copy(), prev)
