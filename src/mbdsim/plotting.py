@@ -1,7 +1,8 @@
 """Time-history plots of a Result (or of its exported DataFrame) with matplotlib.
 
 `plot(res, signal, x=None, ax=None, **kw)` draws curves against time [s], or against another signal
-given as `x`, with axis labels carrying SI units, and marks the run's events with vertical lines.
+given as `x`, with axis labels carrying SI units (signals of different units on separate y axes), and
+marks the run's events with vertical lines.
 A signal is one of:
 
 * a callable of the Result, e.g. ``lambda r: r.joint_coordinate("pin")``: when it returns a Result
