@@ -87,8 +87,36 @@ def test_events_marked_as_vertical_lines(res):
         del res.events
 
 
+def test_different_units_get_separate_labelled_axes(res):
+    import matplotlib.pyplot as plt
+
+    ax = mb.plot(res, ["pin.angle", "rod.x", "rod.y", "pin.angle_rate"])
+    axes = ax.figure.axes
+    assert ax is axes[0] and len(axes) == 3                        # rad, m, rad/s
+    assert [a.get_ylabel() for a in axes] == ["pin.angle [rad]", "[m]", "pin.angle_rate [rad/s]"]
+    assert [len(a.lines) for a in axes] == [1, 2, 1] and axes[-1].get_xlabel() == "time [s]"
+    plt.close(ax.figure)
+    fig, ax = plt.subplots()
+    out = mb.plot(res, ["pin.angle", "rod.x"], ax=ax)               # given axes: a twin on the right
+    assert out is ax and len(fig.axes) == 2
+    assert ax.get_ylabel() == "pin.angle [rad]" and fig.axes[1].get_ylabel() == "rod.x [m]"
+    assert len(mb.plot(res, ["rod.x", "rod.y"]).figure.axes) == 1    # one unit, one axis
+    plt.close("all")
+
+
+def test_unknown_column_names_at_most_ten_closest(res):
+    df = res.to_dataframe()
+    assert len(df.columns) > 20
+    with pytest.raises(mb.ModelError) as e:
+        match_column(df.columns, "rod.vel")
+    msg = str(e.value)
+    listed = [c for c in df.columns if repr(c) in msg]
+    assert f"the closest of the {len(df.columns)} columns" in msg and 1 <= len(listed) <= 10
+    assert "'rod.vx [m/s]'" in msg and "'pin.Tz [N m]'" not in msg
+
+
 def test_bad_signal_errors(res):
-    with pytest.raises(mb.ModelError, match="valid columns"):
+    with pytest.raises(mb.ModelError, match="matches no column; the closest"):
         mb.plot(res, "crank")
     with pytest.raises(mb.ModelError, match="one value .* per output time"):
         mb.plot(res, lambda r: 1.0)
@@ -116,8 +144,11 @@ def test_cli_plot_csv_parquet(res, tmp_path):
     r = cli("plot", str(tmp_path / "r.csv"), "rod.y", "--x", "rod.x", "-o", str(tmp_path / "f.svg"))
     assert r.exit_code == 0, r.output
     assert "<svg" in (tmp_path / "f.svg").read_text()
-    r = cli("plot", str(tmp_path / "r.csv"), "crank", "-o", str(tmp_path / "g.png"))
-    assert r.exit_code == 2 and "valid columns" in r.output and "'pin.angle [rad]'" in r.output
+    r = cli("plot", str(tmp_path / "r.csv"), "pin.angel", "-o", str(tmp_path / "g.png"))
+    assert r.exit_code == 2 and "closest" in r.output and "'pin.angle [rad]'" in r.output
+    assert "--list" in r.output and r.output.count("'") <= 2 * 10 + 2   # ten names at most, and the signal
+    r = cli("plot", str(tmp_path / "r.csv"), "--list")
+    assert r.exit_code == 0 and r.output.split("\n")[0] == "time [s]" and "pin.angle [rad]" in r.output
     assert r.exception is None or isinstance(r.exception, SystemExit)
     assert not (tmp_path / "g.png").exists()
     r = cli("plot", str(tmp_path / "missing.csv"), "rod.x")

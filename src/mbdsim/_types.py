@@ -32,7 +32,7 @@ MassShape = Union["Box", "Cylinder", "Sphere"]       # geometry giving mass prop
 TimeFunction = Union[float, str, Callable[[float], float]]   # a number, an expression in t, or f(t)
 Load = Union[ArrayLike, str, Callable[..., ArrayLike]]       # constant, expression or f(t, state)
 Signal = Union[str, Callable[["Result"], ArrayLike]]         # a column name or a measure of a Result
-Progress = Union[Callable[[float], Any], None]               # progress(t [s])
+Progress = Union[Callable[[float], Any], bool, None]         # progress(t [s]), True: a progress bar
 PathLike = Union[str, "os.PathLike[str]"]
 ModelOrName = Union["Model", PathLike]
 

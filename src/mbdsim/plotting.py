@@ -1,7 +1,8 @@
 """Time-history plots of a Result (or of its exported DataFrame) with matplotlib.
 
 `plot(res, signal, x=None, ax=None, **kw)` draws curves against time [s], or against another signal
-given as `x`, with axis labels carrying SI units, and marks the run's events with vertical lines.
+given as `x`, with axis labels carrying SI units (signals of different units on separate y axes), and
+marks the run's events with vertical lines.
 A signal is one of:
 
 * a callable of the Result, e.g. ``lambda r: r.joint_coordinate("pin")``: when it returns a Result
@@ -70,10 +71,14 @@ def split_unit(name: str) -> tuple[str, str]:
     return (m.group(1), m.group(2)) if m else (str(name), "")
 
 
+MAX_LISTED = 10    # columns named in an error message, at most
+
+
 def match_column(columns: Sequence[str], name: str) -> str:
     """The column of `columns` that `name` designates: exact, then case-insensitive ignoring the unit
-    suffix, then a unique case-insensitive prefix of the unit-less name.  Raises ModelError listing
-    the valid columns when nothing (or more than one column) matches."""
+    suffix, then a unique case-insensitive prefix of the unit-less name.  Raises ModelError naming the
+    columns when nothing (or more than one column) matches: all of them when there are at most
+    MAX_LISTED, else the MAX_LISTED closest (`closest_columns`)."""
     cols = [str(c) for c in columns]
     if name in cols:
         return name
@@ -86,10 +91,25 @@ def match_column(columns: Sequence[str], name: str) -> str:
     if len(pref) == 1:
         return pref[0]
     if len(pref) > 1:
+        more = f" and {len(pref) - MAX_LISTED} more" if len(pref) > MAX_LISTED else ""
         raise ModelError(f"signal {name!r}", "signal", "is ambiguous, it matches the columns "
-                         + ", ".join(repr(c) for c in pref))
-    raise ModelError(f"signal {name!r}", "signal", "matches no column; valid columns: "
-                     + ", ".join(repr(c) for c in cols))
+                         + ", ".join(repr(c) for c in pref[:MAX_LISTED]) + more)
+    if len(cols) <= MAX_LISTED:
+        raise ModelError(f"signal {name!r}", "signal", "matches no column; valid columns: "
+                         + ", ".join(repr(c) for c in cols))
+    raise ModelError(f"signal {name!r}", "signal", f"matches no column; the closest of the {len(cols)} columns: "
+                     + ", ".join(repr(c) for c in closest_columns(cols, name)) + " (all: the table's .columns)")
+
+
+def closest_columns(columns: Sequence[str], name: str, n: int = MAX_LISTED) -> list[str]:
+    """The n columns closest to `name` (unit-less, case-insensitive): those containing it first, then
+    by difflib's similarity ratio."""
+    import difflib
+    key = split_unit(name)[0].strip().lower()
+    bases = {str(c): split_unit(str(c))[0].strip().lower() for c in columns}
+    hits = [c for c, b in bases.items() if key and key in b]
+    ranked = sorted(bases, key=lambda c: -difflib.SequenceMatcher(None, key, bases[c]).ratio())
+    return list(dict.fromkeys(hits[:n] + ranked))[:n]
 
 
 class _Recorder:
@@ -244,9 +264,12 @@ def plot(res: Result | pd.DataFrame, signal: SignalSpec | Sequence[SignalSpec], 
     """Plot one signal or a list of signals of a Result (or of a DataFrame from `res.to_dataframe()` /
     a results file) against time [s], or against the signal `x`; returns the matplotlib Axes.
 
-    Vector signals (N, 3) give one curve per component.  Vertical dotted lines mark the run's events
-    (`event_times`) when `events` is true and curves are against time.  Extra keyword arguments go to
-    `Axes.plot`.  Never calls `plt.show()`.
+    Signals of different units get separate y axes, each labelled with its unit (a signal of unknown
+    unit shares the first signal's axis): stacked subplots
+    sharing x (the first Axes is returned, all are in `ax.figure.axes`), or, when `ax` is given, twin
+    axes on its right.  Vector signals (N, 3) give one curve per component.  Vertical dotted lines mark
+    the run's events (`event_times`) when `events` is true and curves are against time.  Extra keyword
+    arguments go to `Axes.plot`.  Never calls `plt.show()`.
     """
     specs = list(signal) if isinstance(signal, list) else [signal]
     if not specs:
@@ -256,20 +279,44 @@ def plot(res: Result | pd.DataFrame, signal: SignalSpec | Sequence[SignalSpec], 
     xs = resolve(res, x, frame) if x is not None else Signal("time", "s", _time(res))
     if xs.values.ndim != 1:
         raise ModelError("plot", "x", f"must be a scalar signal, {xs.title} has shape {xs.values.shape}")
+    groups: dict[str, list[Signal]] = {}
+    for s in sigs:     # one y axis per unit, in the order given; a signal of unknown unit joins the first
+        groups.setdefault(s.unit or next(iter(groups), ""), []).append(s)
+    axes = _axes(ax, len(groups), kw)
+    marks = event_times(res) if events and x is None else []
+    for k, (a, group) in enumerate(zip(axes, groups.values())):
+        color = {} if ax is None or len(groups) == 1 else {"color": f"C{k}"}
+        for s in group:
+            _draw(a, xs.values, s, len(group) > 1, {**color, **kw} if len(group) == 1 else kw)
+        a.set_ylabel(_ylabel(group))
+        if ax is not None and len(groups) > 1 and len(group) == 1:
+            a.yaxis.label.set_color(color["color"])
+        if sum(1 if s.values.ndim == 1 else s.values.shape[1] for s in group) > 1:
+            a.legend(fontsize="small")
+        for t in marks if a is axes[0] or ax is None else ():
+            a.axvline(t, color="0.5", lw=0.8, ls=":", zorder=0)
+    (axes[0] if ax is not None else axes[-1]).set_xlabel(xs.title)
+    axes[0].grid(True, alpha=0.3)
+    for a in axes[1:] if ax is None else ():
+        a.grid(True, alpha=0.3)
+    return axes[0]
+
+
+def _axes(ax, n: int, kw) -> list:
+    """n y axes: `ax` and n - 1 twins on its right (spines 60 pt apart), or without `ax` a new figure of n
+    stacked subplots sharing x."""
     if ax is None:
         plt = _pyplot()
-        _, ax = plt.subplots(figsize=kw.pop("figsize", (7.0, 4.0)), layout="constrained")
-    for s in sigs:
-        _draw(ax, xs.values, s, len(sigs) > 1, kw)
-    ax.set_xlabel(xs.title)
-    ax.set_ylabel(_ylabel(sigs))
-    if sum(1 if s.values.ndim == 1 else s.values.shape[1] for s in sigs) > 1:
-        ax.legend(fontsize="small")
-    if events and x is None:
-        for t in event_times(res):
-            ax.axvline(t, color="0.5", lw=0.8, ls=":", zorder=0)
-    ax.grid(True, alpha=0.3)
-    return ax
+        w, h = kw.pop("figsize", (7.0, 4.0 if n == 1 else 2.2 * n + 0.6))
+        _, axs = plt.subplots(n, 1, sharex=True, squeeze=False, figsize=(w, h), layout="constrained")
+        return list(axs[:, 0])
+    out = [ax]
+    for k in range(1, n):
+        tw = ax.twinx()
+        if k > 1:
+            tw.spines["right"].set_position(("outward", 60 * (k - 1)))
+        out.append(tw)
+    return out
 
 
 def _draw(ax, xv, s: Signal, several: bool, kw):

@@ -263,6 +263,10 @@ from mbdsim.cli import run_cmds as _run_cmds  # noqa: E402 - run, info, schema (
 
 _run_cmds.register(app)
 
+from mbdsim.cli import analysis_cmds as _analysis_cmds  # noqa: E402 - kinematics, statics, modes (model files)
+
+_analysis_cmds.register(app)
+
 from mbdsim.cli import study_cmds as _study_cmds  # noqa: E402 - study (parameter studies on Dask)
 
 _study_cmds.register(app)

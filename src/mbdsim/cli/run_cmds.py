@@ -2,12 +2,14 @@
 
 Commands::
 
-    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--resume] [--debug]
+    mbdsim run MODEL --end T [--step DT] [--method M] [--rtol R] [--out results.parquet|.csv] [--resume]
+               [--markers | --marker NAME...] [--debug]
 
 ``--out`` is written while the run goes, so an interrupted or killed run leaves a readable file with what it
 computed: a .parquet output of the compiled core is a Parquet dataset streamed in parts with checkpoints
 (bounded memory; ``--resume`` continues it bit-identically, see mbdsim.solvers.stream), otherwise the file
-is rewritten every few seconds, atomically (mbdsim.results.stream).
+is rewritten every few seconds, atomically (mbdsim.results.stream). ``--markers`` (every marker) or
+``--marker NAME`` add marker columns to it ("<body>.<marker>.x [m]" ..., results.export.marker_targets).
     mbdsim info MODEL [--debug]
     mbdsim schema [--out schema.json]
 
@@ -23,7 +25,7 @@ import sys
 import time
 import warnings
 from pathlib import Path
-from typing import Optional
+from typing import List, Optional
 
 import typer
 
@@ -32,6 +34,24 @@ OUT_SUFFIXES = (".parquet", ".csv")
 
 MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml or .json).")
 DEBUG_OPT = typer.Option(False, "--debug", help="Show the Python traceback of an error.")
+ALL_MARKERS_OPT = typer.Option(False, "--markers", help="Add every marker's columns to --out: "
+                               "<body>.<marker>.x [m] .y .z, orientation, velocity, acceleration.")
+MARKER_OPT = typer.Option(None, "--marker", metavar="NAME", show_default=False,
+                          help="Add this marker's columns to --out (name, or body.marker); repeat it or give "
+                          "a list: --marker tip,coupler.B.")
+
+
+def _markers(every: bool, names):
+    """The `markers` argument of the analyses from --markers / --marker (exit 2 without --out)."""
+    picked = [n for raw in names or () for n in str(raw).replace(" ", "").split(",") if n]
+    return True if every else (picked or False)
+
+
+def _note_markers(model, markers) -> None:
+    """Say so when --markers finds no marker in the model (the table then has none)."""
+    if markers is True and not any(b.markers for b in model.bodies.values()):
+        _console().print(f"note: --markers: model {model.name!r} has no markers (add them under a body's "
+                         "'markers:' in the model file)")
 
 
 def _console():
@@ -122,11 +142,15 @@ def run_cmd(
                                        "as the run goes (.parquet: a Parquet dataset streamed in parts)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run streamed to --out (.parquet) from its "
                                                         "last checkpoint (bit-identical to an uninterrupted run)."),
+    every_marker: bool = ALL_MARKERS_OPT,
+    marker: Optional[List[str]] = MARKER_OPT,
     debug: bool = DEBUG_OPT,
 ) -> None:
     """Simulate a model file and print a summary; optionally write the results table.
 
     Example: mbdsim run examples/slider_crank.yaml --end 2 --step 0.01 --out results.parquet
+
+    With --markers (or --marker NAME) the table has marker columns, e.g. rod.tip.y [m] for mbdsim plot.
 
     Exit status: 0 ok, 1 analysis failed, 2 bad input or model file, 130 interrupted."""
     if out is not None and out.suffix.lower() not in OUT_SUFFIXES:
@@ -136,30 +160,27 @@ def run_cmd(
     stream = out is not None and out.suffix.lower() == ".parquet"
     if resume and not stream:
         _fail("--resume needs --out FILE.parquet (the streamed run to continue)", EXIT_BAD_INPUT)
-    _guard(lambda: _run(model, end, step, method, rtol, out, stream, resume), debug)
+    markers = _markers(every_marker, marker)
+    if markers is not False and out is None:
+        _fail("--markers / --marker add columns to the results table: give --out FILE", EXIT_BAD_INPUT)
+    _guard(lambda: _run(model, end, step, method, rtol, out, stream, resume, markers), debug)
 
 
-def _run(path, end, step, method, rtol, out, stream=False, resume=False):
+def _run(path, end, step, method, rtol, out, stream=False, resume=False, markers=False):
     import mbdsim as mb
-    from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
     from mbdsim.errors import AnalysisInterrupted
     from mbdsim.io.summary import summarize
     m = _load(path)
-    if _kernels_cold():
-        _console().print("note: first run of this mbdsim version: compiling its numba kernels (once, cached "
-                         "on disk; a few minutes on a slow machine)")
+    _note_cold()
+    _note_markers(m, markers)
     summary = summarize(m)
     dof, n_redundant, redundant = _rank_dof(m)
-    console = _console()
     t0 = time.perf_counter()
-    with warnings.catch_warnings(), Progress(TextColumn(f"simulating {m.name}"), BarColumn(), TextColumn("t = {task.completed:.4g} s"),
-                  TimeElapsedColumn(), console=console, transient=True) as bar:
+    with warnings.catch_warnings(), _bar(f"simulating {m.name}", end) as bar:
         warnings.simplefilter("ignore", mb.RedundantConstraintWarning)   # reported in the summary
-        task = bar.add_task("run", total=end)
         res = mb.simulate(m, end_time=end, output_step=step, method=method, rtol=rtol, out=_writable(out),
-                          progress=lambda t: bar.update(task, completed=min(float(t), end)), resume=resume)
-        bar.update(task, completed=float(res.time[-1]))
+                          progress=bar, resume=resume, markers=markers)
     wall = time.perf_counter() - t0
     stats = res.stats or {}
     rows = [("model", f"{m.name} ({path})"), *_mobility(summary, dof, n_redundant, redundant),
@@ -174,6 +195,18 @@ def _run(path, end, step, method, rtol, out, stream=False, resume=False):
     if not res.success:
         interrupted = "KeyboardInterrupt" in str(getattr(res, "error", ""))
         raise typer.Exit(EXIT_INTERRUPTED if interrupted else EXIT_FAILED)
+
+
+def _bar(label: str, end: float):
+    """The progress bar of a run from 0 to end [s] on stderr (mbdsim._progress; nothing outside a terminal)."""
+    from mbdsim._progress import ProgressBar
+    return ProgressBar(label, 0.0, end, console=_console())
+
+
+def _note_cold() -> None:
+    if _kernels_cold():
+        _console().print("note: first run of this mbdsim version: compiling its numba kernels (once, cached "
+                         "on disk; a few minutes on a slow machine)")
 
 
 def _kernels_cold() -> bool:
@@ -202,12 +235,13 @@ def _writable(out: Optional[Path]) -> Optional[Path]:
 
 def _print_table(title, rows, headers=("", "")):
     from rich.console import Console
+    from rich.markup import escape
     from rich.table import Table
-    t = Table(title=title, show_header=any(headers), header_style="bold")
-    for h in headers:
-        t.add_column(h)
+    t = Table(title=escape(title), show_header=any(headers), header_style="bold")
+    for h in headers:                 # plain text: "x [m]" is not rich markup
+        t.add_column(escape(h))
     for r in rows:
-        t.add_row(*r)
+        t.add_row(*(escape(str(c)) for c in r))
     Console(highlight=False, width=None if sys.stdout.isatty() else 120).print(t)
 
 

@@ -3,6 +3,7 @@
 Commands::
 
     mbdsim plot RESULTS SIGNAL... [--x SIGNAL] -o fig.png|svg|pdf
+    mbdsim plot RESULTS --list
     mbdsim animate MODEL|RESULTS -o anim.html [--end T] [--signal SIGNAL]
 
 RESULTS is a .csv or .parquet file written from ``res.to_dataframe()``; SIGNAL a column name, matched
@@ -46,11 +47,14 @@ def read_results(path: Path):
 
 def plot_cmd(
     results: Path = typer.Argument(..., metavar="RESULTS", help="Results file (.csv or .parquet from res.to_dataframe())."),
-    signals: List[str] = typer.Argument(..., metavar="SIGNAL...", help="Column names to plot (lenient match)."),
+    signals: Optional[List[str]] = typer.Argument(None, metavar="SIGNAL...", show_default=False,
+                                                  help="Column names to plot (lenient match)."),
     x: Optional[str] = typer.Option(None, "--x", metavar="SIGNAL", help="Plot against this column instead of time."),
     out: Path = typer.Option(Path("fig.png"), "--out", "-o", metavar="FILE", help="Figure file: .png, .svg or .pdf."),
+    list_columns: bool = typer.Option(False, "--list", "-l", help="Print the file's columns and exit."),
 ) -> None:
-    """Plot columns of a results file against time (or against --x) into a PNG/SVG/PDF figure.
+    """Plot columns of a results file against time (or against --x) into a PNG/SVG/PDF figure; signals
+    of different units get separate y axes (stacked), each labelled with its unit.
 
     Example: mbdsim plot r.parquet slider.x --x crank_pin.angle -o x.png
 
@@ -58,13 +62,19 @@ def plot_cmd(
     if out.suffix.lower() not in FIGURE_SUFFIXES:
         _fail(f"--out {str(out)!r}: expected a .png, .svg or .pdf file")
     df = read_results(results)
+    if list_columns:
+        typer.echo("\n".join(str(c) for c in df.columns))
+        return
+    if not signals:
+        _fail(f"give the columns to plot (mbdsim plot {results} --list shows them)")
     from mbdsim.errors import ModelError
     from mbdsim.plotting import plot
 
     try:
         ax = plot(df, list(signals), x=x)
     except ModelError as exc:
-        _fail(str(exc))
+        hint = f"; list them all: mbdsim plot {results} --list" if "matches no column" in str(exc) else ""
+        _fail(str(exc).replace(" (all: the table's .columns)", "") + hint)
     ax.set_title(results.name)
     try:
         out.parent.mkdir(parents=True, exist_ok=True)

@@ -9,7 +9,8 @@ bodies          "<body>.x [m]" .y .z (centre of mass); rigid bodies "<body>.qw [
                 "<body>.ZYX_1 [rad]" _2 _3 (continuous in time); "<body>.vx [m/s]" .vy .vz; rigid
                 "<body>.wx [rad/s]" .wy .wz; with accelerations "<body>.ax [m/s^2]" .ay .az and rigid
                 "<body>.alphax [rad/s^2]" .alphay .alphaz
-markers         with `markers=True`, for every marker of every body, "<body>.<marker>.x [m]" .y .z,
+markers         with `markers=True` for every marker of every body (or markers=["tip", "coupler.B"] for those
+                named, by marker name or "<body>.<marker>"), "<body>.<marker>.x [m]" .y .z,
                 rigid "<body>.<marker>.qw [-]" .qx .qy .qz, "<body>.<marker>.vx [m/s]" ..., and
                 "<body>.<marker>.ax [m/s^2]" ... (its angular motion is its body's)
 joints          coordinates and rates as Result.joint_coordinate / joint_velocity:
@@ -133,6 +134,35 @@ def _element_columns(res, el):
     return {f"{name}.{'torque [N m]' if torque else 'force [N]'}": res.spring_force(el)}
 
 
+def marker_targets(bodies, markers, entity="to_dataframe"):
+    """[(column prefix "<body>.<marker>", Marker)] that `markers` selects among the markers of `bodies`:
+    none for False / None, all for True, else those named in a list (a name "B" or "coupler.B"; a bare
+    name must be unique). ModelError naming `entity`.markers for an unknown or ambiguous name."""
+    from ..errors import ModelError
+    if markers is None or markers is False:
+        return []
+    every = [(f"{b.name}.{mk.name}", mk) for b in bodies if not getattr(b, "is_ground", False)
+             for mk in b.markers.values()]
+    if markers is True:
+        return every
+    names = [markers] if isinstance(markers, str) else markers
+    try:
+        names = list(names)
+    except TypeError:
+        raise ModelError(entity, "markers",
+                         f"expected True, False or a list of marker names, got {markers!r}") from None
+    out = []
+    for name in names:
+        hits = [t for t in every if isinstance(name, str) and (t[0] == name or t[1].name == name)]
+        if len(hits) != 1:
+            known = ", ".join(t[0] for t in every) or "none (the model has no markers)"
+            why = "is ambiguous (give <body>.<marker>)" if hits else "names no marker"
+            raise ModelError(entity, "markers", f"{name!r} {why}; markers: {known}")
+        if hits[0] not in out:
+            out.append(hits[0])
+    return out
+
+
 def to_dataframe(res, markers=False, euler=None):
     """Wide pandas DataFrame of a Result (columns: see the module docstring), SI units in the names."""
     import pandas as pd
@@ -145,10 +175,8 @@ def columns(res, markers=False, euler=None):
     cols = {"time [s]": np.asarray(res.time, dtype=float)}
     for body in res.system.bodies:
         cols.update(_frame_columns(res, body, body.name, not body.is_particle, euler))
-    if markers:
-        for body in res.system.bodies:
-            for mk in body.markers.values():
-                cols.update(_frame_columns(res, mk, f"{body.name}.{mk.name}", not body.is_particle, euler))
+    for prefix, mk in marker_targets(res.system.bodies, markers):
+        cols.update(_frame_columns(res, mk, prefix, not mk.body.is_particle, euler))
     model = res.system.model
     for joint in model.joints.values():
         cols.update(_joint_columns(res, joint))

@@ -24,7 +24,7 @@ if TYPE_CHECKING:
     from scipy.spatial.transform import Rotation
     from .._types import Array, BodyRef, FrameRef, JointRef, PathLike, Signal, Target
     from numpy.typing import ArrayLike
-    from typing import Any
+    from typing import Any, Sequence
     import pandas as pd
 
 
@@ -441,21 +441,22 @@ class Result:
         return extremum(self, signal, sign)
 
     # ------------------------------------------------------------ export
-    def to_dataframe(self, markers: bool = False, euler: str | None = None) -> pd.DataFrame:
+    def to_dataframe(self, markers: bool | Sequence[str] = False, euler: str | None = None) -> pd.DataFrame:
         """Wide pandas DataFrame, one row per output time, SI units in the column names
         ("crank.x [m]", "pin.angle [rad]", "pin.Fx [N]"): body positions, orientations (Euler parameters
         "<body>.qw [-]" ..., and Euler angles "<body>.ZYX_1 [rad]" ... when `euler` names a scipy
         sequence), velocities, accelerations; every joint's coordinates, rates and reactions; driver
-        efforts; force-element forces; marker columns when `markers=True`.  The naming is listed in
-        full in `mbdsim.results.export`."""
+        efforts; force-element forces; marker columns "<body>.<marker>.x [m]" ... when `markers=True` (every
+        marker) or a list of names ("tip" or "<body>.<marker>").  The naming is listed in full in
+        `mbdsim.results.export`."""
         from .export import to_dataframe
         return to_dataframe(self, markers=markers, euler=euler)
 
-    def to_parquet(self, path: PathLike, markers: bool = False, euler: str | None = None) -> None:
+    def to_parquet(self, path: PathLike, markers: bool | Sequence[str] = False, euler: str | None = None) -> None:
         """Write `to_dataframe(markers, euler)` to a Parquet file (pyarrow); read back with pandas."""
         self.to_dataframe(markers=markers, euler=euler).to_parquet(path, index=False)
 
-    def to_csv(self, path: PathLike, markers: bool = False, euler: str | None = None) -> None:
+    def to_csv(self, path: PathLike, markers: bool | Sequence[str] = False, euler: str | None = None) -> None:
         """Write `to_dataframe(markers, euler)` to a CSV file (header = column names, no index)."""
         self.to_dataframe(markers=markers, euler=euler).to_csv(path, index=False)
 

@@ -41,7 +41,8 @@ class ProgressError(EvaluationError):
 def check_progress(progress, entity: str) -> None:
     """ModelError naming `entity`.progress unless progress is None or callable (checked before any work)."""
     if progress is not None and not callable(progress):
-        raise ModelError(entity, "progress", f"expected a callable progress(t) or None, got {progress!r}")
+        raise ModelError(entity, "progress", f"expected True, False, None or a callable progress(t) of the time "
+                         f"reached [s], got {progress!r}")
 
 
 def notify(progress, t, build=None) -> None:
@@ -117,7 +118,8 @@ def check_replaceable(path: Path, entity: str = "simulate") -> None:
 class ResultFile:
     """The results table of one run, rewritten on disk as the run goes (see the module docstring)."""
 
-    def __init__(self, path, entity="simulate"):
+    def __init__(self, path, entity="simulate", markers=False):
+        self.markers = markers     # marker columns: results.export.marker_targets
         try:
             self.path = Path(os.fspath(path))
         except TypeError:
@@ -142,9 +144,9 @@ class ResultFile:
         tmp = self.path.with_name(f".{self.path.name}.partial")
         if self.path.suffix.lower() == ".parquet":   # pyarrow directly: no pandas import to write
             from .export import columns
-            write_parquet(columns(res), tmp)
+            write_parquet(columns(res, self.markers), tmp)
         else:
-            res.to_dataframe().to_csv(tmp, index=False)
+            res.to_dataframe(markers=self.markers).to_csv(tmp, index=False)
         os.replace(tmp, self.path)
         self.writes += 1
         self.last = time.monotonic()
@@ -175,13 +177,14 @@ class RunMonitor:
         self.file.offer(build)
 
 
-def run_writing(run, progress, out, entity):
+def run_writing(run, progress, out, entity, markers=False):
     """`run(progress)` (an analysis taking a progress argument) with its results written to `out` as it goes
-    (None: just run it). The final file is the complete Result's table, also when the run stopped early."""
+    (None: just run it), with the marker columns `markers` selects (results.export.marker_targets). The
+    final file is the complete Result's table, also when the run stopped early."""
     check_progress(progress, entity)
     if out is None:
         return run(progress)
-    file = ResultFile(out, entity)
+    file = ResultFile(out, entity, markers)
     monitor = RunMonitor(progress, file, entity)
     try:
         res = run(monitor)

@@ -27,6 +27,7 @@ from .kinematic import check_model, time_grid
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from typing import Sequence
     from .._types import PathLike, Progress
     from ..model.model import Model
 
@@ -45,7 +46,7 @@ TIGHT = 1e-6        # "auto" on a model the compiled core does not carry: below 
 def simulate(model: Model, end_time: float, output_step: float | None = None, method: str | None = None,
              rtol: float | None = None, atol: float | None = None, max_step: float | None = None,
              start_time: float = 0.0, progress: Progress = None, out: PathLike | None = None,
-             resume: bool = False, monitor: bool = True) -> Result:
+             resume: bool = False, monitor: bool = True, markers: bool | Sequence[str] = False) -> Result:
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
@@ -63,9 +64,10 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
-    progress: optional callable progress(t) receiving the simulated time reached [s] now and then (not
-    callable: ModelError before any work; an exception it raises ends the run like any failure below,
-    res.error a ProgressError naming analysis.progress).
+    progress: True shows a progress bar of the simulated time on stderr (rich, redrawn at most 10 times a
+    second, mbdsim._progress); a callable progress(t) receives the simulated time reached [s] now and then
+    (an exception it raises ends the run like any failure below, res.error a ProgressError naming
+    analysis.progress); None or False: nothing; anything else is a ModelError before any work.
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
     element, field and time (EvaluationError, SolverError, AnalysisInterrupted), the Result holding
@@ -81,22 +83,40 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     resume=True continues it from its last checkpoint, bit-identical to an uninterrupted run
     (mbdsim.solvers.stream). Otherwise `res.to_dataframe()` of the outputs so far is rewritten every few
     seconds, atomically, and completely at the end (mbdsim.results.stream); `pandas.read_parquet(out)`
-    reads either.
+    reads either. markers: the marker columns of the out= table, as `res.to_dataframe(markers=...)`: True
+    every marker's, or a list of names ("tip" or "<body>.<marker>"); ModelError for an unknown name.
     monitor=True (default): constraint violation, energy balance and contact penetration are checked on
     the output samples (after the run, or after every part of a streamed run); the first exceedance of
     each warns (MonitorWarning naming time, quantity and element) and `res.diagnostics` keeps the history
     (mbdsim.results.diagnostics)."""
-    from ..results.diagnostics import monitor as run_monitors
-    from ..results.stream import check_progress, run_writing
+    from .._progress import progress_of
     if not isinstance(resume, bool):
         raise ModelError("simulate", "resume", f"expected True or False, got {resume!r}")
+    _check_markers(model, markers, "simulate")
+    with progress_of(progress, "simulate", f"simulating {getattr(model, 'name', '')}", start_time, end_time) as p:
+        return _simulate_out(model, end_time, output_step, method, rtol, atol, max_step, start_time, p, out, resume,
+                             monitor, markers)
+
+
+def _check_markers(model, markers, entity) -> None:
+    """ModelError naming entity.markers unless `markers` selects markers of `model` (export.marker_targets)."""
+    from ..results.export import marker_targets
+    if markers is not None and markers is not False:
+        marker_targets(getattr(model, "bodies", {}).values(), markers, entity)
+
+
+def _simulate_out(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress, out, resume,
+                  monitor, markers=False) -> Result:
+    """`simulate` once progress is None or a callable: the streamed or whole-file writer, then the monitors."""
+    from ..results.diagnostics import monitor as run_monitors
+    from ..results.stream import check_progress, run_writing
     check_progress(progress, "simulate")
     res = None
     if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith(".parquet") and \
             (method is None or str(method).lower() in ("auto",) + COMPILED_METHODS) and USE_COMPILED:
         try:
             res = _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress, out,
-                            resume, monitor)
+                            resume, monitor, markers)
         except NotStreamable:
             pass
     if res is None:
@@ -104,7 +124,8 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
             raise ModelError("simulate", "resume", "resuming needs out= a .parquet path and the compiled DOP853 "
                              "(method 'auto' or 'dop853' on a model the compiled kernels carry)")
         res = run_writing(lambda p: _simulate(model, end_time, output_step, method, rtol, atol, max_step,
-                                              start_time, p, None, False, monitor), progress, out, "simulate")
+                                              start_time, p, None, False, monitor), progress, out, "simulate",
+                          markers)
     if monitor and res.diagnostics is None:
         res.diagnostics = run_monitors(res)
     return res
@@ -115,7 +136,7 @@ class NotStreamable(Exception):
 
 
 def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=None, max_step=None,
-              start_time=0.0, progress=None, out=None, resume=False, monitor=True) -> Result:
+              start_time=0.0, progress=None, out=None, resume=False, monitor=True, markers=False) -> Result:
     """The analysis of `simulate` (its docstring has the arguments), without the monitors; with `out`, the
     streamed compiled run (NotStreamable when the model needs another path)."""
     check_model(model)
@@ -142,7 +163,8 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
     check_initial_contacts(sys, rep.q, rep.v)
     if out is not None:
-        return _streamed(sys, rep, times, method, user_rtol, user_atol, max_step, progress, out, resume, monitor)
+        return _streamed(sys, rep, times, method, user_rtol, user_atol, max_step, progress, out, resume, monitor,
+                         markers)
     if method == "auto":
         rt, at = _tolerances("auto", user_rtol, user_atol)
         try:
@@ -181,7 +203,8 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
 
 
-def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
+def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resume, monitor=True,
+              markers=False) -> Result:
     """simulate(out=...parquet): the compiled DOP853 streamed to disk in parts (mbdsim.solvers.stream);
     NotStreamable when the model needs another path (nothing written yet)."""
     from . import stream
@@ -192,7 +215,7 @@ def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resu
         rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
     try:
         return _with_history(stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume,
-                                                    monitor), times[0])
+                                                    monitor, markers), times[0])
     except NotCompiled as exc:
         raise NotStreamable(str(exc)) from None
 

@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from ..model.model import Model
+    from typing import Sequence
     from .._types import PathLike, Progress
 
 
@@ -35,13 +36,16 @@ class SingularConfigurationWarning(UserWarning):
 
 @blas_single_thread
 def kinematics(model: Model, end_time: float, output_step: float | None = None, start_time: float = 0.0,
-               progress: Progress = None, out: PathLike | None = None) -> Result:
+               progress: Progress = None, out: PathLike | None = None,
+               markers: bool | Sequence[str] = False) -> Result:
     """Kinematic analysis from start_time to end_time [s], sampled every output_step [s].
 
-    progress: optional callable progress(t) receiving the time reached [s] after each sample; Ctrl-C or
-    an exception it raises returns the partial Result (success=False; res.error a ProgressError naming
-    analysis.progress), a non-callable is a ModelError before any work. out: optional .parquet / .csv path that
-    `res.to_dataframe()` is written to while the run goes and at the end (see mbdsim.results.stream).
+    progress: True shows a progress bar on stderr (as `simulate`); a callable progress(t) receives the time
+    reached [s] after each sample; Ctrl-C or an exception it raises returns the partial Result
+    (success=False; res.error a ProgressError naming analysis.progress); None or False: nothing; anything
+    else is a ModelError before any work. out: optional .parquet / .csv path that
+    `res.to_dataframe(markers=markers)` is written to while the run goes and at the end (see
+    mbdsim.results.stream; markers: True every marker's columns, or a list of names, as `simulate`).
 
     The conditioning of the constraint Jacobian (with drivers, columns weighted by the bodies' masses
     and inertias, rows normalised) is monitored: samples where it falls below SINGULAR_TOL are recorded
@@ -51,9 +55,14 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
     A model the compiled core carries that passes no singular configuration is solved by the compiled
     kinematic sweep (mbdsim.solvers.kinsweep, the same equations; res.stats["method"] "kinematic
     (compiled sweep)"), with progress told each sample's time once the sweep is done."""
+    from .._progress import progress_of
     from ..results.stream import run_writing
-    return run_writing(lambda p: _kinematics(model, end_time, output_step, start_time, p), progress, out,
-                       "kinematics")
+    from .dynamic import _check_markers
+    _check_markers(model, markers, "kinematics")
+    with progress_of(progress, "kinematics", f"kinematics of {getattr(model, 'name', '')}", start_time,
+                     end_time) as bar:
+        return run_writing(lambda p: _kinematics(model, end_time, output_step, start_time, p), bar, out,
+                           "kinematics", markers)
 
 
 def _kinematics(model, end_time, output_step, start_time, progress) -> Result:

@@ -43,6 +43,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from ..model.model import Model
+    from .._types import Progress
 
 DELTA_MAX = 1.0     # largest trust radius: 1 rad of rotation or L of translation per step
 FD_STEP = 1e-6      # central-difference step of the reduced stiffness (dimensionless z)
@@ -90,28 +91,36 @@ def equilibrium(model: Model, t: float = 0.0, tol: float = 1e-10, maxit: int = 1
 
 @blas_single_thread
 def quasi_static(model: Model, end_time: float, output_step: float | None = None, start_time: float = 0.0,
-                 tol: float = 1e-10, maxit: int = 100) -> Result:
+                 tol: float = 1e-10, maxit: int = 100, progress: Progress = None) -> Result:
     """Quasi-static analysis: the static equilibrium at each output time from start_time to end_time [s]
     (every output_step [s]) of a mechanism whose motions move it; each solve starts from the previous one.
+    progress: True shows a progress bar on stderr, a callable progress(t) receives each solved time [s]
+    (an exception it raises ends the run as a failure does, res.error a ProgressError), None or False
+    nothing (as `simulate`).
 
     Inertia and velocity-dependent forces are neglected: velocities and accelerations are reported zero,
     reactions and driver efforts are those that hold the mechanism in equilibrium at each time.
     `res.stats["stable"]` is a bool array per sample. A failure stops the run: the Result keeps every
     sample before it (`success` False, `message`, `error`)."""
+    from .._progress import progress_of
+    from ..results.stream import ProgressError, notify
     from .kinematic import check_model, time_grid
-    check_model(model)
-    sys = assemble_system(model)
-    rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), start_time)
-    times, sf = time_grid(start_time, end_time, output_step), state_factory(sys)
-    sols, q, error = [], rep.q, None
-    for t in times:
-        try:
-            q = _onto(sys, q, t, rep.rows)
-            sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit))
-        except SolverError as exc:
-            error = exc
-            break
-        q = sols[-1].q
+    with progress_of(progress, "quasi_static", f"quasi-static {getattr(model, 'name', '')}", start_time,
+                     end_time) as bar:     # a bad progress value: ModelError before any work
+        check_model(model)
+        sys = assemble_system(model)
+        rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), start_time)
+        times, sf = time_grid(start_time, end_time, output_step), state_factory(sys)
+        sols, q, error = [], rep.q, None
+        for t in times:
+            try:
+                q = _onto(sys, q, t, rep.rows)
+                sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit))
+                notify(bar, t)
+            except (SolverError, ProgressError) as exc:
+                error = exc
+                break
+            q = sols[-1].q
     _warn_unstable(sols)
 
     def evaluate(ts):

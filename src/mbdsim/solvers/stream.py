@@ -100,25 +100,28 @@ def write_part(path: Path, index: int, cols: dict) -> None:
     _atomic(path / f"part-{index:06d}.parquet", lambda p: results_stream.write_parquet(cols, p))
 
 
-def fingerprint(sys, rep, times, rtol, atol, max_step) -> str:
-    """Hash of what makes two runs the same computation (settings, grid, model size, initial state)."""
+def fingerprint(sys, rep, times, rtol, atol, max_step, markers=()) -> str:
+    """Hash of what makes two runs the same computation (settings, grid, model size, initial state) and
+    the same table (the marker columns `markers`: their prefixes)."""
     h = hashlib.sha1()
     for a in (np.asarray([times[0], times[-1], len(times), rtol, atol, max_step or 0.0, sys.nq, sys.nv, sys.nc]),
               np.asarray(times[:2]), np.asarray(rep.q, float), np.asarray(rep.v, float), np.asarray(rep.rows)):
         h.update(np.ascontiguousarray(a, dtype=float).tobytes())
     h.update(",".join(sorted(sys.model.bodies)).encode())
     h.update(",".join(sorted(sys.model.joints)).encode())
+    if markers:
+        h.update(("markers:" + ",".join(markers)).encode())
     return h.hexdigest()
 
 
 # ----------------------------------------------------------------------------- tables
-def chunk_columns(res, prev_row):
+def chunk_columns(res, prev_row, markers=False):
     """The `to_dataframe()` columns of a chunk's Result ({name: array}, see results.export.columns); with
     prev_row (the previous chunk's last table row, {name: float}, also the chunk's first sample), angle
     columns continue it (multiples of 2 pi) and Euler parameters keep its sign, and that first row is
-    dropped."""
+    dropped. markers: the marker columns (results.export.marker_targets)."""
     from ..results.export import columns
-    cols = columns(res)
+    cols = columns(res, markers)
     if prev_row is None:
         return cols
     for col, x in cols.items():
@@ -137,7 +140,7 @@ def chunk_columns(res, prev_row):
     return {k: v[1:] for k, v in cols.items()}
 
 
-def part_columns(result_of, n: int, prev_row):
+def part_columns(result_of, n: int, prev_row, markers=False):
     """`chunk_columns` of a part's n outputs, computed in blocks of at most COLUMN_ROWS + 1 outputs joined as
     parts are (a block's first output repeats the previous block's last): the per-sample work arrays
     (frames, accelerations, the Jacobians behind the reactions) stay bounded by a block, not a part.
@@ -146,7 +149,7 @@ def part_columns(result_of, n: int, prev_row):
     while True:
         e = min(s + COLUMN_ROWS + 1, n)
         res = result_of(s, e)
-        blocks.append(chunk_columns(res, prev_row if s == 0 else last_row(blocks[-1])))
+        blocks.append(chunk_columns(res, prev_row if s == 0 else last_row(blocks[-1]), markers))
         res._fr = None   # break the Result <-> lazy frames cycle: the block's arrays go now, not at a GC
         if e >= n:
             break
@@ -162,7 +165,8 @@ def last_row(cols: dict) -> dict:
 
 
 # ----------------------------------------------------------------------------- compiled streaming
-def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True) -> Result:
+def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True,
+                    markers=False) -> Result:
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
     raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
@@ -176,7 +180,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     path = prepare(out, resume)
     a, w = run.cm.arrays(), run.work.arrays()
     y0 = np.concatenate([rep.q, rep.v])
-    fp = fingerprint(sys, rep, times, rtol, atol, max_step)
+    from ..results.export import marker_targets
+    fp = fingerprint(sys, rep, times, rtol, atol, max_step, [p for p, _ in marker_targets(sys.bodies, markers)])
     from ..system.fingerprint import model_digests
     digests = model_digests(sys.model)
     state = _load_checkpoint(path, fp, digests) if resume else None
@@ -248,7 +253,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         def result_of(s, e, ts=tout, Yc=rows):
             return Result(sys, ts[s:e], Yc[s:e, :sys.nq], Yc[s:e, sys.nq:], None, None,
                           accelerations=lambda: accelerations(ts[s:e], Yc[s:e]))
-        cols = part_columns(result_of, len(tout), prev_row)
+        cols = part_columns(result_of, len(tout), prev_row, markers)
         cres = Result(sys, tout, rows[:, :sys.nq], rows[:, sys.nq:], None, None, accelerations=accelerations)
         if monitor:   # history kept as one entry per chunk (its extremes): bounded memory
             n_t, n_c = (0, 0) if diag is None else (len(diag.time), len(diag.constraint_time))
@@ -318,7 +323,7 @@ def _load_checkpoint(path, fp, digests):
                              f"({differ}); run without resume to start afresh")
         if str(z["fingerprint"]) != fp:
             raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (times, "
-                             "tolerances or initial state differ); run without resume to start afresh")
+                             "tolerances, initial state or marker columns differ); run without resume to start afresh")
         prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
                 z["ylast"].copy(), prev)
@@ -336,11 +341,11 @@ def _differences(theirs, ours) -> str:
 
 
 # ----------------------------------------------------------------------------- in-memory fallback
-def write_result(res: Result, out) -> Result:
+def write_result(res: Result, out, markers=False) -> Result:
     """Write a Result computed in memory in the same layout (parts of CHUNK_ROWS rows, no checkpoint)."""
     from ..results.export import columns
     path = prepare(out, resume=False)
-    cols = columns(res)
+    cols = columns(res, markers)
     n = len(cols["time [s]"])
     for k, start in enumerate(range(0, max(n, 1), CHUNK_ROWS)):
         write_part(path, k, {c: v[start:start + CHUNK_ROWS] for c, v in cols.items()})
