@@ -67,6 +67,11 @@ def _kin(*args, **kw):
     return lambda m: mb.kinematics(m, *args, **kw)
 
 
+class _Junk:
+    """Not a force element, though it has a name."""
+    name = "junk"
+
+
 B, J, MO = "body 'x'", "joint 'j'", "motion 'd'"
 API_CASES = [
     # bodies: mass properties, states
@@ -179,6 +184,11 @@ API_CASES = [
     ("sim-end-1e12-max-step", _sim(1e12, max_step=1e-2), ModelError, "simulate", "max_step"),
     ("sim-outputs-budget-streamed", _sim(1e12, 1e-2, out="run.parquet"), ModelError, "simulate", "output_step"),
     ("sim-outputs-budget-csv", _sim(1e9, 1.0, out="run.csv"), ModelError, "simulate", "output_step"),
+    # issue 35: refused at once, not a bare exception later (ZeroDivisionError, TypeError at simulate)
+    ("sim-empty-model", lambda m: mb.simulate(mb.Model("e"), 1.0), ModelError, "model 'e'", "bodies"),
+    ("kin-empty-model", lambda m: mb.kinematics(mb.Model("e"), 1.0, 0.1), ModelError, "model 'e'", "bodies"),
+    ("element-not-an-element", lambda m: m.add_element(_Junk()), ModelError, "element 'junk'", "type"),
+    ("element-a-string", lambda m: m.add_element("junk"), ModelError, "element 'junk'", "name"),
 ]
 
 BASE_FILE = {

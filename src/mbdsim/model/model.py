@@ -295,8 +295,21 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
 
     # ----------------------------------------------------------------- helpers
     def add_element(self, element: Any) -> Any:
-        """Register a force element built elsewhere (must have a unique `name`)."""
-        self._claim(element.name, type(element).__name__)
+        """Register a force element built elsewhere: a spec of mbdsim.model (Bushing, SpringDamper, ...) or
+        an object with its own generalized(sys, frames, elem, t, state) method; it must have a unique
+        `name`.  Anything else is refused here (ModelError naming the element), not at simulate."""
+        from ..system.force_elements import EVALUATORS, friction, loads  # noqa: F401  (all registered)
+        name = getattr(element, "name", None)
+        what = type(element).__name__
+        if not isinstance(name, str):
+            raise ModelError(f"element {element!r:.60}", "name", f"a force element needs a string `name`; "
+                             f"got a {what} without one")
+        if not any(cls in EVALUATORS for cls in type(element).__mro__) and \
+                not callable(getattr(element, "generalized", None)):
+            raise ModelError(f"element '{name}'", "type", f"a {what} is not a force element (build elements "
+                             "with the Model.add_* methods, or give the object a method "
+                             "generalized(sys, frames, elem, t, state))")
+        self._claim(name, what)
         self.forces[element.name] = element
         return element
 

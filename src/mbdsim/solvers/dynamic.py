@@ -118,7 +118,7 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
               start_time=0.0, progress=None, out=None, resume=False, monitor=True) -> Result:
     """The analysis of `simulate` (its docstring has the arguments), without the monitors; with `out`, the
     streamed compiled run (NotStreamable when the model needs another path)."""
-    check_model(model)
+    check_model(model, "simulate")
     method = "auto" if method is None else method
     if not isinstance(method, str):
         raise ModelError("simulate", "method", f"expected a method name, got {method!r}")

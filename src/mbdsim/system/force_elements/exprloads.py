@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import ModelError
+from ...errors import EvaluationError
 from ...model.forces import ExprForce, ExprTorque, JointForce, LineForce
 from ...model.loadexpr import LoadExpr
 from .. import exprmeasures
@@ -43,8 +43,14 @@ def value(sys, fr, elem, v, t, state) -> float:
     else:
         return float(v)
     if not np.isfinite(out):
-        raise ModelError(f"load '{elem.name}'", "value", f"evaluates to {out} at t = {t} s")
+        what, field = _ENTITY.get(type(elem), ("load", "value"))
+        raise EvaluationError(f"{what} '{elem.name}'", field, f"evaluates to {out}", time=float(t))
     return out
+
+
+# the entity and field of each expression load as named when it was added (Model.add_force ...)
+_ENTITY = {ExprForce: ("force", "force"), ExprTorque: ("torque", "torque"), LineForce: ("line force", "magnitude"),
+           JointForce: ("joint force", "value")}
 
 
 class _Angles:
