@@ -314,8 +314,14 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
         return element
 
     def _claim(self, name, what):
-        if not isinstance(name, str) or not name:
-            raise ModelError(f"{what} {name!r}", "name", "must be a non-empty string")
+        """Reserve `name` for a new entity (ModelError naming it when taken or not a valid name, see
+        loadexpr.check_name: bodies, particles and joints are read by expressions)."""
+        from .loadexpr import check_name
+        check_name(f"{what} {name!r}", name, what in ("body", "particle", "joint"))
+        if what == "joint" and (name.endswith("_dot") and name[:-4] in self.joints or f"{name}_dot" in self.joints):
+            raise ModelError(f"{what} {name!r}", "name", "expressions read a joint's rate as <joint>_dot: a joint "
+                             f"{name!r} and a joint {name[:-4] if name.endswith('_dot') else name + '_dot'!r} "
+                             "cannot both be in the model")
         if name in self._names:
             raise ModelError(f"{what} '{name}'", "name", "an entity of this name already exists in the model")
         self._names.add(name)
