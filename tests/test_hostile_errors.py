@@ -117,3 +117,32 @@ def test_empty_model_is_refused_before_any_work():
         with pytest.raises(ModelError) as err:
             run(mb.Model("empty"))
         assert (err.value.entity, err.value.field) == ("model 'empty'", "bodies")
+
+
+def test_json_duplicate_keys_are_refused_naming_file_line_and_key(tmp_path):
+    text = '{"name": "x",\n "bodies": [{"name": "b", "mass": 1,\n   "inertia": [1, 1, 1],\n   "mass": 2}]}\n'
+    err = _load_error(tmp_path, "m.json", text)
+    assert (err.field, err.line) == ("mass", 4) and "duplicate key 'mass'" in str(err)
+    err = _load_error(tmp_path, "t.json", '{"name": "x",\t"name": "y", "bodies": []}')   # (not YAML: no line)
+    assert err.field == "name" and "duplicate key 'name'" in str(err)
+
+
+# ----------------------------------------------------------------------------- silently accepted before
+@pytest.mark.parametrize("returned", [("1", "0", "0"), (1.0, "0", 0.0), [True, 0, 0]])
+def test_a_load_callable_returning_text_fails_the_run_naming_it(returned):
+    m = pendulum()
+    m.add_force("f", (m.bodies["rod"], (0, 0, 0)), lambda t, s: (0.0, 0.0, 0.0) if t < 0.05 else returned)
+    try:
+        res = mb.simulate(m, 0.2, 0.05)
+        assert not res.success
+        err = res.error
+    except EvaluationError as exc:
+        err = exc
+    assert isinstance(err, EvaluationError) and (err.entity, err.field) == ("force 'f'", "force")
+
+
+def test_a_zero_length_spring_between_coincident_points_runs():
+    m = pendulum()   # free length and preload zero: force stiffness * (p_j - p_i), continuous at zero length
+    m.add_spring_damper("s", (m.bodies["rod"], (0, -1, 0)), (m.ground, (0, -1, 0)), stiffness=50.0)
+    res = mb.simulate(m, 0.5, 0.1)
+    assert res.success and abs(res.joint_coordinate("pin")).max() < 1e-9   # (at rest: hanging, unstretched)

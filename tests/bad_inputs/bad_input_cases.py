@@ -209,6 +209,19 @@ API_CASES = [
     ("marker-name-dotted", lambda m: m.bodies["rod"].add_marker("a.b", (0, 0, 0)), ModelError, "marker 'rod.a.b'",
      "name"),
     ("spring-name-dotted", _spring_named("k.1"), ModelError, "spring 'k.1'", "name"),
+    # issue 35: silently accepted before
+    ("body-mass-text", _b(mass="2"), ModelError, B, "mass"),
+    ("body-position-text", _b(position=("0", "1", "0")), ModelError, B, "position"),
+    ("body-inertia-text", _b(inertia=["1", "1", "1"]), ModelError, B, "inertia"),
+    ("sim-end-true", _sim(True), ModelError, "analysis", "end_time"),
+    ("sim-end-text", _sim("1.0"), ModelError, "analysis", "end_time"),
+    ("sim-step-true", _sim(1.0, True), ModelError, "analysis", "output_step"),
+    ("sim-max-step-text", _sim(1.0, max_step="0.1"), ModelError, "simulate", "max_step"),
+    ("sim-start-false", _sim(1.0, start_time=False), ModelError, "simulate", "start_time"),
+    ("spring-coincident-free-length", _spring(at_j=("ground", (0, -1, 0)), free_length=0.5), ModelError,
+     "spring 's'", "at_j"),
+    ("spring-coincident-preload", _spring(at_j=("ground", (0, -1, 0)), free_length=0.0, preload=3.0), ModelError,
+     "spring 's'", "at_j"),
 ]
 
 BASE_FILE = {

@@ -277,7 +277,12 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
         """Translational spring-damper between two points (Marker or (body, point in ground at t=0)).
 
         stiffness [N/m], damping [N s/m], free_length [m] (None = initial distance), preload [N]:
-        tension = stiffness (L - free_length) + damping dL/dt + preload, positive pulling together."""
+        tension = stiffness (L - free_length) + damping dL/dt + preload, positive pulling together.
+
+        The tension acts along the line between the points, which has no direction where they coincide:
+        at zero length the element applies no force. Points that coincide at t=0 are therefore refused
+        (ModelError naming at_j) unless free_length and preload are zero (a zero-length spring, whose
+        force stiffness * (p_j - p_i) is continuous there)."""
         entity = f"spring '{name}'"
         self._claim(name, "spring")
         try:
@@ -286,7 +291,12 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
             c = scalar(entity, "damping", damping, minimum=0.0)
             L0 = float(np.linalg.norm(mj.point - mi.point)) if free_length is None else \
                 scalar(entity, "free_length", free_length, minimum=0.0)
-            s = SpringDamper(name, mi, mj, k, c, L0, scalar(entity, "preload", preload))
+            P = scalar(entity, "preload", preload)
+            gap = float(np.linalg.norm(mj.point - mi.point))
+            if gap <= 1e-12 * (1.0 + float(np.abs(mi.point).max())) and (L0 > 0.0 or P != 0.0):
+                raise ModelError(entity, "at_j", f"the points coincide at t=0 (length {gap:.3g} m): the "
+                                 f"direction of a tension of free_length {L0:g} m, preload {P:g} N is undefined")
+            s = SpringDamper(name, mi, mj, k, c, L0, P)
         except ModelError:
             self._names.discard(name)
             raise

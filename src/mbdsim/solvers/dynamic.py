@@ -276,8 +276,11 @@ def _check_budget(model, t0, t1, step, max_step=None, in_memory=True):
 
 
 def _number(field, value) -> float:
-    """A finite number for simulate.<field>, else ModelError."""
+    """A finite number for simulate.<field>, else ModelError (a boolean or text is not a number)."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(value):
+            raise TypeError
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError("simulate", field, f"expected a number, got {value!r}") from None
@@ -288,7 +291,10 @@ def _number(field, value) -> float:
 
 def _positive(field, value, strict=True, finite=True) -> float:
     """A solver setting > 0 (>= 0 when not strict), else ModelError naming simulate.<field>."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(value):
+            raise TypeError
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError("simulate", field, f"expected a number, got {value!r}") from None

@@ -202,13 +202,18 @@ def check_model(model, analysis: str | None = None):
 
 def time_grid(t0, t1, step):
     """Output times from t0 to t1 inclusive with spacing step (default (t1-t0)/500) [s]."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(t1):
+            raise TypeError
         t1 = float(t1)
     except (TypeError, ValueError):
         raise ModelError("analysis", "end_time", f"expected a number, got {t1!r}") from None
     if not np.isfinite(t1) or t1 <= t0:
         raise ModelError("analysis", "end_time", f"must be greater than the start time {t0}, got {t1!r}")
     try:
+        if not_a_number(step):
+            raise TypeError
         step = (t1 - t0) / 500 if step is None else float(step)
     except (TypeError, ValueError):
         raise ModelError("analysis", "output_step", f"expected a number, got {step!r}") from None

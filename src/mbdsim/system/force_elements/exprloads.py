@@ -39,7 +39,14 @@ def value(sys, fr, elem, v, t, state) -> float:
             return xd if rate else x
         out = float(exprmeasures.evaluate(sys, fb, v, t, joint_value)[0])
     elif callable(v):
-        out = float(np.asarray(v(t, state), dtype=float).reshape(-1)[0])
+        from ..guard import as_numbers
+        what, field = _ENTITY.get(type(elem), ("load", "value"))
+        got = v(t, state)
+        try:
+            out = float(as_numbers(got).reshape(-1)[0])
+        except (TypeError, ValueError, IndexError):
+            raise EvaluationError(f"{what} '{elem.name}'", field, f"callable returned {got!r}, not a number",
+                                  time=float(t)) from None
     else:
         return float(v)
     if not np.isfinite(out):
