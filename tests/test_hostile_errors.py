@@ -146,3 +146,24 @@ def test_a_zero_length_spring_between_coincident_points_runs():
     m.add_spring_damper("s", (m.bodies["rod"], (0, -1, 0)), (m.ground, (0, -1, 0)), stiffness=50.0)
     res = mb.simulate(m, 0.5, 0.1)
     assert res.success and abs(res.joint_coordinate("pin")).max() < 1e-9   # (at rest: hanging, unstretched)
+
+
+# ----------------------------------------------------------------------------- initial velocities of welded bodies
+def _welded(**given):
+    m = mb.Model("weld", gravity=(0.0, -9.81, 0.0))
+    base = m.add_body("base", 2.0, inertia=(0.1, 0.1, 0.1), **given)
+    m.add_fixed("weld", m.ground, base, (0, 0, 0))
+    rod = m.add_body("rod", 1.0, inertia=(0.08, 1e-4, 0.08), position=(0.3, -0.5, 0.0))
+    m.add_revolute("pin", base, rod, (0.3, 0, 0), (0, 0, 1), initial_velocity=1.0)
+    return m
+
+
+@pytest.mark.parametrize("given", [dict(angular_velocity=(0.0, 0.0, 5.0)), dict(velocity=(1.0, 2.0, 0.0)),
+                                   dict(angular_velocity=(3.0, -1.0, 5.0), velocity=(0.0, 0.0, 4.0))])
+def test_a_welded_body_given_velocities_takes_the_welds(given):
+    ref = mb.simulate(_welded(), 1.0, 0.05)
+    with pytest.warns(mb.InitialConditionWarning, match="body 'base'"):
+        res = mb.simulate(_welded(**given), 1.0, 0.05)
+    assert res.success, res.message   # (before: the child started at 1e15 m/s and the run failed at t = 0)
+    assert abs(res.angular_velocity("base")).max() < 1e-9 and abs(res.velocity("base")).max() < 1e-9
+    assert abs(res.joint_coordinate("pin") - ref.joint_coordinate("pin")).max() < 1e-8
