@@ -167,3 +167,25 @@ def test_a_welded_body_given_velocities_takes_the_welds(given):
     assert res.success, res.message   # (before: the child started at 1e15 m/s and the run failed at t = 0)
     assert abs(res.angular_velocity("base")).max() < 1e-9 and abs(res.velocity("base")).max() < 1e-9
     assert abs(res.joint_coordinate("pin") - ref.joint_coordinate("pin")).max() < 1e-8
+
+
+# ----------------------------------------------------------------------------- dissipated energy, reference path
+def test_dissipated_energy_of_an_hht_run_is_quick_and_balances():
+    import time
+    m = mb.Model("fourbar", gravity=(0.0, -9.81, 0.0), planar=True)
+    crank = m.add_body("crank", 1.0, inertia=(0.1, 0.1, 0.1), position=(0.0, 0.5, 0.0))
+    coupler = m.add_body("coupler", 1.0, inertia=(0.1, 0.1, 0.1), position=(1.0, 1.0, 0.0))
+    rocker = m.add_body("rocker", 1.0, inertia=(0.1, 0.1, 0.1), position=(2.0, 0.5, 0.0))
+    m.add_revolute("A", m.ground, crank, (0, 0, 0), (0, 0, 1), initial_velocity=3.0)
+    m.add_revolute("B", crank, coupler, (0, 1, 0), (0, 0, 1))
+    m.add_revolute("C", coupler, rocker, (2, 1, 0), (0, 0, 1))
+    m.add_revolute("D", rocker, m.ground, (2, 0, 0), (0, 0, 1))
+    m.add_spring_damper("k", (coupler, (1.0, 1.0, 0)), (m.ground, (1.0, -1.0, 0)), stiffness=50.0, damping=2.0,
+                        free_length=1.5)
+    res = mb.simulate(m, 1.0, 0.01, method="hht")
+    assert res.success and res.stats["method"] == "HHT"
+    t0 = time.monotonic()
+    D = res.dissipated_energy()   # (before: every Chebyshev point a Newton solve through Result.at, ~60 s)
+    assert time.monotonic() - t0 < 2.0
+    E = res.kinetic_energy() + res.potential_energy()
+    assert D[-1] > 1.0 and abs((E[0] - E[-1]) - D[-1]) < 1e-3 * D[-1]
