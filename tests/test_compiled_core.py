@@ -106,7 +106,7 @@ def test_particles_and_free_bodies():
     p = m.add_particle("p", 0.7, position=(0.5, 0, 0))
     m.add_spherical("s", m.ground, p, (0.5, 0, 0))
     q = m.add_particle("q", 0.4, position=(0.9, 0.1, 0))
-    m.add_translational("t", p, q, (0.9, 0.1, 0), (1, 1, 0))
+    m.add_translational("tr", p, q, (0.9, 0.1, 0), (1, 1, 0))
     free = _body(m, "free", (0, 1, 0))
     m.add_spring_damper("k", q, free, 10.0, 0.1, 0.5)
     _compare(m)

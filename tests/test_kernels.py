@@ -22,14 +22,14 @@ def mixed_model():
                      velocity=rng.normal(size=3)) for k in range(5)]
     p = m.add_particle("p", 1.0, position=(0.3, 0.2, 0.1), velocity=(1, 2, 3))
     m.add_revolute("r", m.ground, bs[0], (0.1, 0.2, 0.3), (0.3, 0.4, 0.5))
-    m.add_translational("t", bs[0], bs[1], (0.5, 0.2, 0.3), (1, 0.4, 0.5))
+    m.add_translational("tr", bs[0], bs[1], (0.5, 0.2, 0.3), (1, 0.4, 0.5))
     m.add_cylindrical("c", bs[1], bs[2], (0.5, 0.7, 0.3), (1, 0.4, -0.5))
     m.add_universal("u", bs[2], bs[3], (0.5, 0.7, 0.9), (1, 0, 0), (0, 1, 0))
     m.add_fixed("f", bs[3], bs[4], (0.2, 0.1, 0.0))
     m.add_spherical("s", bs[4], p, (0.3, 0.2, 0.1))
     m.add_planar("pl", bs[3], p, (0.3, 0.2, 0.1), (0, 0, 1))
     m.add_motion("m1", "r", displacement="0.3*sin(2*t)")
-    m.add_motion("m2", "t", displacement="0.1*t**2")
+    m.add_motion("m2", "tr", displacement="0.1*t**2")
     m.add_motion("m3", "c", displacement="0.2*t", dof="rotation")
     return m
 

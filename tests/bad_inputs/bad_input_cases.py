@@ -23,10 +23,14 @@ def base_model():
     return m
 
 
-def _b(**kw):
+def _b(name="x", **kw):
     base = dict(mass=1.0, inertia=(1.0, 1.0, 1.0))
     base.update(kw)
-    return lambda m: m.add_body("x", **base)
+    return lambda m: m.add_body(name, **base)
+
+
+def _spring_named(name):
+    return lambda m: m.add_spring_damper(name, (m.bodies["rod"], (0, -1, 0)), (m.ground, (0, -2, 0)), 10.0)
 
 
 def _rev(**kw):
@@ -65,6 +69,11 @@ def _sim(*args, **kw):
 
 def _kin(*args, **kw):
     return lambda m: mb.kinematics(m, *args, **kw)
+
+
+class _Junk:
+    """Not a force element, though it has a name."""
+    name = "junk"
 
 
 B, J, MO = "body 'x'", "joint 'j'", "motion 'd'"
@@ -179,6 +188,40 @@ API_CASES = [
     ("sim-end-1e12-max-step", _sim(1e12, max_step=1e-2), ModelError, "simulate", "max_step"),
     ("sim-outputs-budget-streamed", _sim(1e12, 1e-2, out="run.parquet"), ModelError, "simulate", "output_step"),
     ("sim-outputs-budget-csv", _sim(1e9, 1.0, out="run.csv"), ModelError, "simulate", "output_step"),
+    # issue 35: refused at once, not a bare exception later (ZeroDivisionError, TypeError at simulate)
+    ("sim-empty-model", lambda m: mb.simulate(mb.Model("e"), 1.0), ModelError, "model 'e'", "bodies"),
+    ("kin-empty-model", lambda m: mb.kinematics(mb.Model("e"), 1.0, 0.1), ModelError, "model 'e'", "bodies"),
+    ("element-not-an-element", lambda m: m.add_element(_Junk()), ModelError, "element 'junk'", "type"),
+    ("element-a-string", lambda m: m.add_element("junk"), ModelError, "element 'junk'", "name"),
+    # issue 35: names that expressions would shadow (time, constants, functions) or that hide a marker
+    ("body-name-t", _b(name="t"), ModelError, "body 't'", "name"),
+    ("body-name-dotted", _b(name="rod.tip"), ModelError, "body 'rod.tip'", "name"),
+    ("particle-name-pi", lambda m: m.add_particle("pi", 1.0), ModelError, "particle 'pi'", "name"),
+    ("joint-name-TIME", lambda m: m.add_revolute("TIME", "ground", "block", (0, 0, 0), (0, 0, 1)), ModelError,
+     "joint 'TIME'", "name"),
+    ("joint-name-sin", lambda m: m.add_revolute("sin", "ground", "block", (0, 0, 0), (0, 0, 1)), ModelError,
+     "joint 'sin'", "name"),
+    ("joint-name-step", lambda m: m.add_revolute("STEP", "ground", "block", (0, 0, 0), (0, 0, 1)), ModelError,
+     "joint 'STEP'", "name"),
+    ("joint-name-rate-clash", lambda m: m.add_revolute("pin_dot", "ground", "block", (0, 0, 0), (0, 0, 1)),
+     ModelError, "joint 'pin_dot'", "name"),
+    ("marker-name-DX", lambda m: m.bodies["rod"].add_marker("DX", (0, 0, 0)), ModelError, "marker 'rod.DX'", "name"),
+    ("marker-name-dotted", lambda m: m.bodies["rod"].add_marker("a.b", (0, 0, 0)), ModelError, "marker 'rod.a.b'",
+     "name"),
+    ("spring-name-dotted", _spring_named("k.1"), ModelError, "spring 'k.1'", "name"),
+    # issue 35: silently accepted before
+    ("body-mass-text", _b(mass="2"), ModelError, B, "mass"),
+    ("body-position-text", _b(position=("0", "1", "0")), ModelError, B, "position"),
+    ("body-inertia-text", _b(inertia=["1", "1", "1"]), ModelError, B, "inertia"),
+    ("sim-end-true", _sim(True), ModelError, "analysis", "end_time"),
+    ("sim-end-text", _sim("1.0"), ModelError, "analysis", "end_time"),
+    ("sim-step-true", _sim(1.0, True), ModelError, "analysis", "output_step"),
+    ("sim-max-step-text", _sim(1.0, max_step="0.1"), ModelError, "simulate", "max_step"),
+    ("sim-start-false", _sim(1.0, start_time=False), ModelError, "simulate", "start_time"),
+    ("spring-coincident-free-length", _spring(at_j=("ground", (0, -1, 0)), free_length=0.5), ModelError,
+     "spring 's'", "at_j"),
+    ("spring-coincident-preload", _spring(at_j=("ground", (0, -1, 0)), free_length=0.0, preload=3.0), ModelError,
+     "spring 's'", "at_j"),
 ]
 
 BASE_FILE = {
@@ -231,4 +274,9 @@ FILE_CASES = [
     ("file-mass-power-tower", ("bodies.0.mass", "9**9**9 kg"), ModelFileError, R, "mass"),
     ("file-mass-power-overflow", ("bodies.0.mass", "2**10000 kg"), ModelFileError, R, "mass"),
     ("file-stiffness-unit-power", ("forces.0.stiffness", "1 N/m**9**9**9"), ModelFileError, K, "stiffness"),
+    # issue 35: reserved and dotted names
+    ("file-body-name-pi", ("bodies.1.name", "pi"), ModelFileError, "body 'pi'", "name"),
+    ("file-body-name-dotted", ("bodies.1.name", "rod.tip"), ModelFileError, "body 'rod.tip'", "name"),
+    ("file-joint-name-t", ("joints.0.name", "t"), ModelFileError, "joint 't'", "name"),
+    ("file-marker-name-TIME", ("bodies.0.markers.0.name", "TIME"), ModelFileError, "marker 'rod.TIME'", "name"),
 ]

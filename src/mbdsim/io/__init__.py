@@ -69,7 +69,11 @@ def save_model(model: Model, path: PathLike) -> Path:
     """Write `model` to `path` as YAML or JSON (by extension) in SI units; returns the path.
 
     Raises ModelError naming the element when the model holds a Python callable."""
+    from ..errors import ModelError
+    from ..model.model import Model as _Model
     from .files import file_kind, write
+    if not isinstance(model, _Model):
+        raise ModelError("save_model", "model", f"expected an mbdsim.Model, got {type(model).__name__}")
     file_kind(Path(path), f"model '{model.name}'")
     return write(model_to_dict(model), path)
 

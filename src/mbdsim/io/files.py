@@ -1,9 +1,12 @@
 """Reading and writing model files: YAML (safe loader only, no tags) and JSON, chosen by extension.
 
 YAML is composed into a node tree first: every key's line is recorded (for error messages), any tag
-other than the plain YAML types (``!!python/object``, ``!custom``...) and duplicate keys are refused,
-and only then is the tree turned into plain data by the safe constructor.  Nothing in a model file
-can run code.
+other than the plain YAML types (``!!python/object``, ``!custom``...), duplicate keys, nesting deeper
+than MAX_DEPTH levels and integers of more than MAX_DIGITS digits are refused, and only then is the
+tree turned into plain data by the safe constructor.  Nothing in a model file can run code.  JSON is
+held to the same rules: duplicate keys, deep nesting and huge integers are refused (naming the file,
+and the line where it can be found), never taken silently (last key wins) or left to a bare
+RecursionError or ValueError.
 
 Only a regular file of at most MAX_BYTES (20 MB; model files are kilobytes) is read: a FIFO, a device
 (a link to /dev/zero), a directory or a larger file is refused before reading, naming the file (opened
@@ -45,6 +48,9 @@ def _item_name(node) -> str | None:
 
 
 MAX_NODES = 200_000   # YAML aliases re-use nodes: a "billion laughs" file expands past any budget
+MAX_DEPTH = 64        # nesting levels of lists and mappings (a model file has about 6)
+MAX_DIGITS = 400      # digits of an integer (a float holds at most 309): Python refuses past 4300
+INT_TAG = "tag:yaml.org,2002:int"
 
 
 def _walk(node, path, marks, source, entity="model", budget=None):
@@ -60,9 +66,16 @@ def _walk(node, path, marks, source, entity="model", budget=None):
     if len(path) == 2 and isinstance(path[1], int):
         name = _item_name(node)
         entity = f"{SECTION_ENTITY.get(path[0], 'element')} " + (repr(name) if name else f"#{path[1] + 1}")
+    field = (lambda: field_text(path[2:] if len(path) > 2 else path) if entity != "model" or path
+             else "(top level)")
+    if len(path) > MAX_DEPTH:
+        raise ModelFileError(entity, field(), f"data nested deeper than {MAX_DEPTH} levels", source,
+                             node.start_mark.line + 1)
+    if node.tag == INT_TAG and len(node.value.lstrip("+-")) > MAX_DIGITS:
+        raise ModelFileError(entity, field(), f"an integer of {len(node.value.lstrip('+-'))} digits, larger than any number a "
+                             "model holds", source, node.start_mark.line + 1)
     if node.tag not in PLAIN_TAGS:
-        field = field_text(path[2:] if len(path) > 2 else path) if entity != "model" or path else "(top level)"
-        raise ModelFileError(entity, field, f"YAML tag {node.tag!r} is not allowed in a model file "
+        raise ModelFileError(entity, field(), f"YAML tag {node.tag!r} is not allowed in a model file "
                              "(plain data only, nothing is constructed or run)", source, node.start_mark.line + 1)
     if isinstance(node, yaml.MappingNode):
         seen = set()
@@ -95,6 +108,8 @@ def parse_yaml(text: str, source: str):
             raise ModelFileError("file", "(top level)", "the file is empty", source)
         _walk(node, (), marks, source)
         data = loader.construct_document(node)
+    except RecursionError:
+        raise ModelFileError("file", "(nesting)", f"data nested deeper than {MAX_DEPTH} levels", source) from None
     except yaml.YAMLError as exc:
         mark = getattr(exc, "problem_mark", None)
         problem = getattr(exc, "problem", None) or str(exc)
@@ -105,12 +120,55 @@ def parse_yaml(text: str, source: str):
     return data, marks
 
 
+class _Refused(Exception):
+    """A JSON document breaks a rule of _walk (duplicate key, huge integer): args = (field, message)."""
+
+
+def _json_object(pairs):
+    out = {}
+    for key, value in pairs:
+        if key in out:
+            raise _Refused(key, f"duplicate key {key!r}")
+        out[key] = value
+    return out
+
+
+def _json_int(text):
+    if len(text.lstrip("-")) > MAX_DIGITS:
+        raise _Refused("(number)", f"an integer of {len(text.lstrip('-'))} digits, larger than any number a "
+                       "model holds")
+    return int(text)
+
+
+def _depth(data) -> int:
+    """Nesting depth of lists and dicts in `data` (iterative: no recursion limit)."""
+    deepest, stack = 0, [(data, 0)]
+    while stack:
+        node, d = stack.pop()
+        deepest = max(deepest, d)
+        if isinstance(node, (list, dict)) and d <= MAX_DEPTH:
+            stack.extend((x, d + 1) for x in (node.values() if isinstance(node, dict) else node))
+    return deepest
+
+
 def parse_json(text: str, source: str):
-    """(data, marks) from JSON text; line marks come from reading the same text as YAML where it can."""
+    """(data, marks) from JSON text; line marks come from reading the same text as YAML where it can (and
+    so do the line, entity and field of a duplicate key or a huge integer)."""
     try:
-        data = json.loads(text)
+        data = json.loads(text, object_pairs_hook=_json_object, parse_int=_json_int)
     except json.JSONDecodeError as exc:
         raise ModelFileError("file", "(syntax)", f"JSON syntax error: {exc.msg}", source, exc.lineno) from None
+    except RecursionError:
+        raise ModelFileError("file", "(nesting)", f"data nested deeper than {MAX_DEPTH} levels", source) from None
+    except _Refused as exc:
+        try:
+            parse_yaml(text, source)
+        except ModelFileError as precise:
+            if exc.args[1] in str(precise) or exc.args[0] == "(number)" and "digits" in str(precise):
+                raise precise from None
+        raise ModelFileError("file", *exc.args, source) from None
+    if _depth(data) > MAX_DEPTH:
+        raise ModelFileError("file", "(nesting)", f"data nested deeper than {MAX_DEPTH} levels", source)
     try:
         _, marks = parse_yaml(text, source)
     except ModelFileError:
@@ -168,6 +226,8 @@ def read_bytes(path: Path, limit: int | None = None) -> bytes:
 def write(data: dict, path) -> Path:
     """Write model data as YAML or JSON (by extension); returns the path."""
     path = Path(path)
+    if _depth(data) > MAX_DEPTH:   # (what load_model would refuse; the dumpers would hit RecursionError)
+        raise ModelFileError("file", "(nesting)", f"data nested deeper than {MAX_DEPTH} levels", path.name)
     if file_kind(path) == "json":
         text = json.dumps(data, indent=2, allow_nan=False) + "\n"
     else:

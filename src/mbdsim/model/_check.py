@@ -25,6 +25,24 @@ def _has_bool(value) -> bool:
     return isinstance(value, (list, tuple)) and any(_has_bool(x) for x in value)
 
 
+def not_a_number(value) -> str | None:
+    """Why `value` (a number or a sequence of them, as given to the Python API) is not one that float()
+    should read: "a boolean" or "text" (float("2") and float(True) would succeed), else None."""
+    if type(value) in _NUMBERS:
+        return None
+    if _has_bool(value):
+        return "a boolean"
+    if isinstance(value, np.ndarray):
+        items = value.ravel() if value.dtype.kind == "O" else ()
+        if value.dtype.kind in "US":
+            return "text"
+    else:
+        items = value if isinstance(value, (list, tuple)) else ()
+    if isinstance(value, (str, bytes)) or any(not_a_number(x) == "text" for x in items):
+        return "text"
+    return None
+
+
 def _plain(x) -> bool:
     """A finite float, or an int that a float holds exactly (no booleans, no overflow)."""
     return (type(x) is float and math.isfinite(x)) or (type(x) is int and -2**53 <= x <= 2**53)
@@ -34,8 +52,9 @@ def vector(entity: str, field: str, value, n: int = 3, what: str = "") -> np.nda
     """A finite n-vector, else ModelError (`what` names the components in the message)."""
     if type(value) in (tuple, list) and len(value) == n and all(_plain(x) for x in value):
         return np.array(value, dtype=float)   # the common case: n plain finite numbers
-    if _has_bool(value):
-        raise ModelError(entity, field, f"expected {n} numbers, got a boolean in {value!r}")
+    bad = not_a_number(value)
+    if bad:
+        raise ModelError(entity, field, f"expected {n} numbers, got {bad} in {value!r}")
     try:
         v = np.asarray(value, dtype=float).reshape(-1)
     except (TypeError, ValueError, OverflowError):
@@ -62,6 +81,9 @@ def scalar(entity: str, field: str, value, minimum: float | None = None, strict:
     """A finite float, optionally bounded below, else ModelError (a boolean is not a number)."""
     if _has_bool(value):
         raise ModelError(entity, field, f"expected a number, got the boolean {value!r}")
+    if isinstance(value, (str, bytes)):
+        raise ModelError(entity, field, f"expected a number, got the text {value!r} (the Python API takes "
+                         "numbers in SI units; unit strings such as '2 kg' belong in model files)")
     try:
         x = float(value)
     except (TypeError, ValueError, OverflowError):
@@ -85,8 +107,9 @@ def inertia_matrix(entity: str, value, strict: bool = True) -> np.ndarray:
     and the triangle inequality of the principal moments (I1 + I2 >= I3, relative tolerance 1e-6),
     which every real mass distribution satisfies: a violation is a ModelError (strict=False, for
     callers that knowingly model such values, only warns with InertiaWarning)."""
-    if _has_bool(value):
-        raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got a boolean in {value!r}")
+    bad = not_a_number(value)
+    if bad:
+        raise ModelError(entity, "inertia", f"expected 3 numbers or a 3x3 matrix, got {bad} in {value!r}")
     try:
         a = np.asarray(value, dtype=float)
     except (TypeError, ValueError):

@@ -62,7 +62,9 @@ class Body:
 
     def add_marker(self, name: str, point: Vector | None = None, orientation: Orientation = None) -> Marker:
         """Add a frame fixed on this body; point [m] and orientation (marker->ground) in ground at t=0."""
+        from .loadexpr import check_name
         entity = f"marker '{self.name}.{name}'"
+        check_name(entity, name, True)
         if name in self.markers:
             raise ModelError(entity, "name", "a marker of this name already exists on the body")
         pt = self.position.copy() if point is None else vec3(entity, "point", point)

@@ -87,14 +87,14 @@ class CouplersMixin:
         "crank - 2*rocker" or "sin(j1) - 0.5*j2", and time t [s] (safe whitelist parser, never eval'd;
         its Jacobian and acceleration terms come from exact symbolic derivatives).  Joints: revolute,
         translational, screw (one coordinate each; angles in rad, continuous; slides in m)."""
-        from ..expressions import FUNCTIONS, LIBRARY_FUNCTIONS, ExpressionError, parse
+        from ..expressions import ExpressionError, parse
+        from .loadexpr import reserved_names
         entity = f"user constraint '{name}'"
         self._claim(name, "user constraint")
         try:
             if not isinstance(expression, str):
                 raise ModelError(entity, "expression", f"expected an expression string, got {expression!r}")
-            reserved = set(FUNCTIONS) | set(LIBRARY_FUNCTIONS) | {"pi", "t"}
-            names = [n for n in self.joints if n.isidentifier() and n not in reserved]
+            names = [n for n in self.joints if n.isidentifier() and n not in reserved_names()]
             try:
                 e = parse(expression, ("t", *names))
             except (ExpressionError, ValueError) as exc:

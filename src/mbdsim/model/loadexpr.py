@@ -153,11 +153,33 @@ def joint_variables(model) -> dict:
     return out
 
 
+def reserved_names() -> frozenset:
+    """The names the expression languages read as themselves: the time t and TIME [s], the constant pi,
+    the functions (sin ...), the Adams library (STEP ..., both cases) and the measures (DX ...)."""
+    from ..expressions import FUNCTIONS, LIBRARY_FUNCTIONS
+    return frozenset(FUNCTIONS) | frozenset(LIBRARY_FUNCTIONS) | frozenset(MEASURE_KIND) | {"pi", *TIME_NAMES}
+
+
+def check_name(entity: str, name, read_in_expressions: bool) -> None:
+    """ModelError(entity, "name") unless `name` is a non-empty string without '.' (which separates body
+    and marker: a body "rod.tip" would hide the marker tip of body rod) and, for the entities that
+    expressions read (bodies, markers, joints), not a reserved name (a joint "t" would be shadowed by
+    the time, a body "pi" by the constant)."""
+    if not isinstance(name, str) or not name:
+        raise ModelError(entity, "name", "must be a non-empty string")
+    if "." in name:
+        raise ModelError(entity, "name", f"{name!r} contains '.', which separates a body from its marker "
+                         "(body.marker) in references: choose another name")
+    if read_in_expressions and name in reserved_names():
+        raise ModelError(entity, "name", f"{name!r} is reserved by the expression language (time t and TIME, "
+                         "the constant pi, function and measure names): choose another name")
+
+
 def parse_load(model, text, entity, field, allow_acc=False) -> LoadExpr:
     """LoadExpr of `text` against the model's bodies, markers and joints; ModelError(entity, field) with
     the parser's message (which lists the valid names) when it does not parse."""
-    from ..expressions import FUNCTIONS, LIBRARY_FUNCTIONS, ExpressionError, parse
-    reserved = set(FUNCTIONS) | set(LIBRARY_FUNCTIONS) | set(MEASURE_KIND) | {"pi", *TIME_NAMES}
+    from ..expressions import ExpressionError, parse
+    reserved = reserved_names()
     joints = {v: m for v, m in joint_variables(model).items() if v not in reserved}
     hook = _Hook(model, allow_acc)
     try:

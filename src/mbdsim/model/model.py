@@ -277,7 +277,12 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
         """Translational spring-damper between two points (Marker or (body, point in ground at t=0)).
 
         stiffness [N/m], damping [N s/m], free_length [m] (None = initial distance), preload [N]:
-        tension = stiffness (L - free_length) + damping dL/dt + preload, positive pulling together."""
+        tension = stiffness (L - free_length) + damping dL/dt + preload, positive pulling together.
+
+        The tension acts along the line between the points, which has no direction where they coincide:
+        at zero length the element applies no force. Points that coincide at t=0 are therefore refused
+        (ModelError naming at_j) unless free_length and preload are zero (a zero-length spring, whose
+        force stiffness * (p_j - p_i) is continuous there)."""
         entity = f"spring '{name}'"
         self._claim(name, "spring")
         try:
@@ -286,7 +291,12 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
             c = scalar(entity, "damping", damping, minimum=0.0)
             L0 = float(np.linalg.norm(mj.point - mi.point)) if free_length is None else \
                 scalar(entity, "free_length", free_length, minimum=0.0)
-            s = SpringDamper(name, mi, mj, k, c, L0, scalar(entity, "preload", preload))
+            P = scalar(entity, "preload", preload)
+            gap = float(np.linalg.norm(mj.point - mi.point))
+            if gap <= 1e-12 * (1.0 + float(np.abs(mi.point).max())) and (L0 > 0.0 or P != 0.0):
+                raise ModelError(entity, "at_j", f"the points coincide at t=0 (length {gap:.3g} m): the "
+                                 f"direction of a tension of free_length {L0:g} m, preload {P:g} N is undefined")
+            s = SpringDamper(name, mi, mj, k, c, L0, P)
         except ModelError:
             self._names.discard(name)
             raise
@@ -295,14 +305,33 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
 
     # ----------------------------------------------------------------- helpers
     def add_element(self, element: Any) -> Any:
-        """Register a force element built elsewhere (must have a unique `name`)."""
-        self._claim(element.name, type(element).__name__)
+        """Register a force element built elsewhere: a spec of mbdsim.model (Bushing, SpringDamper, ...) or
+        an object with its own generalized(sys, frames, elem, t, state) method; it must have a unique
+        `name`.  Anything else is refused here (ModelError naming the element), not at simulate."""
+        from ..system.force_elements import EVALUATORS, friction, loads  # noqa: F401  (all registered)
+        name = getattr(element, "name", None)
+        what = type(element).__name__
+        if not isinstance(name, str):
+            raise ModelError(f"element {element!r:.60}", "name", f"a force element needs a string `name`; "
+                             f"got a {what} without one")
+        if not any(cls in EVALUATORS for cls in type(element).__mro__) and \
+                not callable(getattr(element, "generalized", None)):
+            raise ModelError(f"element '{name}'", "type", f"a {what} is not a force element (build elements "
+                             "with the Model.add_* methods, or give the object a method "
+                             "generalized(sys, frames, elem, t, state))")
+        self._claim(name, what)
         self.forces[element.name] = element
         return element
 
     def _claim(self, name, what):
-        if not isinstance(name, str) or not name:
-            raise ModelError(f"{what} {name!r}", "name", "must be a non-empty string")
+        """Reserve `name` for a new entity (ModelError naming it when taken or not a valid name, see
+        loadexpr.check_name: bodies, particles and joints are read by expressions)."""
+        from .loadexpr import check_name
+        check_name(f"{what} {name!r}", name, what in ("body", "particle", "joint"))
+        if what == "joint" and (name.endswith("_dot") and name[:-4] in self.joints or f"{name}_dot" in self.joints):
+            raise ModelError(f"{what} {name!r}", "name", "expressions read a joint's rate as <joint>_dot: a joint "
+                             f"{name!r} and a joint {name[:-4] if name.endswith('_dot') else name + '_dot'!r} "
+                             "cannot both be in the model")
         if name in self._names:
             raise ModelError(f"{what} '{name}'", "name", "an entity of this name already exists in the model")
         self._names.add(name)

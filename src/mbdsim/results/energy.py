@@ -7,7 +7,9 @@ and stick/slip events end a step, so the kinks of P lie on step ends) is a segme
 interpolated at 16 Chebyshev points and integrated exactly (Clenshaw-Curtis-like); a segment whose
 last Chebyshev coefficients exceed `rtol` of the total is halved, recursively.  D at any output time
 inside a segment comes from the interpolant's antiderivative, so the cost does not grow with the
-number of output samples.  Without step information the output intervals are the segments (evaluated
+number of output samples.  The states come from the index-1 trajectory's dense outputs, or from the
+interpolant of the accepted steps (`interpolated(ts)` of the HHT stepper: cubic Hermite, not projected,
+no Newton solve per point); without step information the output intervals are the segments (evaluated
 through Result.at); without dense output the samples are integrated by the trapezoidal rule.
 """
 from __future__ import annotations
@@ -35,27 +37,36 @@ def dissipation_power(sys, fr, t) -> np.ndarray:
 
 
 def _dense_sampler(res):
-    """(power(ts), breakpoints) from the index-1 trajectory's step-wise dense outputs, or None."""
+    """(power(ts), breakpoints) from the index-1 trajectory's step-wise dense outputs, or from the
+    interpolant of a stepper's accepted steps (HHT), or None."""
     traj = getattr(res._evaluate, "__self__", None)
-    if traj is None or not hasattr(traj, "dense") or not hasattr(traj, "t_end") or not traj.dense:
-        return None
     sys = res.system
-    t_end = np.asarray(traj.t_end)
-    starts = np.array([d[0] for d in traj.dense])
+    if hasattr(traj, "interpolated") and hasattr(traj, "steps") and len(traj.steps) > 1:
+        states = traj.interpolated
+        breaks = np.array([s.t for s in traj.steps])
+    elif traj is None or not hasattr(traj, "dense") or not hasattr(traj, "t_end") or not traj.dense:
+        return None
+    else:
+        t_end = np.asarray(traj.t_end)
+        breaks = np.union1d(np.array([d[0] for d in traj.dense]), t_end)
+
+        def states(ts):
+            k = np.clip(np.searchsorted(t_end, ts, side="left"), 0, len(t_end) - 1)
+            Y = np.zeros((len(ts), sys.nq + sys.nv))
+            for kk in np.unique(k):
+                sel = k == kk
+                Y[sel] = np.asarray(traj.dense[kk][1](ts[sel])).T
+            return Y
 
     def power(ts):
-        k = np.clip(np.searchsorted(t_end, ts, side="left"), 0, len(t_end) - 1)
-        Y = np.zeros((len(ts), sys.nq + sys.nv))
-        for kk in np.unique(k):
-            sel = k == kk
-            Y[sel] = np.asarray(traj.dense[kk][1](ts[sel])).T
+        Y = states(ts)
         q, v = Y[:, :sys.nq], Y[:, sys.nq:]
         fr = body_frames(sys, q, v)
         fr.t = ts
         fr.q, fr.v = q, v   # raw states, for elements whose power needs the multipliers (joint friction)
         return dissipation_power(sys, fr, ts)
 
-    return power, np.union1d(starts, t_end)
+    return power, breaks
 
 
 def _at_sampler(res):

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import ModelError
 from ..model.body import Marker
 
 _XYZ = "xyz"
@@ -164,14 +165,34 @@ def marker_targets(bodies, markers, entity="to_dataframe"):
 
 
 def to_dataframe(res, markers=False, euler=None):
-    """Wide pandas DataFrame of a Result (columns: see the module docstring), SI units in the names."""
+    """Wide pandas DataFrame of a Result (columns: see the module docstring), SI units in the names.
+
+    A Result without outputs (a run that failed before its first) raises ModelError("to_dataframe",
+    "result") quoting the run's message: there is nothing to export."""
     import pandas as pd
+    check_euler(euler)
+    if len(res.time) == 0:
+        raise ModelError("to_dataframe", "result", "the result has no outputs (the run failed before its "
+                         f"first: {res.message}); there is nothing to export")
     return pd.DataFrame(columns(res, markers, euler))
+
+
+def check_euler(euler) -> None:
+    """ModelError("to_dataframe", "euler") unless euler is None or a scipy Euler sequence: three axes
+    of "xyz" (extrinsic) or "XYZ" (intrinsic), no two consecutive axes the same ("ZYX", "zxz")."""
+    if euler is None:
+        return
+    ok = isinstance(euler, str) and len(euler) == 3 and (set(euler) <= set("xyz") or set(euler) <= set("XYZ")) \
+        and euler[0] != euler[1] and euler[1] != euler[2]
+    if not ok:
+        raise ModelError("to_dataframe", "euler", f"expected a sequence of three axes such as 'ZYX' (intrinsic, "
+                         f"upper case) or 'zyx' (extrinsic), no axis twice in a row; got {euler!r}")
 
 
 def columns(res, markers=False, euler=None):
     """The columns of `to_dataframe` as an ordered dict {name: 1-D float array per output time}, without
     pandas (the streamed writer builds its Parquet tables from it with pyarrow directly)."""
+    check_euler(euler)
     cols = {"time [s]": np.asarray(res.time, dtype=float)}
     for body in res.system.bodies:
         cols.update(_frame_columns(res, body, body.name, not body.is_particle, euler))

@@ -75,3 +75,28 @@ def analysis_error(exc: BaseException, t) -> Exception:
     if isinstance(exc, KeyboardInterrupt):
         return AnalysisInterrupted("interrupted (KeyboardInterrupt)", time=t)
     return SolverError(f"{type(exc).__name__}: {exc}", time=t)
+
+
+def blame_load(sys, t, y):
+    """The EvaluationError of the first load that is not finite at time t [s] in state y = [q, v] (the
+    reference evaluators, which name the element and field), or None: the diagnosis of a compiled run
+    that ended with a non-finite state or a collapsed step, whose kernels do not name elements."""
+    from ..errors import EvaluationError, MbdsimError
+    from ..results.state import state_factory
+    from ..system.force_elements import evaluator
+    from ..system.frames import body_frames
+    q, v = y[:sys.nq], y[sys.nq:]
+    if not (np.isfinite(q).all() and np.isfinite(v).all()):
+        return None
+    sf = state_factory(sys)
+    fr = body_frames(sys, normalize(sys, q), v)
+    for elem in sys.model.forces.values():
+        try:
+            Q = evaluator(elem).generalized(sys, fr, elem, t, sf(t, q, v) if sf else None)
+        except EvaluationError as exc:
+            return exc
+        except (MbdsimError, ArithmeticError, ValueError, TypeError, np.linalg.LinAlgError):
+            continue   # (not a clear verdict on this element)
+        if not np.isfinite(Q).all():
+            return EvaluationError(f"element '{elem.name}'", "load", "evaluates to a non-finite load", time=t)
+    return None

@@ -303,7 +303,13 @@ def failure(sys, rep, status, t_fail, y_fail, t_done, fallback, error=None):
     AnalysisInterrupted for Ctrl-C; `error` itself when given, e.g. the ProgressError of status
     PROGRESS_FAILED), and the Result's message with the last output time of t_done [s]; `fallback`: the
     text for a status without a message of its own."""
-    from .common import _weak_joints
+    from ..system.dynamics import massless_note
+    from .common import _weak_joints, blame_load
+    if error is None and status in (NONFINITE, TINY_STEP):   # a load that is not finite there, named
+        for t in (float(t_fail), float(t_fail) + 1e-9 * max(1.0, abs(t_fail))):   # (also just past a collapse)
+            error = blame_load(sys, t, y_fail)
+            if error is not None:
+                break
     if error is None:
         try:
             joints = [] if status in (INTERRUPTED, PROGRESS_FAILED, CALLBACK_FAILED) else \
@@ -311,7 +317,10 @@ def failure(sys, rep, status, t_fail, y_fail, t_done, fallback, error=None):
         except (MbdsimError, np.linalg.LinAlgError, ValueError):
             joints = []
         cls = AnalysisInterrupted if status == INTERRUPTED else SolverError
-        error = cls(_MESSAGES.get(status, fallback), time=float(t_fail), joints=joints, state=y_fail[:sys.nq])
+        text = _MESSAGES.get(status, fallback)
+        if status == SINGULAR:
+            text = text[:-1] + massless_note(sys) + ")"
+        error = cls(text, time=float(t_fail), joints=joints, state=y_fail[:sys.nq])
     last = f"{t_done[-1]:.9g}" if len(t_done) else "none"
     return error, f"{error}; last good output at t = {last} s"
 

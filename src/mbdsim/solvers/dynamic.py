@@ -139,7 +139,7 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
               start_time=0.0, progress=None, out=None, resume=False, monitor=True, markers=False) -> Result:
     """The analysis of `simulate` (its docstring has the arguments), without the monitors; with `out`, the
     streamed compiled run (NotStreamable when the model needs another path)."""
-    check_model(model)
+    check_model(model, "simulate")
     method = "auto" if method is None else method
     if not isinstance(method, str):
         raise ModelError("simulate", "method", f"expected a method name, got {method!r}")
@@ -299,8 +299,11 @@ def _check_budget(model, t0, t1, step, max_step=None, in_memory=True):
 
 
 def _number(field, value) -> float:
-    """A finite number for simulate.<field>, else ModelError."""
+    """A finite number for simulate.<field>, else ModelError (a boolean or text is not a number)."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(value):
+            raise TypeError
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError("simulate", field, f"expected a number, got {value!r}") from None
@@ -311,7 +314,10 @@ def _number(field, value) -> float:
 
 def _positive(field, value, strict=True, finite=True) -> float:
     """A solver setting > 0 (>= 0 when not strict), else ModelError naming simulate.<field>."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(value):
+            raise TypeError
         x = float(value)
     except (TypeError, ValueError):
         raise ModelError("simulate", field, f"expected a number, got {value!r}") from None

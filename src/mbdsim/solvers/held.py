@@ -143,16 +143,15 @@ def lexi_solve(J, b, items, M, rel_tol=1e-9):
         r = np.concatenate([it.g for it in items]) - C @ xp
         W = sla.block_diag(*[item_weight(it.C, Minv) for it in items])
         A = C @ N
-        y = np.linalg.lstsq(A, r, rcond=None)[0]
+        y, A_null = _cut_lstsq(A, r, np.linalg.norm(C, 2))
         e = A @ y - r
         ref = float(r @ W @ r + (C @ xp) @ W @ (C @ xp)) + 1e-300
         if float(e @ W @ e) > rel_tol ** 2 * ref:
             consistent = False
             Wh = _sqrt_psd(W)
-            y = np.linalg.lstsq(Wh @ A, Wh @ r, rcond=None)[0]
-            A = Wh @ A
+            y, A_null = _cut_lstsq(Wh @ A, Wh @ r, np.linalg.norm(Wh @ C, 2))
         xp = xp + N @ y
-        N = N @ sla.null_space(A, rcond=1e-10) if A.shape[0] else N
+        N = N @ A_null
     elif items:
         C = np.vstack([it.C for it in items])
         consistent = bool(np.allclose(C @ xp, np.concatenate([it.g for it in items]), rtol=rel_tol,
@@ -161,6 +160,19 @@ def lexi_solve(J, b, items, M, rel_tol=1e-9):
         H = N.T @ M @ N
         xp = xp - N @ np.linalg.solve(H, N.T @ (M @ xp))
     return xp, consistent
+
+
+def _cut_lstsq(A, r, scale, rcond=1e-10):
+    """(least-squares y of A y = r, null-space basis of A), singular values below rcond * scale cut off:
+    `scale` is the size of the rows before their projection onto the free motions (A = C N), so that
+    rows the constraints fix entirely (a body welded to ground given a velocity: A is round-off) fit
+    nothing, rather than round-off divided by round-off (before: velocities of 1e15 m/s)."""
+    if not A.shape[0]:
+        return np.zeros(A.shape[1]), np.eye(A.shape[1])
+    U, sv, Vt = np.linalg.svd(A, full_matrices=True)
+    k = int((sv > rcond * max(float(scale), 1e-300)).sum())
+    y = Vt[:k].T @ ((U[:, :k].T @ r) / sv[:k])
+    return y, Vt[k:].T
 
 
 def _sqrt_psd(W):

@@ -147,6 +147,14 @@ class HHTStepper:
             return cols
         return cols + self.outputs(np.asarray(ts, float), np.hstack(cols))
 
+    def interpolated(self, ts):
+        """Rows [q, v] at times ts [s] from the cubic Hermite interpolant of the accepted steps, neither
+        projected nor completed (cheap: for quantities integrated over the run, e.g. dissipated energy)."""
+        steps, sys = self.steps, self.sys
+        tk = np.array([s.t for s in steps])
+        k = np.clip(np.searchsorted(tk, ts) - 1, 0, max(len(steps) - 2, 0))
+        return np.array([_hermite_y(sys, steps[i], steps[min(i + 1, len(steps) - 1)], t) for t, i in zip(ts, k)])
+
     def step_states(self):
         steps = self.steps
         return np.array([s.t for s in steps]), np.array([s.q for s in steps]), np.array([s.v for s in steps])

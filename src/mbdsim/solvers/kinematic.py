@@ -69,7 +69,7 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
     from ..results.stream import ProgressError, notify
     from ..system.assemble import assemble_system
     from .dynamic import _check_budget, _number
-    check_model(model)
+    check_model(model, "kinematics")
     start_time = _number("start_time", start_time)
     _check_budget(model, start_time, end_time, output_step)
     sys = assemble_system(model)
@@ -202,22 +202,31 @@ def _warn_singular(records):
              "keeps the branch by continuity; see res.stats['singular']", SingularConfigurationWarning)
 
 
-def check_model(model):
-    """ModelError unless `model` is an mbdsim Model."""
+def check_model(model, analysis: str | None = None):
+    """ModelError unless `model` is an mbdsim Model; with `analysis` (a time-history analysis), also
+    unless it has a body or particle besides ground (an empty model has nothing to integrate)."""
     from ..model.model import Model
     if not isinstance(model, Model):
         raise ModelError("analysis", "model", f"expected an mbdsim.Model, got {type(model).__name__}")
+    if analysis is not None and len(model.bodies) < 2:
+        raise ModelError(f"model '{model.name}'", "bodies", f"{analysis} needs at least one body or particle "
+                         "besides ground; the model has none (add_body / add_particle)")
 
 
 def time_grid(t0, t1, step):
     """Output times from t0 to t1 inclusive with spacing step (default (t1-t0)/500) [s]."""
+    from ..model._check import not_a_number
     try:
+        if not_a_number(t1):
+            raise TypeError
         t1 = float(t1)
     except (TypeError, ValueError):
         raise ModelError("analysis", "end_time", f"expected a number, got {t1!r}") from None
     if not np.isfinite(t1) or t1 <= t0:
         raise ModelError("analysis", "end_time", f"must be greater than the start time {t0}, got {t1!r}")
     try:
+        if not_a_number(step):
+            raise TypeError
         step = (t1 - t0) / 500 if step is None else float(step)
     except (TypeError, ValueError):
         raise ModelError("analysis", "output_step", f"expected a number, got {step!r}") from None

@@ -57,8 +57,8 @@ def accelerations(sys, q, v, t, rows, state_factory=None):
             return friction_kkt(sys, fr, J, gamma, Q, rows, t)
         vd, lam_i = solve_kkt(sys.M, J[rows], Q, gamma[rows])
     except (np.linalg.LinAlgError, ValueError) as exc:
-        raise SolverError(f"singular equations of motion (lock-up or singular configuration): {exc}",
-                          time=t, joints=_worst_joints(sys, J, rows)) from None
+        raise SolverError(f"singular equations of motion (lock-up or singular configuration{massless_note(sys)}): "
+                          f"{exc}", time=t, joints=_worst_joints(sys, J, rows)) from None
     lam = np.zeros(sys.nc)
     if len(rows) == sys.nc:
         lam = lam_i
@@ -79,3 +79,10 @@ def _worst_joints(sys, J, rows):
         if abs(weak[k]) > 1e-3 and sys.row_owner[rows[k]] not in names:
             names.append(sys.row_owner[rows[k]])
     return names
+
+
+def massless_note(sys) -> str:
+    """"; zero mass: body 'a', body 'b'" naming the bodies of mass 0 kg (a singular mass matrix unless the
+    joints and drivers fix their motion: the usual cause of singular equations of motion), else ""."""
+    names = [f"'{b.name}'" for b in sys.bodies if not b.is_ground and b.mass == 0.0]
+    return f"; zero mass: {'body' if len(names) == 1 else 'bodies'} {', '.join(names)}" if names else ""

@@ -20,6 +20,16 @@ def _time(t):
         return None
 
 
+def as_numbers(v) -> np.ndarray:
+    """A user function's result as a float array; TypeError for text or booleans (which np.asarray would
+    read as numbers: "1" -> 1.0, True -> 1.0), ValueError for what is not numbers at all."""
+    from ..model._check import not_a_number
+    bad = not_a_number(v)
+    if bad:
+        raise TypeError(f"{v!r} holds {bad}")
+    return np.asarray(v, dtype=float)
+
+
 class GuardedTimeFunction:
     """A TimeFunction whose evaluations are checked (finite numbers) and whose failures are named.
     Other attributes (expr, f, f_d1, f_d2, description) are the wrapped function's."""
@@ -39,7 +49,7 @@ class GuardedTimeFunction:
             raise EvaluationError(self._entity, self._field, f"{what} raised {type(exc).__name__}: {exc}",
                                   time=_time(t)) from exc
         try:
-            finite = bool(np.all(np.isfinite(np.asarray(y, dtype=float))))
+            finite = bool(np.all(np.isfinite(as_numbers(y))))
         except (TypeError, ValueError):
             raise EvaluationError(self._entity, self._field, f"{what} returned {y!r}, not a number",
                                   time=_time(t)) from None
@@ -76,7 +86,7 @@ def call_vector(fn, t, state, entity: str, field: str) -> np.ndarray:
     except Exception as exc:  # noqa: BLE001 - user code
         raise EvaluationError(entity, field, f"callable raised {type(exc).__name__}: {exc}", time=_time(t)) from exc
     try:
-        a = np.asarray(v, dtype=float).reshape(-1)
+        a = as_numbers(v).reshape(-1)
     except (TypeError, ValueError):
         raise EvaluationError(entity, field, f"callable returned {v!r}; expected 3 finite numbers",
                               time=_time(t)) from None

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import ModelError
+from ...errors import EvaluationError
 from ...model.forces import ExprForce, ExprTorque, JointForce, LineForce
 from ...model.loadexpr import LoadExpr
 from .. import exprmeasures
@@ -39,12 +39,25 @@ def value(sys, fr, elem, v, t, state) -> float:
             return xd if rate else x
         out = float(exprmeasures.evaluate(sys, fb, v, t, joint_value)[0])
     elif callable(v):
-        out = float(np.asarray(v(t, state), dtype=float).reshape(-1)[0])
+        from ..guard import as_numbers
+        what, field = _ENTITY.get(type(elem), ("load", "value"))
+        got = v(t, state)
+        try:
+            out = float(as_numbers(got).reshape(-1)[0])
+        except (TypeError, ValueError, IndexError):
+            raise EvaluationError(f"{what} '{elem.name}'", field, f"callable returned {got!r}, not a number",
+                                  time=float(t)) from None
     else:
         return float(v)
     if not np.isfinite(out):
-        raise ModelError(f"load '{elem.name}'", "value", f"evaluates to {out} at t = {t} s")
+        what, field = _ENTITY.get(type(elem), ("load", "value"))
+        raise EvaluationError(f"{what} '{elem.name}'", field, f"evaluates to {out}", time=float(t))
     return out
+
+
+# the entity and field of each expression load as named when it was added (Model.add_force ...)
+_ENTITY = {ExprForce: ("force", "force"), ExprTorque: ("torque", "torque"), LineForce: ("line force", "magnitude"),
+           JointForce: ("joint force", "value")}
 
 
 class _Angles:
