@@ -95,8 +95,10 @@ def test_motion_driven_slider_crank_with_slider_friction_runs_through_dead_centr
 
 def test_torque_driven_slider_crank_passes_dead_centres_with_energy_balance():
     """Constant 0.5 N m, from 20 rad/s: every dead centre (crank angle k pi) is a
-    reversal of the slider carried by the loop."""
-    res = mb.simulate(slider_crank("torque"), 0.5, output_step=0.01, method="dop853", rtol=1e-8)
+    reversal of the slider carried by the loop. rtol 1e-9: the balance's residual follows the
+    integrator's error (9e-7 of the work at rtol 1e-8, up to 1.2e-6 when the System is reused from an
+    earlier run in the same process; 9e-8 at 1e-9), so 1e-9 leaves the 1e-6 check a tenfold margin."""
+    res = mb.simulate(slider_crank("torque"), 0.5, output_step=0.01, method="dop853", rtol=1e-9)
     assert res.success, res.message
     th = res.joint_coordinate("O") + np.pi / 3
     assert th[-1] > 3.5 * np.pi                                  # at least 3 dead centres

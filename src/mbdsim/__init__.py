@@ -32,7 +32,7 @@ _LAZY = {
     "Study": ".studies", "load_study": ".studies", "plot_study": ".studies", "sensitivity": ".studies",
     "OutputError": ".studies.measures", "InertiaWarning": ".model._check",
     "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
-    "IndeterminateReactionWarning": ".system.determinacy",
+    "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
 }
 
 
@@ -57,7 +57,7 @@ __all__ = [
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",
-    "AnalysisInterrupted", "ExpressionError", "OutputError",
+    "AnalysisInterrupted", "ProgressError", "ExpressionError", "OutputError",
     "RedundantConstraintWarning", "InitialConditionWarning", "SingularConfigurationWarning", "InertiaWarning",
     "InitialPenetrationWarning", "MonitorWarning", "IndeterminateReactionWarning",
     "expressions", "functions", "parse",
