@@ -26,7 +26,7 @@ def oscillator(k=100.0, mass=1.0):
     m = mb.Model("osc", gravity=(0.0, 0.0, 0.0))
     b = m.add_body("b", mass, inertia=(0.01, 0.01, 0.01), position=(1.0, 0.0, 0.0))
     m.add_translational("s", m.ground, b, (0, 0, 0), (1, 0, 0))
-    m.add_spring_damper("k", (b, (0, 0, 0)), (m.ground, (0, 0, 0)), stiffness=k, free_length=0.5)
+    m.add_spring_damper("k", (b, (1, 0, 0)), (m.ground, (0, 0, 0)), stiffness=k, free_length=0.5)
     return m
 
 

@@ -88,7 +88,7 @@ class Result:
         vd, lam = fn()
         self._vd, self._lambda = np.atleast_2d(vd), np.atleast_2d(lam)
 
-    def inject_frames(self, fr) -> None:
+    def inject_frames(self, fr: Frames) -> None:
         """Use Frames `fr` (with a sample axis) already computed for this Result's (q, v) instead of
         computing them on first use (solvers.pyloads hands over the compiled kernels' frames); they get
         the sample times (time-dependent element measures) and the angles continued by this Result."""

@@ -37,6 +37,7 @@ N_STAGES = _c.N_STAGES
 # overdamped 1e9 N/m spring hovered at 5.7 and were never flagged (0.74 s against HHT's 0.08 s): 5.0 is
 # ~0.8 of DOP853's real-axis stability bound, above what accuracy-limited steps give
 STIFF_RATIO = 5.0
+CALLBACK_RETRIES = 24   # a step whose Python-callable load fails is retried 4x shorter, this many times in a row
 FAC_MIN, FAC_MAX = 0.2, 10.0   # step-size change bounds per step (scipy's; Hairer's 1/3..6 hid the
 # stability-limited steps of stiff models from the stiffness test, tests/test_compiled_core.py)
 # `run` returns to Python (progress, Ctrl-C) after this many state entries x right-hand-side evaluations
@@ -294,6 +295,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     n_sensors = wk[44][2].shape[0] if watch else 0
     written = 0
     steps0, nfev0 = stats[0], stats[2]
+    failed = 0   # consecutive steps a Python-callable load failed in (solvers.pyloads)
     budget = max(EVALS_PER_RETURN // max(n, 1), 20 * N_STAGES)
     rejected = False
     eps = 2.220446049250313e-16
@@ -323,9 +325,14 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             K[0, i] = f[i]
         ok = _stages(cm, wk, co, t, h, y, K, ys, ynew)
         stats[2] += N_STAGES
-        if not ok and wk[48][1][1] != 0:   # a Python-callable load raised: no smaller step helps
-            st[0], st[1] = t, h
-            return CALLBACK_FAILED, iout
+        if not ok and wk[48][1][1] != 0:   # a Python-callable load failed: smaller steps reach up to
+            wk[48][1][1] = 0               # the failure (its outputs before it kept), then the run ends
+            failed += 1
+            if failed >= CALLBACK_RETRIES:
+                st[0], st[1] = t, h
+                return CALLBACK_FAILED, iout
+        elif ok:
+            failed = 0
         err = np.inf
         if ok:
             e5, e3 = 0.0, 0.0

@@ -10,9 +10,10 @@ of the callables (the same evaluators as the reference path: `system.force_eleme
 48[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
 
 A callable that raises, or returns a non-finite or malformed value, is caught here (a ctypes callback
-cannot raise into the kernel): the callback returns 1, the kernel ends the run with CALLBACK_FAILED, and
-`error` keeps the EvaluationError naming the load, field and time (a KeyboardInterrupt stays a
-KeyboardInterrupt, reported as an interrupted run).
+cannot raise into the kernel): the callback returns 1 and the step is rejected; shorter steps then reach
+up to the failure (the outputs before it are written), and after CALLBACK_RETRIES failed steps in a row the
+kernel ends the run with CALLBACK_FAILED; `error` keeps the EvaluationError naming the load, field and
+time (a KeyboardInterrupt inside the callable makes every later call fail: an interrupted run).
 """
 from __future__ import annotations
 
@@ -57,6 +58,10 @@ class PythonLoads:
 
     def _call(self, t):
         self.calls += 1
+        if self.interrupted:   # Ctrl-C is not retried: every later call fails until the run ends
+            self.F[:] = np.nan
+            self.ctl[1] = 1
+            return 1
         try:
             state, fr = self.state(t)
             Q = np.zeros(self.sys.nv)
@@ -82,12 +87,17 @@ class PythonLoads:
 
 
 def settle(pyl, status, error):
-    """(status, error) of a kernel run that ended with `status`: CALLBACK_FAILED with the load's error
-    (or INTERRUPTED for a Ctrl-C inside the callable) when the callback `pyl` failed."""
+    """(status, error) of a kernel run that ended with `status`: CALLBACK_FAILED with the callable's error
+    (or INTERRUPTED for a Ctrl-C inside it) when the run ended on a failed callback (the step loop's
+    CALLBACK_FAILED, or another failure status with the failure flag still set)."""
     from .fastdyn import CALLBACK_FAILED, INTERRUPTED
-    if pyl is None or not pyl.ctl[1] or status == 0 or error is not None:
+    if pyl is None or status == 0 or error is not None:
         return status, error
-    return (INTERRUPTED, None) if pyl.interrupted else (CALLBACK_FAILED, pyl.error)
+    if pyl.interrupted:
+        return INTERRUPTED, None
+    if (status == CALLBACK_FAILED or pyl.ctl[1]) and pyl.error is not None:
+        return CALLBACK_FAILED, pyl.error
+    return status, error
 
 
 def attach(sys, cm, work) -> PythonLoads | None:
