@@ -14,7 +14,7 @@ from mbdsim.validation.framework import CaseInfo, CaseOutcome, Plot, Quantity
 
 typer_testing = pytest.importorskip("typer.testing")
 from mbdsim.cli.app import app  # noqa: E402
-from mbdsim.reports.validation_report import (  # noqa: E402
+from mbdsim.validation.report import (  # noqa: E402
     fmt_pct,
     fmt_value,
     quantity_records,
@@ -188,6 +188,25 @@ def test_discover_is_sorted_by_number():
 
 
 # --------------------------------------------------------------------------- report
+
+def test_the_report_knows_the_cases_not_the_other_way_round():
+    """validation/report imports the framework and registry; the cases, framework and registry never
+    import the report (issue 29: one path in the code)."""
+    import ast
+
+    import mbdsim.validation as validation
+    root = Path(validation.__file__).parent
+    sources = [root / "framework.py", root / "registry.py", *sorted((root / "cases").rglob("*.py"))]
+    assert len(sources) > 30
+    for path in sources:
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            names = ([a.name for a in node.names] if isinstance(node, ast.Import) else
+                     [node.module or ""] + [a.name for a in node.names] if isinstance(node, ast.ImportFrom)
+                     else [])
+            assert not any("report" in n for n in names), (path, ast.dump(node))
+    assert not list((root.parent / "reports").glob("*.py"))   # the old mbdsim.reports is gone (a leftover
+                                                              # __pycache__ of an older checkout may remain)
+
 
 def test_write_report(tmp_path: Path):
     outcomes = [registry.run_case(m) for m in _fake_modules()]

@@ -164,7 +164,7 @@ def validate(
             progress.advance(task)
         progress.update(task, description="done")
 
-    from mbdsim.reports.validation_report import COLUMNS, fmt_pct, fmt_value, quantity_records
+    from mbdsim.validation.report import COLUMNS, fmt_pct, fmt_value, quantity_records
 
     console.print(_table(outcomes, registry, COLUMNS, fmt_value, fmt_pct))
 
@@ -186,7 +186,7 @@ def validate(
             raise typer.Exit(1) from None
 
     if not no_report:
-        from mbdsim.reports.validation_report import write_report
+        from mbdsim.validation.report import write_report
 
         try:
             md_path, html_path = write_report(outcomes, out)

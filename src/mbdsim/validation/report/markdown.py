@@ -11,8 +11,8 @@ from typing import Any, Iterable, Sequence
 from mbdsim import __version__ as _mbdsim_version
 from mbdsim.validation.registry import is_finite, outcome_error
 from mbdsim.validation.framework import FLOOR, REL_TOL, CaseOutcome
-from ._vr_format import COLUMNS, MANUAL, _row_cells, _safe, fmt_pct
-from ._vr_figures import _Figure
+from .format import COLUMNS, MANUAL, _row_cells, _safe, fmt_pct
+from .figures import _Figure
 
 
 _MATH_RE = re.compile(r"\$\$(.+?)\$\$|(?<![\\$])\$(?!\s)([^$\n]+?)(?<!\s)\$", re.S)

@@ -1,19 +1,7 @@
-"""The validation report: Markdown + one self-contained HTML page + figure PNGs.
+"""Builds the validation report: :func:`write_report` (Markdown, HTML page, figure PNGs).
 
-:func:`write_report` takes the :class:`~mbdsim.validation.framework.CaseOutcome` list
-produced by the validation runner and writes, into ``out_dir``::
-
-    report.md            Markdown (figures referenced as figures/*.png)
-    report.html          one self-contained page: inline CSS, figures as base64 data URIs
-    figures/*.png        the mechanism at t=0 of every case and the manual's plots
-
-The mechanism figure is drawn from the model itself (x-y projection of the bodies,
-markers, joints and spring-dampers at t=0).  Figure drawing is defensive: if anything
-is missing or fails, the report carries a note instead of the figure and goes on.
-
-matplotlib is imported lazily (Agg canvas, no pyplot state), so importing this module
-is cheap; :func:`quantity_records` and the formatting helpers need neither matplotlib
-nor the engine.
+The rest of the report lives beside it: ``format`` (values and quantity records),
+``markdown``, ``html`` and ``figures``.
 """
 from __future__ import annotations
 
@@ -22,19 +10,12 @@ from pathlib import Path
 from typing import Sequence
 
 from mbdsim.validation.framework import CaseOutcome
-from ._vr_markdown import _CaseDoc, _markdown  # noqa: F401
-from ._vr_html import _html  # noqa: F401
-from ._vr_figures import _render_figures  # noqa: F401
-from ._vr_format import COLUMNS, case_status, fmt_pct, fmt_value, quantity_records  # noqa: F401
+from .figures import _render_figures
+from .format import case_status
+from .html import _html
+from .markdown import _CaseDoc, _markdown
 
-__all__ = [
-    "write_report",
-    "quantity_records",
-    "fmt_value",
-    "fmt_pct",
-    "case_status",
-    "COLUMNS",
-]
+__all__ = ["write_report"]
 
 
 def write_report(outcomes: Sequence[CaseOutcome], out_dir: str | Path) -> tuple[Path, Path]:

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mbdsim.validation.framework import CaseOutcome, Plot
-from ._vr_format import _safe
+from .format import _safe
 
 
 @dataclass

@@ -7,9 +7,9 @@ from typing import Any, Iterable, Sequence
 
 from mbdsim.validation.framework import Quantity
 from mbdsim.validation.registry import outcome_error
-from ._vr_format import COLUMNS, MANUAL, _row_cells, _safe
-from ._vr_markdown import CRITERION, _CaseDoc, _NUM_COLS, _SUMMARY_HEADER, _counts, _environment, _md_html, _summary_rows
-from ._vr_figures import _Figure
+from .format import COLUMNS, MANUAL, _row_cells, _safe
+from .markdown import CRITERION, _CaseDoc, _NUM_COLS, _SUMMARY_HEADER, _counts, _environment, _md_html, _summary_rows
+from .figures import _Figure
 
 
 _CSS = """

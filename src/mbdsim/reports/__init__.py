@@ -1,1 +1,0 @@
-"""Report writers (validation report: Markdown + self-contained HTML)."""
