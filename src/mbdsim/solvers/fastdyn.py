@@ -35,7 +35,8 @@ CALLBACK_FAILED = 11   # a Python-callable load raised (solvers.pyloads keeps th
 
 @njit(cache=True, _nrt=False)
 def drivers_at(cm, wk, t):
-    """Driver values f, f', f'' at time t [s] from the compiled expression programs."""
+    """Driver values f, f', f'' at time t [s] from the compiled expression programs, then those of the drivers
+    written as Python callables (the callback of solvers.pyloads writes them into wk[34:37])."""
     code, consts, tables, start, end = cm[16], cm[17], cm[18], cm[19], cm[20]
     fv, x, stack = (wk[34], wk[35], wk[36]), wk[23], wk[24]
     nd = start.shape[0] // 3
@@ -44,6 +45,9 @@ def drivers_at(cm, wk, t):
         for k in range(3):
             p = 3 * d + k
             fv[k][d] = eval_program(code, consts, tables, start[p], end[p], x, stack)
+    ctl = wk[48][1]
+    if ctl[2] != 0 and call_address(ctl[2], t) != 0:   # drivers written as Python callables (solvers.pyloads)
+        ctl[1] = 1
 
 
 @njit(cache=True, _nrt=False)

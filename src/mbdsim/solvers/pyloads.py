@@ -1,4 +1,5 @@
-"""Loads written as Python callables (t, state), evaluated from inside the compiled step loop (issue 29).
+"""Loads (t, state) and drivers (t) written as Python callables, evaluated from inside the compiled step
+loop (issue 29).
 
 `attach(sys, cm, work)` wraps the model's callable loads (`system.compiled.python_loads`) in one ctypes
 callback `int64 f(double t)` whose address goes into the work arrays (slot 48); the kernels' `loads_into`
@@ -8,6 +9,10 @@ just computed (r, A, rd, w: work slots 0-3, ground axes), rebuilds the absolute 
 (its frames injected, so nothing is recomputed; `results.state.State`), and writes the generalized loads
 of the callables (the same evaluators as the reference path: `system.force_elements`) into work slot
 48[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
+
+Drivers whose function has no compiled program (a Python callable of t, or an integral without a closed
+form) get a second callback (address in slot 48[1][2]): `drivers_at` calls it after the programs, and it
+writes value, d1, d2 of each such driver into the kernels' driver arrays (work slots 34-36).
 
 A callable that raises, or returns a non-finite or malformed value, is caught here (a ctypes callback
 cannot raise into the kernel): the callback returns 1 and the step is rejected; shorter steps then reach
@@ -40,11 +45,50 @@ class PythonLoads:
         self.F, self.ctl = wk[48][0], wk[48][1]
         self.y = np.zeros(sys.nq + sys.nv)
         self.calls, self.error, self.interrupted = 0, None, False
-        self._callback = _CALLBACK(self._call)
-        self.ctl[0] = ctypes.cast(self._callback, ctypes.c_void_p).value
-        self.ctl[1] = 0
+        self.ctl[:] = 0
+        self._callbacks = []   # kept alive: the kernels hold their addresses
+        if self.elems:
+            self.ctl[0] = self._address(self._call)
+        if cm.python_drivers:
+            fns = sys.derived["packed"][6]
+            drv, owner = sys.derived["packed"][5], sys.row_owner
+            rows = {int(d): r for r, d in enumerate(drv) if d >= 0}
+            self.drivers = [(d, fns[d], f"motion '{owner[rows[d]]}'") for d in cm.python_drivers]
+            self.ctl[2] = self._address(self._drive)
         # the velocity slots of each frame (frame f's six load slots are v[vadr[f]: vadr[f] + 6]; particles 3)
         self.slots = [(f, int(a), 6 if sys.frame_rigid[f] else 3) for f, a in enumerate(sys.frame_v_adr) if a >= 0]
+
+    def _address(self, fn) -> int:
+        cb = _CALLBACK(fn)
+        self._callbacks.append(cb)
+        return ctypes.cast(cb, ctypes.c_void_p).value
+
+    def _drive(self, t):
+        """The driver callback: value, d1, d2 of each Python-callable driver at t [s] into wk[34:37]."""
+        try:
+            for d, fn, entity in self.drivers:
+                for k, part in enumerate((fn.value, fn.d1, fn.d2)):
+                    x = part(t)
+                    try:
+                        x = float(np.asarray(x, dtype=float).reshape(()))
+                    except (TypeError, ValueError):
+                        raise EvaluationError(entity, "function", f"returned {x!r}, not a number", time=float(t)) from None
+                    if not np.isfinite(x):
+                        raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
+                    self.wk[34 + k][d] = x
+            return 0
+        except KeyboardInterrupt:
+            self.interrupted = True
+        except MbdsimError as exc:
+            self.error = exc
+        except Exception as exc:  # noqa: BLE001 - user code
+            self.error = EvaluationError(", ".join(e for _, _, e in self.drivers), "function",
+                                         f"{type(exc).__name__}: {exc}", time=float(t))
+        for d, _, _ in self.drivers:
+            for k in range(3):
+                self.wk[34 + k][d] = np.nan
+        self.ctl[1] = 1
+        return 1
 
     def state(self, t) -> tuple[State, Frames]:
         """The light State of the kernel's current frames at t [s] (absolute [q, v] rebuilt from them) and
@@ -101,5 +145,5 @@ def settle(pyl, status, error):
 
 
 def attach(sys, cm, work) -> PythonLoads | None:
-    """The callback of the model's Python-callable loads set into `work` (None when it has none)."""
-    return PythonLoads(sys, cm, work) if cm.python_loads else None
+    """The callbacks of the model's Python-callable loads and drivers set into `work` (None without)."""
+    return PythonLoads(sys, cm, work) if cm.python_loads or cm.python_drivers else None

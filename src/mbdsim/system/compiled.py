@@ -88,6 +88,7 @@ class CompiledModel:
     cand: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
     python_loads: tuple = ()  # names of the loads written as Python callables (t, state): evaluated by
     #                           the callback of solvers.pyloads from inside the kernels (Work slot 48)
+    python_drivers: tuple = ()   # driver indices (into the packed driver functions) called back the same way
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -136,9 +137,9 @@ class Work:
              # 46: the loop rows in use (from the compiled selection; `fastdyn._factor` re-selects them),
              # 47: (the pivot ratio below which it re-selects, its nominal value RESELECT_RATIO)
              np.array(t.loop_rows, dtype=np.int64), np.full(2, RESELECT_RATIO),
-             # 48: loads written as Python callables (solvers.pyloads): their loads (nf, 6) and
-             # [callback address (0: none), failed flag]
-             (z((nf, 6)), np.zeros(2, np.int64)))
+             # 48: loads and drivers written as Python callables (solvers.pyloads): the loads (nf, 6) and
+             # [load callback address (0: none), failed flag, driver callback address (0: none)]
+             (z((nf, 6)), np.zeros(3, np.int64)))
         return cls(a)
 
     def arrays(self) -> tuple:
@@ -176,23 +177,25 @@ def _singular_masses(M6) -> bool:
 
 
 def _driver_programs(fns):
-    """Packed value/d1/d2 programs of every driver function, or NotCompiled."""
+    """Packed value/d1/d2 programs of every driver function, and the indices of the drivers that have
+    none (Python callables, integrals without a closed form): their programs are zeros and the kernels
+    call them back (solvers.pyloads writes their values over the programs' at every evaluation)."""
     if not fns:
-        return np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64), 4
+        return (np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64),
+                4, ())
     try:
         from . import exprvm
     except ImportError:
         raise NotCompiled("the expression compiler (system.exprvm) is not available") from None
-    progs = []
-    for fn in fns:
+    progs, called = [], []
+    for d, fn in enumerate(fns):
         p = exprvm.time_programs(fn)
         if p is None:
-            why = "an integral without a closed form (sin(t**2), tables, ...)" if "integral of" in \
-                fn.description else "a Python callable"
-            raise NotCompiled(f"driver function {fn.description} is {why}")
+            called.append(d)
+            p = (exprvm.constant_program(0.0),) * 3
         progs.extend(p)
     pk = exprvm.pack(progs)
-    return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size)
+    return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size), tuple(called)
 
 
 def python_loads(sys) -> tuple:
@@ -278,7 +281,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         packed = sys.derived["packed"] = packing.pack_rows(sys)
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
-    code, consts, tables, start, end, stack = _driver_programs(fns)
+    code, consts, tables, start, end, stack, pyd = _driver_programs(fns)
     bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
     dense = int(_singular_masses(M6[1:]))
@@ -299,7 +302,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd)
 
 
 def _candidates(sys, topo) -> np.ndarray:
