@@ -65,6 +65,8 @@ class PythonLoads:
 
     def _drive(self, t):
         """The driver callback: value, d1, d2 of each Python-callable driver at t [s] into wk[34:37]."""
+        if self.interrupted:
+            return self._fail_drivers()
         try:
             for d, fn, entity in self.drivers:
                 for k, part in enumerate((fn.value, fn.d1, fn.d2)):
@@ -84,6 +86,9 @@ class PythonLoads:
         except Exception as exc:  # noqa: BLE001 - user code
             self.error = EvaluationError(", ".join(e for _, _, e in self.drivers), "function",
                                          f"{type(exc).__name__}: {exc}", time=float(t))
+        return self._fail_drivers()
+
+    def _fail_drivers(self):
         for d, _, _ in self.drivers:
             for k in range(3):
                 self.wk[34 + k][d] = np.nan
