@@ -59,6 +59,38 @@ def rod(axial):
     return m
 
 
+def pendulum(torque):
+    """Rod pendulum with a drag torque -0.3 w_z, written as given."""
+    m = mb.Model("p", gravity=(0.0, -9.81, 0.0))
+    rod = m.add_body("rod", 2.0, inertia=(0.01, 2 / 12, 2 / 12), position=(0.5, 0, 0))
+    m.add_revolute("pin", m.ground, rod, (0, 0, 0), (0, 0, 1))
+    m.add_torque("drag", rod, torque(rod))
+    return m
+
+
+def callable_drag(rod):
+    return lambda t, s: (0.0, 0.0, -0.3 * s.angular_velocity(rod)[2])
+
+
+def gears(geared):
+    """Gear pair (ratio -1/2) driven by a torque on gear 1, torsion spring on gear 2's shaft; baseline: the
+    equivalent single shaft (inertia J1 + J2 r^2, spring k r^2)."""
+    J1, J2, r, k = 0.01, 0.04, -0.5, 2.0
+    m = mb.Model("gears", gravity=(0.0, 0.0, 0.0))
+    if geared:
+        m.add_body("g1", 1.0, inertia=(0.02, 0.02, J1))
+        m.add_body("g2", 1.0, inertia=(0.05, 0.05, J2), position=(0.3, 0, 0))
+        m.add_revolute("p1", "ground", "g1", (0, 0, 0), (0, 0, 1), initial_velocity=5.0)
+        p2 = m.add_revolute("p2", "ground", "g2", (0.3, 0, 0), (0, 0, 1), initial_velocity=5.0 * r)
+        m.add_gear("mesh", "p1", "p2", r)
+        m.add_torsion_spring("spring", p2, stiffness=k)
+    else:
+        m.add_body("g1", 1.0, inertia=(0.02, 0.02, J1 + J2 * r * r))
+        p1 = m.add_revolute("p1", "ground", "g1", (0, 0, 0), (0, 0, 1), initial_velocity=5.0)
+        m.add_torsion_spring("spring", p1, stiffness=k * r * r)
+    return m
+
+
 def timed(fn):
     fn()
     ts = []
@@ -81,6 +113,18 @@ CASES = [
     ("velocity driver (slider-crank kinematics, 0 DOF)", lambda: slider_crank(velocity="18.85"),
      lambda: slider_crank(displacement="18.85*t"), "kinematics", ("O", "slide")),
     ("slender rod, axial inertia 0 (torsion spring)", lambda: rod(0.0), lambda: rod(1e-6), "simulate", ("pin",)),
+    ("Python-callable drag torque (pendulum)", lambda: pendulum(callable_drag),
+     lambda: pendulum(lambda rod: (0, 0, "-0.3*WZ(rod)")), "simulate", ("pin",)),
+    ("Python-callable driver, exact derivatives (carousel)",
+     lambda: carousel(displacement=mb.expressions.time_function(lambda t: 3 * t + 2 * np.sin(t),
+                                                                d1=lambda t: 3 + 2 * np.cos(t),
+                                                                d2=lambda t: -2 * np.sin(t))),
+     lambda: carousel(displacement="3*t + 2*sin(t)"), "simulate", ("hub", "tip")),
+    ("Python-callable driver, numerical derivatives (carousel)",
+     lambda: carousel(displacement=lambda t: 3 * t + 2 * np.sin(t)),
+     lambda: carousel(displacement="3*t + 2*sin(t)"), "simulate", ("hub", "tip")),
+    ("gear pair + torsion spring vs the equivalent shaft (not compiled yet)", lambda: gears(True),
+     lambda: gears(False), "simulate", ("p1",)),
 ]
 
 

@@ -3,22 +3,11 @@ step loop through the driver callback of solvers.pyloads: same motion as the exp
 import warnings
 
 import numpy as np
-import pytest
 
 import mbdsim as mb
 from mbdsim.errors import EvaluationError
 from mbdsim.solvers import dynamic
-
-
-def _carousel(**drive):
-    """Arm turned about z by the motion, pendulum hinged at its tip about the arm (1 free DOF)."""
-    m = mb.Model("carousel", gravity=(0.0, 0.0, -9.81))
-    arm = m.add_body("arm", 2.0, inertia=(0.002, 0.02, 0.02), position=(0.15, 0, 0))
-    pend = m.add_body("pend", 1.2, inertia=(0.025, 0.025, 1e-3), position=(0.3, 0, -0.25))
-    hub = m.add_revolute("hub", m.ground, arm, (0, 0, 0), (0, 0, 1))
-    m.add_revolute("tip", arm, pend, (0.3, 0, 0), (1, 0, 0))
-    m.add_motion("spin", hub, **drive)
-    return m
+from test_driver_integrals import _carousel   # arm turned about z by the motion, pendulum at its tip
 
 
 def _run(model, **kw):

@@ -45,6 +45,7 @@ class PythonLoads:
         self.F, self.ctl = wk[48][0], wk[48][1]
         self.y = np.zeros(sys.nq + sys.nv)
         self.calls, self.error, self.interrupted = 0, None, False
+        self.last_failed = False   # whether the latest call of either callback failed
         self.ctl[:] = 0
         self._callbacks = []   # kept alive: the kernels hold their addresses
         if self.elems:
@@ -78,6 +79,7 @@ class PythonLoads:
                     if not np.isfinite(x):
                         raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
                     self.wk[34 + k][d] = x
+            self.last_failed = False
             return 0
         except KeyboardInterrupt:
             self.interrupted = True
@@ -92,7 +94,7 @@ class PythonLoads:
         for d, _, _ in self.drivers:
             for k in range(3):
                 self.wk[34 + k][d] = np.nan
-        self.ctl[1] = 1
+        self.ctl[1], self.last_failed = 1, True
         return 1
 
     def state(self, t) -> tuple[State, Frames]:
@@ -122,6 +124,7 @@ class PythonLoads:
                 raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
             for f, a, n in self.slots:
                 self.F[f, :n] = Q[a:a + n]
+            self.last_failed = False
             return 0
         except KeyboardInterrupt:
             self.interrupted = True
@@ -131,20 +134,21 @@ class PythonLoads:
             name = self.elems[0].name if len(self.elems) == 1 else ", ".join(e.name for e in self.elems)
             self.error = EvaluationError(f"load '{name}'", "value", f"{type(exc).__name__}: {exc}", time=float(t))
         self.F[:] = np.nan
-        self.ctl[1] = 1
+        self.ctl[1], self.last_failed = 1, True
         return 1
 
 
 def settle(pyl, status, error):
     """(status, error) of a kernel run that ended with `status`: CALLBACK_FAILED with the callable's error
     (or INTERRUPTED for a Ctrl-C inside it) when the run ended on a failed callback (the step loop's
-    CALLBACK_FAILED, or another failure status with the failure flag still set)."""
+    CALLBACK_FAILED, or another failure status, e.g. the step size collapsing onto the failure, right
+    after a failed call)."""
     from .fastdyn import CALLBACK_FAILED, INTERRUPTED
     if pyl is None or status == 0 or error is not None:
         return status, error
     if pyl.interrupted:
         return INTERRUPTED, None
-    if (status == CALLBACK_FAILED or pyl.ctl[1]) and pyl.error is not None:
+    if (status == CALLBACK_FAILED or pyl.last_failed) and pyl.error is not None:
         return CALLBACK_FAILED, pyl.error
     return status, error
 
