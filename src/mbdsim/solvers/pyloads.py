@@ -105,7 +105,11 @@ class PythonLoads:
         fasttree.to_maximal(cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid, r, A, rd, w,
                             self.y, self.y[:0])
         q, v = self.y[:sys.nq].copy(), self.y[sys.nq:].copy()
-        return State(sys, t, q, v, Frames(r[None], A[None], rd[None], w[None])), Frames(r, A, rd, w, t=t, q=q, v=v)
+        state = State(sys, t, q, v, Frames(r[None], A[None], rd[None], w[None]))
+        # joint angles read by the evaluators (torsion springs, stops, expression loads in closed loops):
+        # continued beyond +-pi over the run by the State's anchors (results.state._continued)
+        angle = lambda jt: np.atleast_1d(state.joint_coordinate(jt))[:1]  # noqa: E731
+        return state, Frames(r, A, rd, w, t=t, q=q, v=v, angle=angle)
 
     def _call(self, t):
         self.calls += 1

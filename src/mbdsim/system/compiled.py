@@ -211,12 +211,33 @@ def python_loads(sys) -> tuple:
     return tuple(out)
 
 
-def _loads(sys):
+def _called_back(sys, mode, tree, state) -> tuple:
+    """Names of every force element the kernels call back through its Python evaluator (solvers.pyloads)
+    instead of packing it: the Python callables (`python_loads`), the expression loads, torsion springs and
+    stops that cannot be packed in this formulation (joint angles of closed loops, continued beyond +-pi:
+    the callback continues them), and element types the kernels do not have. Joint friction is not among
+    them (its slip loads depend on the multipliers: the Python path)."""
+    out = list(python_loads(sys))
+    for e in sys.model.forces.values():
+        if e.name in out:
+            continue
+        if isinstance(e, exprloads_pack.EXPR_TYPES):
+            try:
+                exprloads_pack.pack(sys, [e], mode, tree, state, ())
+            except NotCompiled:
+                out.append(e.name)
+        elif not isinstance(e, (Force, Torque, Bushing, Contact, SpringDamper)):
+            from .force_elements import evaluator
+            if not getattr(evaluator(e), "needs_lambda", False):
+                out.append(e.name)
+    return tuple(out)
+
+
+def _loads(sys, skip=()):
     """Constant point forces and torques, spring-dampers and bushings as arrays (expression loads, torsion
-    springs and stops are packed by exprloads_pack, contacts by `_contacts`); NotCompiled for anything
-    else."""
+    springs and stops are packed by exprloads_pack, contacts by `_contacts`, the elements named in `skip`
+    are called back: `_called_back`); NotCompiled for anything else."""
     pf, sp, bu = [], [], []
-    skip = python_loads(sys)
     for e in sys.model.forces.values():
         if isinstance(e, exprloads_pack.EXPR_TYPES) or e.name in skip:
             continue   # packed by exprloads_pack, or called back (solvers.pyloads)
@@ -282,14 +303,14 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     code, consts, tables, start, end, stack, pyd = _driver_programs(fns)
-    bushings, loads = _loads(sys)
     rows = np.asarray(rows, dtype=np.int64)
     dense = int(_singular_masses(M6[1:]))
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
         jointtree.tree_arrays(sys, rows, *state)
     if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
         dense = 2   # zero DOF: the independent rows' Jacobian is square (solvers.kkt_square)
-    pyl = python_loads(sys)
+    pyl = _called_back(sys, mode, tree, state)
+    bushings, loads = _loads(sys, pyl)
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES) and e.name not in pyl]
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
     ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \

@@ -22,7 +22,7 @@ def batched(fr: Frames) -> tuple[Frames, bool]:
     """Frames with a leading time axis and whether the input was a single state."""
     if fr.r.ndim == 3:
         return fr, False
-    out = Frames(fr.r[None], fr.A[None], fr.rd[None], fr.w[None])
+    out = Frames(fr.r[None], fr.A[None], fr.rd[None], fr.w[None], angle=fr.angle)   # (angle: continuation)
     if hasattr(fr, "t"):
         out.t = np.atleast_1d(fr.t)
     return out, True
