@@ -186,6 +186,7 @@ def test_dissipated_energy_of_an_hht_run_is_quick_and_balances():
     assert res.success and res.stats["method"] == "HHT"
     t0 = time.monotonic()
     D = res.dissipated_energy()   # (before: every Chebyshev point a Newton solve through Result.at, ~60 s)
-    assert time.monotonic() - t0 < 2.0
+    # ~1 s on an idle 2-core machine, 3 s seen with two other jobs compiling: the bound guards the 60 s
+    assert time.monotonic() - t0 < 10.0
     E = res.kinetic_energy() + res.potential_energy()
     assert D[-1] > 1.0 and abs((E[0] - E[-1]) - D[-1]) < 1e-3 * D[-1]
