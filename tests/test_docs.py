@@ -102,3 +102,21 @@ def test_hooks_schema_page_says_when_there_is_no_schema_command():
         assert text.startswith("```")
     else:
         assert "Schema not available in this build" in text
+
+
+def test_model_file_reference_is_generated_and_current():
+    """docs/model-file-reference.md and docs/model-file-schema.json are what `python3 -m mbdsim.io.reference`
+    writes from the schema now (regenerate them after a schema change); every element type has a table."""
+    from mbdsim.io.reference import REFERENCE, SCHEMA_FILE, reference_markdown, schema_text
+    text = reference_markdown()
+    assert (ROOT / "docs" / REFERENCE).read_text(encoding="utf-8") == text, \
+        f"docs/{REFERENCE} is stale: run python3 -m mbdsim.io.reference docs"
+    assert (ROOT / "docs" / SCHEMA_FILE).read_text(encoding="utf-8") == schema_text(), \
+        f"docs/{SCHEMA_FILE} is stale: run python3 -m mbdsim.io.reference docs"
+    for kind in ("revolute", "spring_damper", "contact", "coupler", "point_on_curve", "joint_force"):
+        assert re.search(rf"^### .*\b{kind}\b", text, re.M), kind
+    assert "| `mass` | quantity | kg |" in text and "| `stiffness` | quantity | N/m |" in text
+    assert text.count("```yaml") >= 25
+    page = (ROOT / "docs" / "model-files.md").read_text()
+    assert "(model-file-reference.md)" in page and "(model-file-schema.json)" in page and len(page) < 20000
+    assert "model-file-reference.md" in (ROOT / "mkdocs.yml").read_text()

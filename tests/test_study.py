@@ -367,3 +367,48 @@ def test_reaction_measures_equal_result_values():
     df = mb.Study(slider_crank, {"crank": [0.1]}, {"bad": "max(norm(reaction_force('crank_rod', relative_to='rod')))"},
                   analysis={**FAST, "end_time": 0.1}).run(workers=0)
     assert df.status[0] == "error" and "study output 'bad'" in df.message[0]
+
+
+def _three_parameter_runs():
+    rng = np.random.default_rng(0)
+    n = 60
+    df = pd.DataFrame({"a": rng.uniform(0, 1, n), "b": rng.uniform(0, 1, n), "c": rng.uniform(0.1, 0.3, n)})
+    df["F"] = 0.01 * df.a + 50 * df.c + 4 * df.b + rng.normal(0, 1e-3, n)   # c dominates, then b, a is noise
+    df["status"] = "ok"
+    df.attrs.update(parameters=["a", "b", "c"], outputs=["F"], units={"c": "m", "F": "N"})
+    return df
+
+
+def test_surface_defaults_to_the_dominant_parameters_and_labels_units():
+    df = _three_parameter_runs()
+    fig = mb.plot_study(df, "surface")
+    ax = fig.axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("c [m]", "b")
+    assert fig.axes[1].get_ylabel() == "F [N]"                        # the colour bar
+    ax = mb.plot_study(df, "surface", x="a", y="b").axes[0]           # an explicit choice is kept
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("a", "b")
+    ax = mb.plot_study(df, "surface", x="a", units={"a": "kg"}).axes[0]
+    assert (ax.get_xlabel(), ax.get_ylabel()) == ("a [kg]", "c [m]")
+    me = mb.plot_study(df, "main_effects")
+    assert [a.get_xlabel() for a in me.axes] == ["a", "b", "c [m]"] and me.axes[0].get_ylabel() == "F [N]"
+
+
+def test_one_parameter_main_effects_title_lies_inside_the_figure():
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    fig = mb.plot_study(_three_parameter_runs(), "main_effects", ["c"], ["F"])
+    FigureCanvasAgg(fig).draw()
+    box = fig._suptitle.get_window_extent(fig.canvas.get_renderer())
+    assert fig.bbox.x0 <= box.x0 and box.x1 <= fig.bbox.x1 and fig.bbox.y0 <= box.y0 and box.y1 <= fig.bbox.y1
+
+
+def test_study_units_of_parameters_and_outputs():
+    from mbdsim.studies.units import output_unit, schema_unit
+    study = mb.Study("examples/slider_crank.yaml",
+                     {"bodies.rod.mass": [1, 2], "bodies.slider.mass": {"range": ["1000 g", "2 kg"], "num": 2},
+                      "gravity.1": [-9.81, -1.62]}, SC_OUT, analysis=FAST)
+    assert study.units == {"bodies.rod.mass": "kg", "bodies.slider.mass": "kg", "gravity.1": "m/s**2",
+                           "amax": "m/s**2", "t_idc": "s", "F": "N"}
+    assert schema_unit("forces.s.stiffness") == "N/m" and schema_unit("motions.drive.displacement") == ""
+    assert output_unit("degrees(final(joint_coordinate('j')))") == "" and output_unit(len) == ""
+    factory = mb.Study(slider_crank, {"crank": ["100 mm", "120 mm"], "rod_mass": [1.0, 3.0]}, SC_OUT, analysis=FAST)
+    assert factory.units["crank"] == "m" and "rod_mass" not in factory.units

@@ -57,9 +57,11 @@ def _summary(df, study, seconds: float) -> None:
 def _plots(df, directory: Path) -> None:
     import mbdsim as mb
     directory.mkdir(parents=True, exist_ok=True)
-    for kind in ("main_effects", "scatter_matrix", "surface"):
-        mb.plot_study(df, kind=kind).savefig(directory / f"{kind}.png", dpi=90)
-    _console().print(f"plots: {directory}/main_effects.png, scatter_matrix.png, surface.png")
+    numeric = [p for p in df.attrs.get("parameters", []) if p in df and df[p].dtype.kind in "fiu"]
+    kinds = ("main_effects", "scatter_matrix") + (("surface",) if len(numeric) >= 2 else ())
+    for kind in kinds:   # a surface needs two numeric parameters
+        mb.plot_study(df, kind=kind).savefig(directory / f"{kind}.png", dpi=90, bbox_inches="tight")
+    _console().print(f"plots: {directory}/" + ", ".join(f"{k}.png" for k in kinds))
 
 
 def study_cmd(

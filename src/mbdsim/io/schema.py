@@ -22,6 +22,10 @@ class Spec(BaseModel):
     model_config = ConfigDict(extra="forbid")
 
 
+class UnitMark(str):
+    """Metadata on a quantity field: its SI unit ("m", "N*m/rad"; "" for a pure number)."""
+
+
 def _quantity_validator(unit: str):
     def convert(value):
         return to_si(value, unit)
@@ -32,7 +36,7 @@ def Q(unit: str):  # noqa: N802 - a type factory
     """A float field in SI `unit`, given as a number (SI) or a string with units."""
     return Annotated[float, BeforeValidator(_quantity_validator(unit)), WithJsonSchema(
         {"anyOf": [{"type": "number"}, {"type": "string"}],
-         "description": f"{dimension_name(unit)}: a number in SI units or a string with units"})]
+         "description": f"{dimension_name(unit)}: a number in SI units or a string with units"}), UnitMark(unit)]
 
 
 def V(unit: str, n: int = 3):  # noqa: N802

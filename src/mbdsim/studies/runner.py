@@ -113,7 +113,7 @@ class _Sink:
         df = pd.concat(frames, ignore_index=True).sort_values("run", kind="stable").reset_index(drop=True)
         df = df[cols]
         df.attrs.update(executed=self.executed, parameters=list(study.design.columns),
-                        outputs=list(study.plan.outputs))
+                        outputs=list(study.plan.outputs), units=dict(getattr(study, "units", {})))
         return df
 
 

@@ -95,6 +95,8 @@ class Study:
         self.plan = Plan(base, factory, source, validate_analysis(analysis if analysis is not None else {}),
                          dict(outputs), settings)
         self.name = name or (source if factory is None else "study")
+        from .units import study_units
+        self.units = study_units(parameters, outputs, model_file=factory is None)   # column -> SI unit
         self.chunk_size = chunk_size
         self._check_names(parameters, settings)
 
