@@ -186,3 +186,33 @@ def test_joint_initial_values_against_a_driver_are_changed_with_a_warning_naming
     assert "joint 'pin' initial_velocity given 1, used 2" in text
     assert rep.moved["rod"][1] == pytest.approx(0.1, abs=1e-12)       # turned to the driver's 0.1 rad
     assert rep.v[5] == pytest.approx(2.0, abs=1e-12)
+
+
+def test_inconsistent_initial_velocity_on_a_dependent_joint_is_warned_with_the_change():
+    """Issue 34: the crank driven at 2 pi rad/s, the slide (dependent on it) given 1 m/s: the fit keeps
+    the driver and moves the slide's value to the slider-crank law, named with how much it moved."""
+    th, w = np.radians(60.0), 2 * np.pi
+    model, slider = slider_crank(th)
+    model.add_motion("turn", "O", velocity=w)
+    model.joints["slide"].initial_velocity = np.array([1.0])
+    rep, warned = assembled(model)
+    used = slider_law(th, w)[1]     # slide coordinate: the slider's x from as drawn, its rate dx/dt
+    assert len(warned) == 1
+    text = str(warned[0].message)
+    assert "joint 'slide' initial_velocity given 1, used" in text and "joint 'O'" not in text
+    import re
+    change = re.search(r"joint 'slide' initial_velocity .*?\(changed by (\S+) m/s\)", text)
+    assert change and float(change.group(1)) == pytest.approx(used - 1.0, abs=1e-8)
+    assert rep.joint_changed["slide"]["initial_velocity"] == pytest.approx([used - 1.0], abs=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.kinematics(model, 0.02, 0.01)
+    assert res.joint_velocity("slide")[0] == pytest.approx(used, abs=1e-9)
+    # crank and slide both given, inconsistent (free mechanism): both are moved and named with units
+    model, _ = slider_crank(th, v0=w)
+    model.joints["slide"].initial_velocity = np.array([1.0])
+    rep, warned = assembled(model)
+    text = str(warned[0].message)
+    assert "joint 'O' initial_velocity given 6.28318531" in text and "rad/s)" in text
+    assert "joint 'slide' initial_velocity given 1" in text and "m/s)" in text
+    assert set(rep.joint_changed) == {"O", "slide"} and "changed by" in str(rep)

@@ -238,3 +238,59 @@ def test_cli_ctrl_c_exits_130_after_writing_what_it_has(tmp_path, monkeypatch):
     assert r.exit_code == 130, r.output
     df = pd.read_csv(out)
     assert len(df) >= 256 and 0 < df["time [s]"].iloc[-1] < 2000
+
+
+# ------------------------------------------------------------------ issue 34: every analysis keeps what it computed
+def _raising_at(t_fail, value=lambda t: 0.5 * t):
+    def f(t):
+        if t > t_fail:
+            raise RuntimeError("encoder lost")
+        return value(t)
+    return f
+
+
+@pytest.mark.parametrize("wrap", ["plain", "time_function"])
+def test_kinematics_driver_raising_at_0_12_keeps_the_samples_before(wrap):
+    m, _, j = pendulum()
+    f = _raising_at(0.12)
+    drive = f if wrap == "plain" else mb.expressions.time_function(f, d1=lambda t: 0.5, d2=lambda t: 0.0)
+    m.add_motion("d", j, displacement=drive)
+    res = mb.kinematics(m, 1.0, 0.01)
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert res.error.entity == "motion 'd'" and "encoder lost" in res.message
+    # the plain callable's numerical derivatives at 0.12 s need f beyond 0.12 s: the fault is at 0.12 s
+    # there (12 samples kept), at 0.13 s with exact derivatives (13 samples); before issue 34 the coarse
+    # steps (0.1 s) of the numerical derivatives failed already at 0.02 s and kept 2
+    assert 0.12 - 1e-9 <= res.error.time <= 0.13 + 1e-9
+    assert len(res.time) >= 12 and res.time[-1] < res.error.time
+    assert np.allclose(res.joint_coordinate("j"), 0.5 * res.time, atol=1e-9)
+
+
+def test_quasi_static_load_raising_mid_run_keeps_the_equilibria_before():
+    m, b, _ = pendulum()
+    f = _raising_at(0.12, lambda t: 2.0 * t)
+    m.add_torque("tq", b, lambda t, state: (0.0, 0.0, f(t)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.quasi_static(m, 1.0, 0.01)
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert res.error.entity == "torque 'tq'" and "encoder lost" in res.message
+    assert len(res.time) >= 12 and res.time[-1] < res.error.time <= 0.13 + 1e-9
+    # equilibrium of the hanging rod: m g sin(th) = torque, th measured from hanging straight down
+    th = res.joint_coordinate("j") + np.pi / 2
+    np.testing.assert_allclose(9.81 * np.sin(th), 2.0 * res.time, atol=1e-7)
+
+
+def _failing_pendulum(fail):
+    m, _, j = pendulum()
+    m.add_motion("d", j, displacement=_raising_at(0.12) if fail else (lambda t: 0.5 * t))
+    return m
+
+
+def test_study_variant_failing_mid_run_is_marked_and_the_others_kept():
+    study = mb.Study(_failing_pendulum, {"fail": [0, 1, 0]}, {"last": "final(x(position('b')))"},
+                     analysis={"type": "kinematics", "end_time": 0.5, "output_step": 0.01})
+    df = study.run(workers=0)
+    assert list(df.status) == ["ok", "failed", "ok"]
+    assert "motion 'd'" in df.message[1] and "encoder lost" in df.message[1]
+    assert np.isfinite(df["last"][[0, 2]]).all() and df["last"][0] == pytest.approx(np.cos(0.25), abs=1e-9)

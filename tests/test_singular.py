@@ -67,3 +67,69 @@ def test_a_crank_driven_slider_crank_is_not_flagged():
         res = mb.kinematics(model, 1.0, 0.01)
     assert res.stats["singular"] == []
     assert not [w for w in caught if issubclass(w.category, mb.SingularConfigurationWarning)]
+
+
+# ----------------------------------------------------------------------------- issue 34: geometry, not mass
+RB, RP, H = 1.0, 0.5, 1.0                                    # base and platform radii, height [m]
+BASE = np.radians([-20.0, 20.0, 100.0, 140.0, 220.0, 260.0])
+PLAT = np.radians([-40.0, 40.0, 80.0, 160.0, 200.0, 280.0])
+
+
+def stewart(leg_mass):
+    """6-UPS Stewart platform (platform 10 kg), each leg a cylinder and a piston of `leg_mass` [kg],
+    the legs driven by 5 cm sines of staggered phase; the platform Jacobian's condition number is about
+    4.6 as built and stays small over the motion."""
+    m = mb.Model("stewart", gravity=(0, 0, -9.81))
+    plat = m.add_body("platform", 10.0, inertia=(0.6, 0.6, 1.2), position=(0, 0, H))
+    b = np.stack([RB * np.cos(BASE), RB * np.sin(BASE), np.zeros(6)], 1)
+    p = np.stack([RP * np.cos(PLAT), RP * np.sin(PLAT), np.full(6, H)], 1)
+    for k in range(6):
+        d = p[k] - b[k]
+        u = d / np.linalg.norm(d)
+        a1 = np.cross((0, 0, 1.0), u)
+        a1 /= np.linalg.norm(a1)
+        inertia = (0.01 * leg_mass,) * 3
+        cyl = m.add_body(f"cyl{k}", leg_mass, inertia=inertia, position=b[k] + 0.25 * d)
+        pis = m.add_body(f"pis{k}", leg_mass, inertia=inertia, position=b[k] + 0.75 * d)
+        m.add_universal(f"U{k}", "ground", cyl, b[k], a1, np.cross(u, a1))
+        m.add_translational(f"P{k}", cyl, pis, b[k] + 0.5 * d, u)
+        m.add_spherical(f"S{k}", pis, plat, p[k])
+        ph = float(np.pi * k / 3)
+        m.add_motion(f"leg{k}", f"P{k}", displacement=f"0.05*(sin(2*pi*t + {ph!r}) - {float(np.sin(ph))!r})")
+    return m
+
+
+def timed_kinematics(model):
+    import time
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        t0 = time.perf_counter()
+        res = mb.kinematics(model, 1.0, 0.01)
+        wall = time.perf_counter() - t0
+    return res, wall, [w for w in caught if issubclass(w.category, mb.SingularConfigurationWarning)]
+
+
+def test_stewart_platform_with_near_massless_legs_is_not_flagged_singular():
+    """Before issue 34 the test weighed the Jacobian's columns by 1/sqrt(mass): legs of 1e-6 kg made
+    every sample 'singular' (101 flagged, the Python path instead of the compiled sweep, 16-56 s)."""
+    timed_kinematics(stewart(1.0))                             # compiles / loads the kernels
+    heavy, t_heavy, w_heavy = timed_kinematics(stewart(1.0))
+    light, t_light, w_light = timed_kinematics(stewart(1e-6))
+    for res, warned in ((heavy, w_heavy), (light, w_light)):
+        assert res.success and res.stats["singular"] == [] and not warned
+        assert res.stats["method"] == "kinematic (compiled sweep)"
+    assert light.stats["steps"] == heavy.stats["steps"]
+    np.testing.assert_allclose(light.position("platform"), heavy.position("platform"), atol=1e-9)
+    assert t_light < 3 * t_heavy + 1.0
+
+
+def test_dead_centre_with_near_massless_links_is_still_flagged():
+    """The geometric test flags a true singularity whatever the masses: the slider-driven slider-crank
+    through its dead centre with rod and slider of 1e-6 kg."""
+    model, _ = slider_crank(TH0)
+    for name in ("rod", "slider"):
+        body = model.bodies[name]
+        body.mass, body.inertia = body.mass * 1e-6, body.inertia * 1e-6
+    model.add_motion("push", "slide", displacement=f"{float(C)!r}*(2*{TC}*t - t**2)")
+    res, _, warned = timed_kinematics(model)
+    assert [r["time"] for r in res.stats["singular"]] == [0.5] and len(warned) == 1

@@ -11,7 +11,8 @@ d2 per s^2. Build them with :func:`time_function` (re-exported by :mod:`mbdsim.e
   Richardson-extrapolated central differences (Ridders' tableau: initial step 0.1 s, halved 9
   times, the estimate with the smallest error estimate kept): about 1e-9 relative for smooth
   functions whose time scale is 0.003 s or longer (e.g. sin(300 t)); faster features, or kinks
-  within 0.1 s of t, need explicit d1/d2 or an expression.
+  within 0.1 s of t, need explicit d1/d2 or an expression. Steps at which the callable raises (it
+  fails beyond some time) are skipped, so its derivatives are those of the finer steps.
 
 :func:`integrated` and :func:`double_integrated` turn a velocity or acceleration driver into a
 displacement TimeFunction: an exact expression when the driver's expression has a closed-form
@@ -90,15 +91,25 @@ def _richardson(f, t, order):
     Steps h = 0.1 s, 0.05 s, ... (the actual steps (t + h) - t and t - (t - h) are used, so large
     t only costs roundoff). All 10 levels are always run (20 calls of f): stopping early on a
     growing error estimate mistakes garbage at coarse steps for convergence when f varies fast.
+    Levels at which f raises are skipped while no level has succeeded (a callable that fails beyond
+    some time, e.g. a sensor lost at 0.12 s, still has its derivatives at 0.02 s from the finer steps,
+    so an analysis keeps every sample up to the fault); later failures end the tableau with what it
+    has; when every level raised, the last exception is raised.
     """
     t = np.asarray(t, dtype=float)
     h = np.full(t.shape, _H0)
     f0 = np.asarray(_apply(f, t), dtype=float) if order == 2 else None
-    best, err, prev = None, np.full(t.shape, np.inf), None
+    best, err, prev, failed = None, np.full(t.shape, np.inf), None, None
     for _ in range(_LEVELS):
         tp, tm = t + h, t - h
         hp, hm = tp - t, t - tm
-        fp, fm = np.asarray(_apply(f, tp), dtype=float), np.asarray(_apply(f, tm), dtype=float)
+        try:
+            fp, fm = np.asarray(_apply(f, tp), dtype=float), np.asarray(_apply(f, tm), dtype=float)
+        except Exception as exc:  # noqa: BLE001 - the user's f, re-raised below when no level succeeds
+            if best is not None:
+                break
+            failed, h = exc, h / 2.0
+            continue
         if order == 1:
             row = [(fp - fm) / (hp + hm)]
         else:
@@ -111,6 +122,8 @@ def _richardson(f, t, order):
         if best is None:
             best = row[0]
         prev, h = row, h / 2.0
+    if best is None:
+        raise failed
     return best[()] if best.ndim == 0 else best
 
 

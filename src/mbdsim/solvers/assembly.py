@@ -47,6 +47,8 @@ class AssemblyReport:
             below the tolerance (1e-10 of the model size, 1e-10 rad) is listed.
         velocity_changed: body name -> |change| of its given velocity or angular velocity (SI).
         changed: (entity, field, given, used) of each given value that could not be held.
+        joint_changed: joint name -> {field: used - given} of its initial_displacement [rad or m] or
+            initial_velocity [rad/s or m/s] that could not be held (the fit moved them; also warned).
         notes: remarks on the model's geometry (e.g. universal-joint axes orthogonalised).
         residual: max |phi| after assembly [m or rad].
     `print(report)` gives a readable summary.
@@ -64,6 +66,7 @@ class AssemblyReport:
     residual: float = 0.0
     changed: list = field(default_factory=list)
     notes: list = field(default_factory=list)
+    joint_changed: dict = field(default_factory=dict)
 
     def __repr__(self) -> str:
         return f"AssemblyReport(t={self.t:g} s, dof={self.dof}, residual={self.residual:.3g}, moved={list(self.moved)})"
@@ -80,6 +83,8 @@ class AssemblyReport:
         for name, dv in self.velocity_changed.items():
             lines.append(f"  velocity of {name} changed by {_tiny(dv):.6g}")
         lines += [f"  {e} {f}: given {_fmt(g)}, used {_fmt(u)}" for e, f, g, u in self.changed]
+        for name, fields in self.joint_changed.items():
+            lines += [f"  joint '{name}' {f} changed by {_fmt(d)}" for f, d in fields.items()]
         return "\n".join(lines)
 
 
@@ -165,15 +170,36 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     else:
         v = project_velocities(sys, q, v0, t, rows)
         vmoved = _vchanged(sys, v0, v)
+    moves = [_change(sys, q, e, f, g, u) for e, f, g, u in changed]
     if changed:
         warn("initial values not consistent with the joints and drivers were changed (kinetic-"
-             "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)}"
-                                         for e, f, g, u in changed), InitialConditionWarning)
+             "energy fit): " + "; ".join(f"{e} {f} given {_fmt(g)}, used {_fmt(u)} (changed by {_fmt(d)}{unit})"
+                                         for (e, f, g, u), (d, unit) in zip(changed, moves)),
+             InitialConditionWarning)
+    jmoved = {}
+    for (e, f, _, _), (d, _) in zip(changed, moves):
+        if e.startswith("joint"):
+            jmoved.setdefault(e.split("'")[1], {})[f] = d
     phi = terms[0][rows_all]
     notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
     notes += [planar_note] if planar_note else []
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
-                          vmoved, float(np.max(np.abs(phi), initial=0.0)), changed, notes)
+                          vmoved, float(np.max(np.abs(phi), initial=0.0)), changed, notes, jmoved)
+
+
+def _change(sys, q, entity, fld, given, used):
+    """(used - given, ' unit') of a changed item: angles wrapped to [-pi, pi) [rad], slides [m],
+    their rates [rad/s, m/s]; body velocities [m/s], angular velocities [rad/s]."""
+    d = np.atleast_1d(np.asarray(used, dtype=float) - np.asarray(given, dtype=float))
+    if entity.startswith("body"):
+        return d, " m/s" if fld == "velocity" else " rad/s"
+    from .held import ROTVEC_JOINTS, joint_values
+    jt = sys.model.joints[entity.split("'")[1]]
+    angle = np.ones(len(d), dtype=bool) if jt.kind in ROTVEC_JOINTS else joint_values(sys, jt, q)[4][:len(d)]
+    if fld == "initial_displacement":
+        d = np.where(angle, (d + np.pi) % (2 * np.pi) - np.pi, d)
+    units = [("rad" if a else "m") + ("/s" if fld == "initial_velocity" else "") for a in angle]
+    return d, f" {units[0]}" if len(set(units)) == 1 else f" [{', '.join(units)}]"
 
 
 # ------------------------------------------------------------------------------ positions

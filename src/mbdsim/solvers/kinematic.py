@@ -47,14 +47,15 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
     `res.to_dataframe(markers=markers)` is written to while the run goes and at the end (see
     mbdsim.results.stream; markers: True every marker's columns, or a list of names, as `simulate`).
 
-    The conditioning of the constraint Jacobian (with drivers, columns weighted by the bodies' masses
-    and inertias, rows normalised) is monitored: samples where it falls below SINGULAR_TOL are recorded
-    in res.stats["singular"] (time [s], conditioning, joints involved) and each passage is warned
-    (SingularConfigurationWarning); the branch is kept by continuity, every prediction coming from
-    the last non-singular sample and the rates at a singular sample from that sample's extrapolation.
-    A model the compiled core carries that passes no singular configuration is solved by the compiled
-    kinematic sweep (mbdsim.solvers.kinsweep, the same equations; res.stats["method"] "kinematic
-    (compiled sweep)"), with progress told each sample's time once the sweep is done."""
+    The conditioning of the constraint Jacobian (with drivers, rows normalised, columns scaled by the
+    mechanism's geometry: the model's length [m] for translations, 1 for rotations [rad], never by the
+    masses, see system.metrics.geometric_scale) is monitored: samples where it falls below
+    SINGULAR_TOL are recorded in res.stats["singular"] (time [s], conditioning, joints involved) and
+    each passage is warned (SingularConfigurationWarning); the branch is kept by continuity, every
+    prediction coming from the last non-singular sample and the rates at a singular sample from that
+    sample's extrapolation.  A model the compiled core carries that passes no singular configuration
+    is solved by the compiled kinematic sweep (mbdsim.solvers.kinsweep, the same equations;
+    res.stats["method"] "kinematic (compiled sweep)"), with progress told each sample's time once the sweep is done."""
     from .._progress import progress_of
     from ..results.stream import run_writing
     from .dynamic import _check_markers
@@ -144,8 +145,8 @@ def _compiled_sweep(sys, rep, times):
         return None
     if len(rep.rows) and sys.nv <= DENSE_LIMIT:
         from ..system.equations import jacobians
-        from ..system.metrics import position_metric
-        scale = 1.0 / np.sqrt(position_metric(sys))
+        from ..system.metrics import geometric_scale
+        scale = geometric_scale(sys)
         block = max(1, 2**22 // max(1, sys.nc * sys.nv))   # samples per batch: Jacobians of <= 32 MB at a time
         r = len(rep.rows)   # the rank the rows must keep: that of all rows (the kernel re-selects its own)
         for k in range(0, len(res.time), block):
@@ -160,17 +161,17 @@ def _compiled_sweep(sys, rep, times):
 
 
 class Monitor:
-    """Conditioning of the constraint Jacobian (its columns weighted by 1/sqrt of the position metric and
-    its rows normalised): the r-th over the largest singular value of all its rows in force, r the number
-    of independent rows `rows` (which rows are dependent may change along the motion, as for a loop carried
-    on a turning body; only a loss of rank is a singular configuration), and the joints/motions of the
-    weakest direction."""
+    """Conditioning of the constraint Jacobian (its columns scaled by the geometry, system.metrics.
+    geometric_scale: not by the masses; its rows normalised): the r-th over the largest singular value of
+    all its rows in force, r the number of independent rows `rows` (which rows are dependent may change
+    along the motion, as for a loop carried on a turning body; only a loss of rank is a singular
+    configuration), and the joints/motions of the weakest direction."""
 
     def __init__(self, sys, rows):
-        from ..system.metrics import position_metric
+        from ..system.metrics import geometric_scale
         self.sys, self.rank = sys, len(rows)
         self.rows = np.union1d(rows, np.setdiff1d(np.arange(sys.nc), sys.lock_rows)).astype(int)
-        self.scale = 1.0 / np.sqrt(position_metric(sys))
+        self.scale = geometric_scale(sys)
 
     def __call__(self, q, t):
         sys = self.sys
@@ -241,7 +242,8 @@ def solve_at(sys, q_guess, t, sf=None, hint=None):
     """(t, q, v, vd, lambda_) of the driven mechanism at time t [s].
 
     `hint` = (v, vd) expected by continuity: at a (nearly) singular configuration the rates are the
-    hint corrected by the least change that satisfies the velocity and acceleration equations."""
+    hint corrected by the least change (in the geometric metric of the singularity test) that satisfies
+    the velocity and acceleration equations."""
     q, res, _ = project_positions(sys, q_guess, t, sys.fixed_rows, tol=1e-13, maxit=30)
     if res > 1e-9:
         phi = constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0]
@@ -250,9 +252,9 @@ def solve_at(sys, q_guess, t, sf=None, hint=None):
                             time=t, joints=worst, state=q)
     if hint is None:
         v0, vd0, S, rc = np.zeros(sys.nv), np.zeros(sys.nv), np.ones(sys.nv), None
-    else:   # least change in the mass/inertia metric, the singular direction left to the hint
-        from ..system.metrics import position_metric
-        (v0, vd0), S, rc = hint, 1.0 / np.sqrt(position_metric(sys)), SINGULAR_TOL
+    else:   # least change in the singularity test's geometric metric, the singular direction to the hint
+        from ..system.metrics import geometric_scale
+        (v0, vd0), S, rc = hint, geometric_scale(sys), SINGULAR_TOL
     _, J, nu, _ = constraint_terms(sys, q, np.zeros(sys.nv), t)
     v = v0 + S * np.linalg.lstsq(J * S, nu - J @ v0, rcond=rc)[0]
     _, J, _, gamma = constraint_terms(sys, q, v, t)

@@ -101,7 +101,9 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
     Inertia and velocity-dependent forces are neglected: velocities and accelerations are reported zero,
     reactions and driver efforts are those that hold the mechanism in equilibrium at each time.
     `res.stats["stable"]` is a bool array per sample. A failure stops the run: the Result keeps every
-    sample before it (`success` False, `message`, `error`)."""
+    sample before it (`success` False, `message`, `error`: the mbdsim error, e.g. an EvaluationError
+    naming a load callable that raised, AnalysisInterrupted for Ctrl-C, other exceptions as a
+    SolverError naming their type and the time [s])."""
     from .._progress import progress_of
     from ..results.stream import ProgressError, notify
     from .kinematic import check_model, time_grid
@@ -117,8 +119,9 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
                 q = _onto(sys, q, t, rep.rows)
                 sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit))
                 notify(bar, t)
-            except (SolverError, ProgressError) as exc:
-                error = exc
+            except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
+                from .common import analysis_error
+                error = exc if isinstance(exc, ProgressError) else analysis_error(exc, t)
                 break
             q = sols[-1].q
     _warn_unstable(sols)

@@ -63,3 +63,20 @@ def kinetic_metric(sys) -> np.ndarray:
     empty = diag <= 1e-12 * max(float(diag.max(initial=0.0)), 1e-300)
     M[empty, empty] += D[empty]
     return M
+
+
+@_cached("geometric_scale")
+def geometric_scale(sys) -> np.ndarray:
+    """Column scales (nv,) that make a position increment dimensionless by the mechanism's geometry
+    alone: the model's length L [m] for each CM shift [m] (dx = L dz) and for the auxiliary coordinates
+    (curve parameters), 1 for each rotation [rad].  With the constraint rows normalised, the conditioning
+    of J * scale is that of the mechanism's geometry, independent of the bodies' masses and inertias
+    (a Stewart platform with legs of 1e-6 kg conditions as with heavy legs); used by the kinematic
+    singularity test (solvers.kinematic)."""
+    L = length_scale(sys)
+    S = np.full(sys.nv, L)
+    for k, b in enumerate(sys.bodies):
+        if not b.is_particle:
+            a = sys.frame_v_adr[k + 1]
+            S[a + 3:a + 6] = 1.0
+    return S
