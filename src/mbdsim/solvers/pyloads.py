@@ -66,34 +66,43 @@ class PythonLoads:
 
     def _drive(self, t):
         """The driver callback: value, d1, d2 of each Python-callable driver at t [s] into wk[34:37]."""
-        if self.interrupted:
-            return self._fail_drivers()
-        try:
-            for d, fn, entity in self.drivers:
-                for k, part in enumerate((fn.value, fn.d1, fn.d2)):
-                    x = part(t)
-                    try:
-                        x = float(np.asarray(x, dtype=float).reshape(()))
-                    except (TypeError, ValueError):
-                        raise EvaluationError(entity, "function", f"returned {x!r}, not a number", time=float(t)) from None
-                    if not np.isfinite(x):
-                        raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
-                    self.wk[34 + k][d] = x
-            self.last_failed = False
-            return 0
-        except KeyboardInterrupt:
-            self.interrupted = True
-        except MbdsimError as exc:
-            self.error = exc
-        except Exception as exc:  # noqa: BLE001 - user code
-            self.error = EvaluationError(", ".join(e for _, _, e in self.drivers), "function",
-                                         f"{type(exc).__name__}: {exc}", time=float(t))
-        return self._fail_drivers()
+        return self._guarded(lambda: self._drivers_at(t), ", ".join(e for _, _, e in self.drivers), "function",
+                             t, self._poison_drivers)
 
-    def _fail_drivers(self):
+    def _drivers_at(self, t):
+        for d, fn, entity in self.drivers:
+            for k, part in enumerate((fn.value, fn.d1, fn.d2)):
+                x = part(t)
+                try:
+                    x = float(np.asarray(x, dtype=float).reshape(()))
+                except (TypeError, ValueError):
+                    raise EvaluationError(entity, "function", f"returned {x!r}, not a number", time=float(t)) from None
+                if not np.isfinite(x):
+                    raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
+                self.wk[34 + k][d] = x
+
+    def _poison_drivers(self):
         for d, _, _ in self.drivers:
             for k in range(3):
                 self.wk[34 + k][d] = np.nan
+
+    def _guarded(self, work, entity, field, t, poison):
+        """0 after work() (the callback's evaluation at t [s]); on any failure 1, with the error kept (a
+        user exception named after `entity`.`field`) and the outputs poisoned (poison()). After a Ctrl-C
+        inside it every later call fails at once (an interrupted run)."""
+        self.calls += 1
+        if not self.interrupted:
+            try:
+                work()
+                self.last_failed = False
+                return 0
+            except KeyboardInterrupt:
+                self.interrupted = True
+            except MbdsimError as exc:
+                self.error = exc
+            except Exception as exc:  # noqa: BLE001 - user code: reported with the element's name
+                self.error = EvaluationError(entity, field, f"{type(exc).__name__}: {exc}", time=float(t))
+        poison()
         self.ctl[1], self.last_failed = 1, True
         return 1
 
@@ -112,34 +121,21 @@ class PythonLoads:
         return state, Frames(r, A, rd, w, t=t, q=q, v=v, angle=angle)
 
     def _call(self, t):
-        self.calls += 1
-        if self.interrupted:   # Ctrl-C is not retried: every later call fails until the run ends
-            self.F[:] = np.nan
-            self.ctl[1] = 1
-            return 1
-        try:
-            state, fr = self.state(t)
-            Q = np.zeros(self.sys.nv)
-            for e in self.elems:
-                Q += evaluator(e).generalized(self.sys, fr, e, t, state)
-            if not np.all(np.isfinite(Q)):
-                bad = next(e for e in self.elems if not np.all(np.isfinite(
-                    evaluator(e).generalized(self.sys, fr, e, t, state))))
-                raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
-            for f, a, n in self.slots:
-                self.F[f, :n] = Q[a:a + n]
-            self.last_failed = False
-            return 0
-        except KeyboardInterrupt:
-            self.interrupted = True
-        except MbdsimError as exc:
-            self.error = exc
-        except Exception as exc:  # noqa: BLE001 - user code: reported with the load's name
-            name = self.elems[0].name if len(self.elems) == 1 else ", ".join(e.name for e in self.elems)
-            self.error = EvaluationError(f"load '{name}'", "value", f"{type(exc).__name__}: {exc}", time=float(t))
-        self.F[:] = np.nan
-        self.ctl[1], self.last_failed = 1, True
-        return 1
+        """The load callback: generalized loads of the called-back elements at t [s] into slot 48[0]."""
+        names = ", ".join(e.name for e in self.elems)
+        return self._guarded(lambda: self._loads_at(t), f"load '{names}'", "value", t, lambda: self.F.fill(np.nan))
+
+    def _loads_at(self, t):
+        state, fr = self.state(t)
+        Q = np.zeros(self.sys.nv)
+        for e in self.elems:
+            Q += evaluator(e).generalized(self.sys, fr, e, t, state)
+        if not np.all(np.isfinite(Q)):
+            bad = next(e for e in self.elems if not np.all(np.isfinite(
+                evaluator(e).generalized(self.sys, fr, e, t, state))))
+            raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
+        for f, a, n in self.slots:
+            self.F[f, :n] = Q[a:a + n]
 
 
 def settle(pyl, status, error):
