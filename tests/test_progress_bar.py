@@ -71,3 +71,36 @@ def test_the_bar_in_a_terminal_shows_the_time_and_updates_at_most_ten_times_a_se
     assert "simulating demo" in text and "t = " in text
     assert during <= 1 + elapsed * REFRESH_HZ + 1                  # 20000 calls, a handful of bar updates
     assert bar.updates == during + 1 and bar.t == 2.0             # the last time is shown at the end
+
+
+def test_default_progress_shows_a_bar_only_in_a_terminal_and_after_the_delay(monkeypatch):
+    """progress=None: in a terminal (or notebook) a bar appears once the run has taken DELAY s of wall time;
+    outside a terminal, or before the delay, nothing is drawn."""
+    import mbdsim._progress as pr
+    made = []
+
+    class Recorder:
+        def __init__(self, *args):
+            made.append(args)
+            self.ts = []
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            made.append("closed")
+
+        def __call__(self, t):
+            self.ts.append(t)
+    monkeypatch.setattr(pr, "ProgressBar", Recorder)
+    with pr.progress_of(None, "simulate", "sim", 0.0, 2.0) as p:   # not a terminal here: nothing
+        assert p is None
+    monkeypatch.setattr(pr, "interactive", lambda: True)
+    with pr.progress_of(None, "simulate", "sim", 0.0, 2.0) as p:   # a terminal, before the delay: no bar
+        p(0.5)
+    assert made == []
+    monkeypatch.setattr(pr, "DELAY", 0.0)
+    with pr.progress_of(None, "simulate", "sim", 0.0, 2.0) as p:   # past the delay: the bar, closed at the end
+        p(0.5)
+        p(1.0)
+    assert made == [("sim", 0.0, 2.0), "closed"]

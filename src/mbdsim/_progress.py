@@ -1,8 +1,9 @@
 """`progress=True`: a rich progress bar of the analysis time reached, on stderr.
 
-`simulate`, `kinematics` and `quasi_static` take `progress` as None / False (nothing), a callable
-progress(t) of the time reached [s] (the user's own reporting), or True (this bar: "<label> ━━━  t = 0.42 s
-0:00:03"). A call stores the time reached and hands it to the bar at most REFRESH_HZ times per second
+`simulate`, `kinematics` and `quasi_static` take `progress` as False (nothing), a callable progress(t) of
+the time reached [s] (the user's own reporting), True (this bar: "<label> ━━━  t = 0.42 s 0:00:03") or
+None, the default: in a terminal or a notebook the bar appears once the run has taken DELAY = 2 s of
+wall time (the runs expected to take more than a few seconds), elsewhere nothing. A call stores the time reached and hands it to the bar at most REFRESH_HZ times per second
 (its cost per solver report is a clock read and a comparison); rich redraws at the same rate and
 removes the bar at the end (transient) in a terminal; it draws nothing where stderr is not a terminal. The command line
 (`mbdsim run`, `kinematics`, `statics`) uses the same bar.
@@ -17,6 +18,12 @@ from typing import Any, Iterator
 from .errors import ModelError
 
 REFRESH_HZ = 10.0      # redraws per second, at most
+DELAY = 2.0            # [s] of wall time before the default bar (progress=None) appears
+
+
+def interactive() -> bool:
+    """True in a terminal (stderr is a TTY) or in a Jupyter kernel: where the default shows a bar."""
+    return sys.stderr.isatty() or "ipykernel" in sys.modules
 
 
 class ProgressBar:
@@ -59,22 +66,52 @@ class ProgressBar:
         self.updates += 1
 
 
+class DelayedBar:
+    """The default (progress=None) in a terminal or notebook: a ProgressBar that appears once the analysis
+    has run DELAY s of wall time (the runs expected to take more than a few seconds), nothing before."""
+
+    def __init__(self, label: str, start: float, end: float) -> None:
+        self.args, self.t0, self.bar = (label, start, end), time.monotonic(), None
+
+    def __call__(self, t: float) -> None:
+        if self.bar is None:
+            if time.monotonic() - self.t0 < DELAY:
+                return
+            self.bar = ProgressBar(*self.args).__enter__()
+        self.bar(t)
+
+    def close(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
+
+
 @contextlib.contextmanager
 def progress_of(progress: Any, entity: str, label: str, start: float, end: Any) -> Iterator[Any]:
-    """The progress argument an analysis passes on: None for None / False, the user's callable as it
-    is, or for True a ProgressBar from start to end [s], shown while the block runs. Anything else is a
+    """The progress argument an analysis passes on: None for False (and for None outside a terminal or
+    notebook), the user's callable as it is, for True a ProgressBar from start to end [s], shown while the
+    block runs, and for None in a terminal or notebook a DelayedBar (shown after DELAY s). Anything else is a
     ModelError naming `entity`.progress (before any work)."""
-    if progress is None or progress is False:
+    if progress is None and interactive():
+        delayed = DelayedBar(label, *_times(start, end))
+        try:
+            yield delayed
+        finally:
+            delayed.close()
+    elif progress is None or progress is False:
         yield None
     elif progress is True:
-        try:
-            start, end = float(start), float(end)
-        except (TypeError, ValueError):   # bad times are the analysis's own error, raised inside the block
-            start, end = 0.0, 1.0
-        with ProgressBar(label, start, end) as bar:
+        with ProgressBar(label, *_times(start, end)) as bar:
             yield bar
     elif callable(progress):
         yield progress
     else:
         raise ModelError(entity, "progress", f"expected True, False, None or a callable progress(t) of the time "
                          f"reached [s], got {progress!r}")
+
+
+def _times(start: Any, end: Any) -> tuple[float, float]:
+    """(start, end) [s] as floats; bad times are the analysis's own error, raised inside the block."""
+    try:
+        return float(start), float(end)
+    except (TypeError, ValueError):
+        return 0.0, 1.0
