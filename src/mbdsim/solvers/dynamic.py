@@ -67,7 +67,8 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     progress: True shows a progress bar of the simulated time on stderr (rich, redrawn at most 10 times a
     second, mbdsim._progress); a callable progress(t) receives the simulated time reached [s] now and then
     (an exception it raises ends the run like any failure below, res.error a ProgressError naming
-    analysis.progress); None or False: nothing; anything else is a ModelError before any work.
+    analysis.progress); False: nothing; None (default): the bar once the run has taken 2 s, in a terminal or
+    notebook only; anything else is a ModelError before any work.
     Every failure during the run (solver, a user function raising or returning a non-number or a
     non-finite value, Ctrl-C) ends it with `res.success = False`, `res.message` and `res.error` naming the
     element, field and time (EvaluationError, SolverError, AnalysisInterrupted), the Result holding

@@ -42,8 +42,8 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
 
     progress: True shows a progress bar on stderr (as `simulate`); a callable progress(t) receives the time
     reached [s] after each sample; Ctrl-C or an exception it raises returns the partial Result
-    (success=False; res.error a ProgressError naming analysis.progress); None or False: nothing; anything
-    else is a ModelError before any work. out: optional .parquet / .csv path that
+    (success=False; res.error a ProgressError naming analysis.progress); False: nothing; None (default):
+    the bar after 2 s in a terminal or notebook; anything else is a ModelError before any work. out: optional .parquet / .csv path that
     `res.to_dataframe(markers=markers)` is written to while the run goes and at the end (see
     mbdsim.results.stream; markers: True every marker's columns, or a list of names, as `simulate`).
 

@@ -95,8 +95,8 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
     """Quasi-static analysis: the static equilibrium at each output time from start_time to end_time [s]
     (every output_step [s]) of a mechanism whose motions move it; each solve starts from the previous one.
     progress: True shows a progress bar on stderr, a callable progress(t) receives each solved time [s]
-    (an exception it raises ends the run as a failure does, res.error a ProgressError), None or False
-    nothing (as `simulate`).
+    (an exception it raises ends the run as a failure does, res.error a ProgressError), False nothing,
+    None (default) the bar after 2 s in a terminal or notebook (as `simulate`).
 
     Inertia and velocity-dependent forces are neglected: velocities and accelerations are reported zero,
     reactions and driver efforts are those that hold the mechanism in equilibrium at each time.
