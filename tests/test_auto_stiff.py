@@ -279,3 +279,17 @@ def test_hand_over_on_a_jointed_model_keeps_constraints_accelerations_and_energy
     E = res.kinetic_energy() + res.potential_energy()
     D = res.dissipated_energy()
     assert np.max(np.abs(E + D - E[0])) < 5e-3 * E[0]   # E[0]: the spring's 0.5 k (1e-5 m)^2
+
+
+def test_hand_over_says_which_tolerance_hht_reached():
+    """Default settings: the outputs' target is 1e-7, HHT continues at its own 1e-5 and says so
+    (AccuracyWarning, res.stats["rtol_reached"]); a given rtol is HHT's own, so no warning then."""
+    import warnings
+    m, _ = stiff_spring(1e8, 1e6, 1e-3)
+    with pytest.warns(mb.AccuracyWarning, match=r"rtol 1e-05.*target 1e-07"):
+        res = mb.simulate(m, 0.02, output_step=5e-4)
+    assert "stiffness detected" in res.stats["method"] and res.stats["rtol_reached"] == 1e-5
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", mb.AccuracyWarning)
+        res = mb.simulate(m, 0.02, output_step=5e-4, rtol=1e-5)
+    assert res.stats["rtol_reached"] == 1e-5

@@ -33,6 +33,7 @@ _LAZY = {
     "OutputError": ".studies.measures", "InertiaWarning": ".model._check",
     "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
+    "AccuracyWarning": ".solvers.autoswitch",
 }
 
 
@@ -59,7 +60,7 @@ __all__ = [
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",
     "AnalysisInterrupted", "ProgressError", "ExpressionError", "OutputError",
     "RedundantConstraintWarning", "InitialConditionWarning", "SingularConfigurationWarning", "InertiaWarning",
-    "InitialPenetrationWarning", "MonitorWarning", "IndeterminateReactionWarning",
+    "InitialPenetrationWarning", "MonitorWarning", "IndeterminateReactionWarning", "AccuracyWarning",
     "expressions", "functions", "parse",
     "plot", "animate",
     "Study", "load_study", "plot_study", "sensitivity",

@@ -47,6 +47,22 @@ class OrderTrack:
             self.history.append((float(t_old), self.name, order))
 
 
+class AccuracyWarning(UserWarning):
+    """The automatic method could not run at the requested (or default) tolerance: after a stiffness
+    hand-over HHT, second order, ran at a looser rtol (`res.stats["rtol_reached"]`)."""
+
+
+def warn_reached(res, reached: float, target: float, reason: str) -> None:
+    """Record in res.stats["rtol_reached"] the rtol HHT ran at and warn (AccuracyWarning) when it is
+    looser than the target rtol of the outputs."""
+    from .._userwarn import warn
+    res.stats["rtol_reached"] = reached
+    if reached > target:
+        warn(f"simulate: {reason}; HHT (second order) ran at rtol {reached:g}, so the outputs from there are "
+             f"accurate to about that, not to the target {target:g} (give rtol to tighten HHT, at the cost of "
+             "its second order)", AccuracyWarning)
+
+
 def continue_implicit(sys, rep, times, stiff, rtol, atol, max_step, progress, reason) -> Result:
     """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and HHT from its
     switch time on (rtol, atol: HHT's tolerances); `reason` goes into res.stats["method"]. Accelerations

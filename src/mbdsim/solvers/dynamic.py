@@ -20,6 +20,7 @@ from ..system.assemble import assemble_system
 from ..system.compiled import NotCompiled
 from ..system.force_elements import evaluator
 from .assembly import assemble_state
+from .autoswitch import warn_reached
 from .compiled_run import Stiff, integrate_compiled
 from .common import _weak_joints, consistent_state  # noqa: F401  (names other modules import from here)
 from .checks import check_initial_contacts
@@ -188,8 +189,10 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             if exc.prefix is not None and _default_method(model) == "hht":   # HHT continues from there
                 from .autoswitch import continue_implicit
                 hr = None if user_rtol is None else max(user_rtol, HHT_RTOL_FLOOR)
-                return continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
-                                         progress, reason)
+                res = continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
+                                        progress, reason)
+                warn_reached(res, _tolerances("hht", hr, user_atol)[0], rt, reason)
+                return res
         else:
             reason = "compiled path disabled"
         method = _default_method(model)
@@ -202,6 +205,8 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             user_rtol = max(user_rtol, HHT_RTOL_FLOOR)   # stiff hand-over: HHT's own floor
         res = _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
         res.stats["method"] = f"auto: {res.stats.get('method', method)} ({reason})"
+        if method == "hht":
+            warn_reached(res, _tolerances("hht", user_rtol, user_atol)[0], rt, reason)
         return res
     return _run(sys, rep, times, method, *_tolerances(method, user_rtol, user_atol), max_step, progress)
 
