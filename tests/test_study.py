@@ -412,3 +412,31 @@ def test_study_units_of_parameters_and_outputs():
     assert output_unit("degrees(final(joint_coordinate('j')))") == "" and output_unit(len) == ""
     factory = mb.Study(slider_crank, {"crank": ["100 mm", "120 mm"], "rod_mass": [1.0, 3.0]}, SC_OUT, analysis=FAST)
     assert factory.units["crank"] == "m" and "rod_mass" not in factory.units
+
+
+def test_designs_over_the_size_limit_are_refused_before_any_is_generated():
+    import time
+    from mbdsim.studies.design import MAX_VARIANTS, ParameterSpec, make_design
+    from scipy import stats
+    grid = [ParameterSpec(f"p{k}", values=tuple(range(10))) for k in range(10)]   # 1e10 variants
+    t0 = time.monotonic()
+    with pytest.raises(mb.ModelError) as err:
+        make_design(grid)
+    assert (err.value.entity, err.value.field) == ("study", "values") and "1e+10 variants" in str(err.value)
+    with pytest.raises(mb.ModelError) as err:
+        make_design([ParameterSpec("m", dist=stats.uniform(1, 2))], "lhs", samples=10**9)
+    assert err.value.field == "samples" and f"{MAX_VARIANTS:,}" in str(err.value)
+    assert time.monotonic() - t0 < 5.0
+    assert len(make_design([ParameterSpec("a", values=(1.0, 2.0))])) == 2
+
+
+def test_output_power_towers_are_double_precision_not_endless():
+    """'9**9**9' was Python's exact integer power (it never ends); now double precision: inf at once."""
+    import subprocess
+    import sys
+    code = ("from mbdsim.studies.measures import compile_output, evaluate_outputs, OutputError\n"
+            "assert compile_output('o', '2**3')(None) == 8.0\n"
+            "print(evaluate_outputs({'o': '9**9**9', 'p': '2**10000'}, None))\n")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "{'o': inf, 'p': inf}"

@@ -31,6 +31,8 @@ from ..errors import ModelError
 __all__ = ["ParameterSpec", "parse_parameter", "make_design", "to_si_value", "SAMPLING_METHODS"]
 
 SAMPLING_METHODS = ("grid", "lhs", "sobol", "random")
+MAX_VARIANTS = 1_000_000   # variants a study may have (refused above, before any is generated: a design
+#                            of 10**9 rows would take tens of GB before the first run)
 DISTRIBUTIONS = {"normal": ("mean", "std"), "uniform": ("low", "high"), "lognormal": ("median", "sigma")}
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(.*?)\s*$")
 
@@ -196,6 +198,7 @@ def make_design(params: list[ParameterSpec], sampling: str | None = None, sample
         if bad:
             raise ModelError(_entity(bad[0]), "values", "a grid needs discrete values (or a range with num); "
                              "use sampling 'lhs', 'sobol' or 'random' for ranges and distributions")
+        _check_size("values", [len(p.values) for p in params], params)
         rows = list(itertools.product(*(p.values for p in params)))
         return _frame(rows, [p.name for p in params])
     cont = [p for p in params if p.dist is not None]
@@ -205,11 +208,24 @@ def make_design(params: list[ParameterSpec], sampling: str | None = None, sample
                          "here has discrete values: use sampling 'grid'")
     if not isinstance(samples, int) or isinstance(samples, bool) or samples < 1:
         raise ModelError("study", "samples", f"sampling '{sampling}' needs a positive number of samples, got {samples!r}")
+    _check_size("samples", [len(p.values) for p in disc] + [samples], params)
     u = _unit_cube(sampling, samples, len(cont), seed)
     cols = [np.asarray(p.dist.ppf(u[:, k]), dtype=float) for k, p in enumerate(cont)]
     sampled = list(zip(*cols))
     rows = [d + s for d in itertools.product(*(p.values for p in disc)) for s in sampled]
     return _frame(rows, [p.name for p in disc] + [p.name for p in cont])[[p.name for p in params]]
+
+
+def _check_size(field: str, counts: list, params) -> None:
+    """ModelError naming the study's `field` when the design would have more than MAX_VARIANTS rows."""
+    n = 1
+    for c in counts:
+        n *= int(c)
+    if n > MAX_VARIANTS:
+        what = " x ".join(str(int(c)) for c in counts)
+        raise ModelError("study", field, f"the design has {n:.3g} variants ({what} over "
+                         f"{', '.join(p.name for p in params)}), more than the {MAX_VARIANTS:,} a study runs "
+                         "(mbdsim.studies.design.MAX_VARIANTS): use fewer values or samples, or split the study")
 
 
 def _frame(rows, names) -> pd.DataFrame:

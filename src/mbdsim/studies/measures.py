@@ -139,7 +139,11 @@ class _Interpreter:
                 return res.time
             return self.ns[node.id] if node.id in self.ns else CONSTANTS[node.id]
         if isinstance(node, ast.BinOp):
-            return BINOPS[type(node.op)](self.ev(node.left, res), self.ev(node.right, res))
+            a, b = self.ev(node.left, res), self.ev(node.right, res)
+            if isinstance(node.op, ast.Pow):   # in double precision: Python's exact integer power of
+                with np.errstate(all="ignore"):   # "9**9**9" would never end (inf instead: a clear error)
+                    return np.power(np.asarray(a, dtype=float), np.asarray(b, dtype=float))
+            return BINOPS[type(node.op)](a, b)
         if isinstance(node, ast.UnaryOp):
             return UNARY[type(node.op)](self.ev(node.operand, res))
         if isinstance(node, ast.Subscript):
@@ -212,7 +216,8 @@ def compile_output(name: str, spec):
 
 
 def evaluate_outputs(outputs: dict, res) -> dict:
-    """{name: float} of every output on `res`; a value that is not a finite scalar raises OutputError."""
+    """{name: float} of every output on `res`; a value that is not one number raises OutputError (nan and
+    inf pass through, e.g. the time of an event that never happens, or an overflow)."""
     out = {}
     for name, spec in outputs.items():
         try:
