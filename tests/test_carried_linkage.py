@@ -27,6 +27,8 @@ from scipy.spatial.transform import Rotation
 import mbdsim as mb
 
 A_, B_, C_, D_ = 0.1, 0.3, 0.25, 0.3       # crank, coupler, rocker, base [m] (Grashof crank-rocker)
+from test_core_four_bar import A_ as _A, B_ as _B, C_ as _C, D_ as _D, closure, e  # noqa: E402  (same linkage)
+assert (_A, _B, _C, _D) == (A_, B_, C_, D_)   # closure() solves test_core_four_bar's link lengths
 TH1_0 = np.radians(60.0)                   # crank angle in the four-bar's plane at t = 0
 X0 = 0.15                                  # the four-bar's base pivot O on the spindle's x axis [m]
 MASS = (0.5, 1.2, 0.9)                     # crank, coupler, rocker [kg]
@@ -43,20 +45,6 @@ def watchdog(seconds=WATCHDOG_S):
         yield
     finally:
         faulthandler.cancel_dump_traceback_later()
-
-
-def e(th):
-    return np.array([np.cos(th), np.sin(th)])
-
-
-def closure(th1):
-    """Coupler and rocker angles [rad] in the four-bar's plane for crank angle th1 (open branch)."""
-    A, C = A_ * e(th1), np.array([D_, 0.0])
-    d = np.linalg.norm(C - A)
-    x = (B_**2 - C_**2 + d**2) / (2 * d)
-    u = (C - A) / d
-    B = A + x * u + np.sqrt(B_**2 - x**2) * np.array([-u[1], u[0]])
-    return np.arctan2(*(B - A)[::-1]), np.arctan2(*(B - C)[::-1])
 
 
 def planar_points(th1):
