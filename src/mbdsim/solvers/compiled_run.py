@@ -29,7 +29,7 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
                         "or a discontinuity)",
              MAX_STEPS: "step budget exhausted (max_steps)",
              STIFF: "the model is stiff for an explicit method",
-             INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load written as a Python callable failed"}
+             INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load or driver written as a Python callable failed"}
 PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.run_error)
 CHUNK = 256
 CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand

@@ -172,9 +172,9 @@ def _reselect(cm, wk):
     best conditioned independent subset, greedily), then factor with them. A loop carried on a turning
     body needs this: which of its rows are dependent changes with the turn (a four-bar's out-of-plane
     rows in ground axes). Where all loop rows lose rank (a change point of the mechanism) the rows in use
-    are kept. Where even the best subset stays nearly dependent (a change point of the
-    mechanism) the re-selection threshold wk[47][0] drops below its ratio, so that the factorisations
-    near it are not re-selected again; it returns to nominal once the ratio has recovered."""
+    are kept; where even the best subset stays nearly dependent, the re-selection threshold wk[47][0]
+    drops below its ratio, so that the factorisations near it are not re-selected again; it returns to
+    nominal once the ratio has recovered."""
     cand, sel, lim = cm[45], wk[46], wk[47]
     n = sel.shape[0]
     if not _kkt(cm, wk, cand):
@@ -344,8 +344,7 @@ def read_state(cm, wk, yrow, y):
 def joint_rows(cm, wk, Y, Yref, YJ):
     """Tree path: the joint state YJ[k] of each output row Y[k] (`read_state`), every angle continued to
     within pi of the reference joint state Yref[k] (Yref[-1] past its rows; e.g. the run's own state at a
-    nearby step), so that
-    loads of joint angles see the run's continuous angles beyond +-pi."""
+    nearby step), so that loads of joint angles see the run's continuous angles beyond +-pi."""
     jtype, qadr = cm[42][1], cm[42][7]
     for k in range(Y.shape[0]):
         read_state(cm, wk, Y[k], YJ[k])

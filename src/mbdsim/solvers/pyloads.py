@@ -1,13 +1,15 @@
 """Loads (t, state) and drivers (t) written as Python callables, evaluated from inside the compiled step
 loop (issue 29).
 
-`attach(sys, cm, work)` wraps the model's callable loads (`system.compiled.python_loads`) in one ctypes
+`attach(sys, cm, work)` wraps the force elements the kernels call back (`CompiledModel.python_loads`: Python
+callables, and elements that cannot be packed in the model's formulation, `system.compiled._called_back`)
+in one ctypes
 callback `int64 f(double t)` whose address goes into the work arrays (slot 48); the kernels' `loads_into`
 calls it at every evaluation of the loads (solvers.pycall). The callback reads the frames the kernel has
 just computed (r, A, rd, w: work slots 0-3, ground axes), rebuilds the absolute state [q, v] from them
 (one compiled call, `fasttree.to_maximal`), hands the user's callable a light `State` of that one instant
 (its frames injected, so nothing is recomputed; `results.state.State`), and writes the generalized loads
-of the callables (the same evaluators as the reference path: `system.force_elements`) into work slot
+of those elements (the same evaluators as the reference path: `system.force_elements`) into work slot
 48[0] (six slots per frame: force [N] in ground axes, torque [N m] in body axes).
 
 Drivers whose function has no compiled program (a Python callable of t, or an integral without a closed

@@ -86,8 +86,9 @@ class CompiledModel:
     # arrays()[45]: the loop rows the kernel may select from (all loop rows of the spanning tree;
     # `fastdyn._factor` re-selects among them when the rows in use turn dependent as the configuration changes)
     cand: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
-    python_loads: tuple = ()  # names of the loads written as Python callables (t, state): evaluated by
-    #                           the callback of solvers.pyloads from inside the kernels (Work slot 48)
+    python_loads: tuple = ()  # names of the force elements called back through their Python evaluators by
+    #                           solvers.pyloads from inside the kernels (Work slot 48): Python callables and
+    #                           what cannot be packed here (`_called_back`)
     python_drivers: tuple = ()   # driver indices (into the packed driver functions) called back the same way
 
     def arrays(self) -> tuple:
