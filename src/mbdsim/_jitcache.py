@@ -6,6 +6,13 @@ Keying the cache directory on a hash of every kernel module makes any change sta
 Imported (by `mbdsim.system`) before any kernel module is compiled or loaded. A user-set
 NUMBA_CACHE_DIR is respected (the hash is appended below it).
 
+The cache does not depend on where mbdsim is installed: numba files each module's kernels under a
+hash of the source directory's absolute path, so a second clone, a new virtual environment or a
+moved checkout compiled everything again (214 s on a second clone).  `_PackageCacheLocator` files
+mbdsim's kernels under their path inside the package instead; numba itself still checks each file's
+content hash, its own version and the CPU (its index and data keys), so a changed kernel, another
+numba or another machine never loads a stale entry.
+
 Loading a cached kernel: numba's `FunctionCache.load_overload` first refreshes the whole CPU target
 context (imports and installs every typing and lowering registry, numba.np.linalg's check for scipy's
 BLAS included: 0.3-0.8 s in a fresh process), which only a compilation needs: rebuilding a cached
@@ -48,6 +55,45 @@ def configure() -> str:
     return path
 
 
+def _package_locator() -> bool:
+    """Put `_PackageCacheLocator` first in numba's locator list; False when this numba lacks it."""
+    try:
+        from numba.core import caching
+        base = caching.UserProvidedCacheLocator
+        impl = caching.CacheImpl
+    except (ImportError, AttributeError):
+        return False
+    if any(getattr(c, "mbdsim", False) for c in impl._locator_classes):
+        return True
+
+    class _PackageCacheLocator(base):
+        """mbdsim's modules, cached under `CACHE_DIR/<path inside the package>`, whatever the
+        checkout's absolute path; any other file falls through to numba's locators."""
+
+        mbdsim = True
+
+        def __init__(self, py_func, py_file):
+            super().__init__(py_func, py_file)
+            rel = Path(py_file).resolve().parent.relative_to(_HERE.resolve())
+            self._cache_path = os.path.join(numba_config().CACHE_DIR, "mbdsim", *rel.parts)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            try:
+                Path(py_file).resolve().relative_to(_HERE.resolve())
+            except (ValueError, OSError):
+                return None
+            return super().from_function(py_func, py_file)
+
+    impl._locator_classes.insert(0, _PackageCacheLocator)
+    return True
+
+
+def numba_config():
+    from numba.core import config
+    return config
+
+
 def _fast_cached_loads() -> bool:
     """Install the short load path for the cached kernels of mbdsim's modules (see the module
     docstring); False (numba's own method kept) when this numba lacks the internals it relies on."""
@@ -79,4 +125,5 @@ def _fast_cached_loads() -> bool:
 
 
 CACHE_DIR = configure()
+PACKAGE_LOCATOR = _package_locator()
 FAST_LOADS = _fast_cached_loads()
