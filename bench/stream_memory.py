@@ -3,7 +3,8 @@ simulate(out=...) to a Parquet dataset, in a fresh process, as a user would run 
 
     import mbdsim as mb; model = ...; mb.simulate(model, 1000, 0.001, out="run.parquet")
 
-    python bench/stream_memory.py [END] [--memory]    (default END = 1000 s; --memory: the in-memory run)
+    python bench/stream_memory.py [END] [--memory] [--csv]    (default END = 1000 s; --memory: the in-memory
+                                                               run; --csv: out="run.csv", one streamed CSV file)
 
 Nothing is loaded or run before the measured call but `import mbdsim` and building the model (no warm-up
 run, no pandas: the streamed writer does not use it). Peak RSS is VmHWM of the whole process (Python,
@@ -43,6 +44,7 @@ def peak_mb() -> float:
 def main():
     end = float(next((a for a in sys.argv[1:] if not a.startswith("--")), 1000.0))
     in_memory = "--memory" in sys.argv
+    as_csv = "--csv" in sys.argv
     import mbdsim as mb
     m = mb.Model("double_pendulum", gravity=(0.0, -9.81, 0.0))
     a = m.add_body("a", 1.0, inertia=(0.01, 0.01, 0.01), position=(0.5, 0.0, 0.0))
@@ -55,7 +57,7 @@ def main():
     def progress(t):
         if not first:
             first.append(rss_mb())
-    out = Path(tempfile.mkdtemp()) / "run.parquet"
+    out = Path(tempfile.mkdtemp()) / ("run.csv" if as_csv else "run.parquet")
     t0 = time.perf_counter()
     if in_memory:
         res = mb.simulate(m, end, 0.001, progress=progress)
@@ -71,7 +73,11 @@ def main():
     scipy_sub = sorted({k.split(".")[1] for k in mods if k.startswith("scipy.") and not k.split(".")[1][0] == "_"})
     print(f"  RSS [MB]: model built {base:.0f}, first progress report {first[0] if first else float('nan'):.0f}, "
           f"end {last:.0f}; pandas imported: {'pandas' in sys.modules}; scipy subpackages: {scipy_sub}")
-    if not in_memory:
+    if as_csv and not in_memory:
+        with open(out, "rb") as fh:
+            n = sum(1 for _ in fh) - 1
+        print(f"file {out}: {n} rows, {out.stat().st_size / 2**20:.0f} MiB on disk")
+    elif not in_memory:
         import pyarrow.parquet as pq
         n = sum(pq.ParquetFile(p).metadata.num_rows for p in out.glob("part-*.parquet"))
         size = sum(p.stat().st_size for p in out.iterdir()) / 2**20

@@ -155,3 +155,32 @@ def test_resume_after_a_kill_inside_an_atomic_write(tmp_path, small_chunks):
     (out / "notes.txt").write_text("a user's file")
     with pytest.raises(mb.ModelError, match="not written by mbdsim"):
         mb.simulate(m, 0.5, 0.001, out=out, resume=True)
+
+
+def test_csv_is_streamed_in_parts_equal_to_the_in_memory_table(tmp_path, small_chunks, monkeypatch):
+    """Issue 35: out=.csv on the compiled path is one file appended part by part (bounded memory, as the
+    Parquet dataset), not a whole table rewritten from a pandas frame; its rows are the in-memory
+    run's to_dataframe() exactly (floats written as round-trip text)."""
+    appended = []
+    original = stream.CsvFile.part
+    monkeypatch.setattr(stream.CsvFile, "part", lambda self, cols: (appended.append(len(cols["time [s]"])),
+                                                                     original(self, cols))[1])
+    m = double_pendulum()
+    ref = mb.simulate(m, 3.0, 0.001)
+    res = mb.simulate(m, 3.0, 0.001, out=tmp_path / "run.csv")
+    assert res.success and res.stats["method"] == "DOP853 (compiled, streamed)" and res.stats["samples"] == 3001
+    assert len(appended) >= 3 and sum(appended) == 3001   # appended in parts, every row once
+    df, d0 = pd.read_csv(tmp_path / "run.csv"), ref.to_dataframe()
+    assert list(df.columns) == list(d0.columns) and len(df) == len(d0)
+    assert np.max(np.abs(df.to_numpy() - d0.to_numpy())) < 1e-10
+    assert np.max(np.abs(np.diff(df["j2.angle [rad]"].to_numpy()))) < 0.1   # continuous across parts
+    # a rerun replaces the file mbdsim wrote; a foreign .csv and resume are refused before any work
+    mb.simulate(m, 0.2, 0.01, out=tmp_path / "run.csv")
+    assert len(pd.read_csv(tmp_path / "run.csv")) == 21
+    (tmp_path / "theirs.csv").write_text("a,b\n1,2\n")
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, 0.2, 0.01, out=tmp_path / "theirs.csv")
+    assert err.value.field == "out" and (tmp_path / "theirs.csv").read_text() == "a,b\n1,2\n"
+    with pytest.raises(mb.ModelError) as err:
+        mb.simulate(m, 0.2, 0.01, out=tmp_path / "run.csv", resume=True)
+    assert err.value.field == "resume"

@@ -80,6 +80,28 @@ def write_parquet(cols: dict, path) -> None:
     pq.write_table(table, path, use_dictionary=False)
 
 
+def write_csv(cols: dict, fh, header: bool = True) -> None:
+    """Write {column name: 1-D float array} as CSV rows to the binary file `fh` (with the header row when
+    `header`) through pyarrow (no pandas frame: bounded by the columns given); floats as the shortest text
+    that reads back to the same double, integral values with ".0" ("0.0", not "0") so that pandas reads
+    every column back as float."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+    import pyarrow.csv as pcsv
+    arrays = []
+    for name, v in cols.items():
+        x = np.ascontiguousarray(v, dtype=float)
+        if x.ndim != 1:
+            raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
+        a = pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)])
+        text = pc.cast(a, pa.string())
+        integral = pc.and_(pc.equal(pc.floor(a), a), pc.less(pc.abs(a), 1e15))
+        arrays.append(pc.if_else(integral, pc.binary_join_element_wise(text, ".0", ""), text))
+    table = pa.Table.from_arrays(arrays, names=list(cols))
+    pcsv.write_csv(table, fh, write_options=pcsv.WriteOptions(include_header=header, quoting_style="none",
+                                                              batch_size=4096))
+
+
 def _mbdsim_header(names) -> bool:
     """Column names of an mbdsim table: "time [s]" first, every one "name [unit]"."""
     names = list(names)
@@ -145,8 +167,12 @@ class ResultFile:
         if self.path.suffix.lower() == ".parquet":   # pyarrow directly: no pandas import to write
             from .export import columns
             write_parquet(columns(res, self.markers), tmp)
-        else:
-            res.to_dataframe(markers=self.markers).to_csv(tmp, index=False)
+        else:   # pyarrow's CSV writer from the columns: no pandas frame beside them
+            from .export import columns
+            if len(res.time) == 0:
+                res.to_dataframe()   # the ModelError of an empty result
+            with open(tmp, "wb") as fh:
+                write_csv(columns(res, self.markers), fh)
         os.replace(tmp, self.path)
         self.writes += 1
         self.last = time.monotonic()

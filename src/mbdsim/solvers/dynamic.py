@@ -83,9 +83,10 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     computed, with checkpoints: bounded memory whatever the length (the returned Result holds every
     output while they fit 8 MB (stream.STREAM_KEEP), else the last part; res.stats["out"], ["samples"]) and
     resume=True continues it from its last checkpoint, bit-identical to an uninterrupted run
-    (mbdsim.solvers.stream). Otherwise `res.to_dataframe()` of the outputs so far is rewritten every few
-    seconds, atomically, and completely at the end (mbdsim.results.stream); `pandas.read_parquet(out)`
-    reads either. markers: the marker columns of the out= table, as `res.to_dataframe(markers=...)`: True
+    (mbdsim.solvers.stream); a ".csv" path there is one CSV file streamed the same way (rows appended
+    part by part; no checkpoint, so no resume). Otherwise `res.to_dataframe()` of the outputs so far is
+    rewritten every few seconds, atomically, and completely at the end (mbdsim.results.stream);
+    `pandas.read_parquet(out)` or `pandas.read_csv(out)` reads either. markers: the marker columns of the out= table, as `res.to_dataframe(markers=...)`: True
     every marker's, or a list of names ("tip" or "<body>.<marker>"); ModelError for an unknown name.
     monitor=True (default): constraint violation, energy balance and contact penetration are checked on
     the output samples (after the run, or after every part of a streamed run); the first exceedance of
@@ -113,8 +114,11 @@ def _simulate_out(model, end_time, output_step, method, rtol, atol, max_step, st
     from ..results.diagnostics import monitor as run_monitors
     from ..results.stream import check_progress, run_writing
     check_progress(progress, "simulate")
+    if resume and str(out).lower().endswith(".csv"):
+        raise ModelError("simulate", "resume", "a .csv output has no checkpoint to resume from: stream to a "
+                         ".parquet path to resume a run")
     res = None
-    if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith(".parquet") and \
+    if out is not None and isinstance(out, (str, os.PathLike)) and str(out).lower().endswith((".parquet", ".csv")) and \
             (method is None or str(method).lower() in ("auto",) + COMPILED_METHODS) and USE_COMPILED:
         try:
             res = _simulate(model, end_time, output_step, method, rtol, atol, max_step, start_time, progress, out,

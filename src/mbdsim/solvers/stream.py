@@ -22,6 +22,11 @@ and continues with exactly the carried state: the compiled step loop returns to 
 at every chunk boundary in an uninterrupted run too, so a resumed run is bit-identical to an
 uninterrupted one.
 
+A ".csv" `out` is streamed the same way into one CSV file: the header, then each part's rows appended
+(one write and an fsync per part) as they are computed, so memory stays bounded by a part and a killed
+run leaves every completed part's rows (at most the last line of a part cut short by a SIGKILL in the
+middle of its write). A CSV run has no checkpoint: resume needs the Parquet dataset.
+
 Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
 switch while streaming). Other methods and models run in memory and then write the same layout (no
 resume).
@@ -92,6 +97,34 @@ def _atomic(path: Path, write) -> None:
     with open(tmp, "rb") as fh:
         os.fsync(fh.fileno())
     os.replace(tmp, path)
+
+
+class CsvFile:
+    """The `.csv` sink of a streamed run: the header, then each part appended (see the module docstring).
+    An existing file is replaced only when mbdsim wrote it (results.stream.check_replaceable)."""
+
+    def __init__(self, out):
+        try:
+            self.path = Path(out)
+        except TypeError:
+            raise ModelError("simulate", "out", f"expected a path, got {out!r}") from None
+        if self.path.is_dir():
+            raise ModelError("simulate", "out", f"{str(self.path)!r} is a directory")
+        results_stream.check_replaceable(self.path)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self.path.write_bytes(b"")
+        except OSError as exc:
+            raise ModelError("simulate", "out", f"cannot write {str(self.path)!r}: {exc}") from None
+        self.header = True
+
+    def part(self, cols: dict) -> None:
+        """Append the rows of `cols` ({column name: 1-D array}; the header before the first part)."""
+        with open(self.path, "ab") as fh:
+            results_stream.write_csv(cols, fh, header=self.header)
+            fh.flush()
+            os.fsync(fh.fileno())
+        self.header = False
 
 
 def write_part(path: Path, index: int, cols: dict) -> None:
@@ -177,16 +210,17 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         from ..system.compiled import NotCompiled
         raise NotCompiled("sensors are not streamed in parts")
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v))
-    path = prepare(out, resume)
+    csv = CsvFile(out) if str(out).lower().endswith(".csv") else None
+    path = csv.path if csv is not None else prepare(out, resume)
     a, w = run.cm.arrays(), run.work.arrays()
     y0 = np.concatenate([rep.q, rep.v])
     from ..results.export import marker_targets
     fp = fingerprint(sys, rep, times, rtol, atol, max_step, [p for p, _ in marker_targets(sys.bodies, markers)])
     from ..system.fingerprint import model_digests
     digests = model_digests(sys.model)
-    state = _load_checkpoint(path, fp, digests) if resume else None
+    state = _load_checkpoint(path, fp, digests) if resume and csv is None else None
     if state is None:
-        for p in path.iterdir():
+        for p in () if csv is not None else path.iterdir():
             p.unlink()
         y = run.state_of(y0)
         f = np.zeros(len(y))
@@ -195,7 +229,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
         st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
         chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
-        _write_meta(path, fp, times, rtol, atol, digests)
+        if csv is None:
+            _write_meta(path, fp, times, rtol, atol, digests)
     else:
         chunk, i0, st, y, f, stats, ylast, prev_row = state
         run.stats[:] = stats
@@ -260,7 +295,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             diag = run_monitors(cres, diag, first=prev_row is None)
             compact_tail(diag, n_t, n_c)
         if len(cols["time [s]"]):
-            write_part(path, chunk, cols)
+            csv.part(cols) if csv is not None else write_part(path, chunk, cols)
         cres._fr = None   # break the Result <-> lazy frames cycle: the chunk's arrays go now, not at a GC
         last = (tout, rows, accelerations)
         if status != 0:
@@ -273,7 +308,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
         prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
-        _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row)
+        if csv is None:
+            _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row)
     ts, rows, acc = last
     if kept is not None and state is None and len(kept) > 1:   # every output fits: the Result holds them all
         ts, rows = np.concatenate([k[0] for k in kept]), np.concatenate([k[1] for k in kept])
