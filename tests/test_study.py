@@ -440,3 +440,43 @@ def test_output_power_towers_are_double_precision_not_endless():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "{'o': inf, 'p': inf}"
+
+
+def _stuck_or_slow(mode, c=0.0):
+    """A damped pendulum; mode 1: the factory never returns (a Python loop); mode 2: its damping torque is a
+    Python callable that takes 20 ms a call (the run would take minutes); mode 0: an ordinary variant."""
+    import time
+    if mode == 1:
+        while True:
+            pass
+    m = mb.Model("pend")
+    rod = m.add_body("rod", 1.0, inertia=(0.01, 0.01, 0.01), position=(0.5, 0.0, 0.0))
+    pin = m.add_revolute("pin", m.ground, rod, (0, 0, 0), (0, 0, 1))
+    if mode == 2:
+        def slow(t, state):
+            time.sleep(0.02)
+            return 0.0
+        m.add_joint_force("damper", pin, slow)
+    return m
+
+
+def test_time_limit_turns_a_stuck_or_endless_variant_into_a_failed_row():
+    """Issue 35: a variant that never returns (a factory in an endless loop) or that would run for minutes
+    (a slow Python load called back from the compiled loop) is stopped at analysis.time_limit and becomes
+    a 'failed' row naming the limit; the other variants run and the study returns."""
+    import time
+    mb.simulate(_stuck_or_slow(0), 0.1)   # kernels loaded before: the ordinary variants take milliseconds
+    study = mb.Study(_stuck_or_slow, {"mode": [0, 1, 2, 0]}, {"angle": "final(joint_coordinate('pin'))"},
+                     analysis={"end_time": 5.0, "output_step": 0.01, "time_limit": "1.5 s"})
+    t0 = time.monotonic()
+    df = study.run(workers=0)
+    assert time.monotonic() - t0 < 30.0
+    assert list(df["status"]) == ["ok", "failed", "failed", "ok"], df[["status", "message"]]
+    for k in (1, 2):
+        assert "time limit" in df["message"][k] and "1.5 s" in df["message"][k] and math.isnan(df["angle"][k])
+        assert 1.4 < df["wall_time"][k] < 10.0
+    # the pendulum released from horizontal swings to the other side: final angle finite and nonzero
+    assert np.isfinite(df["angle"][0]) and df["angle"][0] == df["angle"][3]
+    with pytest.raises(ModelError) as err:
+        mb.Study(_stuck_or_slow, {"mode": [0]}, {"a": "final(joint_coordinate('pin'))"}, analysis={"end_time": 1.0, "time_limit": -1})
+    assert err.value.field == "time_limit"

@@ -18,7 +18,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Literal, Optional, Union
 
-from pydantic import Field, PositiveFloat, ValidationError, model_validator
+from pydantic import Field, PositiveFloat, ValidationError, field_validator, model_validator
 
 from ..errors import ModelFileError
 from ..io.schema import Q, Spec
@@ -28,7 +28,8 @@ __all__ = ["AnalysisSpec", "SamplingSpec", "StudySpec", "validate_analysis", "lo
 
 class AnalysisSpec(Spec):
     """The analysis every variant runs: dynamics (mb.simulate), kinematics, statics (mb.equilibrium) or
-    quasi_static; times in s (or strings with units)."""
+    quasi_static; times in s (or strings with units). time_limit: wall time [s] a variant may take
+    (None: no limit); a variant over it becomes a 'failed' row (mbdsim.studies.deadline)."""
 
     type: Literal["dynamics", "kinematics", "statics", "quasi_static"] = "dynamics"
     end_time: Optional[Q("s")] = None
@@ -37,12 +38,20 @@ class AnalysisSpec(Spec):
     rtol: Optional[PositiveFloat] = None
     atol: Optional[PositiveFloat] = None
     max_step: Optional[Q("s")] = None
+    time_limit: Optional[Q("s")] = None
 
     @model_validator(mode="after")
     def _times(self):
         if self.type != "statics" and (self.end_time is None or not self.end_time > 0):
             raise ValueError(f"a {self.type} analysis needs a positive end_time")
         return self
+
+    @field_validator("time_limit")
+    @classmethod
+    def _positive_limit(cls, v):
+        if v is not None and not v > 0:
+            raise ValueError(f"the wall time a variant may take must be positive, got {v!r} s")
+        return v
 
 
 class SamplingSpec(Spec):

@@ -70,7 +70,8 @@ class Study:
     factory, names are its keyword arguments.
     outputs: name -> expression over the Result's measures (mbdsim.studies.measures) or callable(result).
     analysis: {"type": "dynamics"|"kinematics"|"statics"|"quasi_static", "end_time": s,
-    "output_step": s, "rtol", "atol", "method", "max_step"}.
+    "output_step": s, "rtol", "atol", "method", "max_step", "time_limit": s of wall time per variant (a
+    variant over it becomes a 'failed' row; default none)}.
     sampling: "grid", "lhs", "sobol" or "random" with `samples` points and `seed`.
     set: path -> value with {expr} fields over the parameters, applied after the parameter paths
     (derived quantities: {"joints.crank_rod.point": ["{crank}", 0, 0]}).

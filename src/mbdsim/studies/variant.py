@@ -122,18 +122,28 @@ def run_variant(plan: Plan, params: dict) -> dict:
     message and wall time [s].  Never raises for a problem of the variant itself."""
     t0 = time.perf_counter()
     from ..system.assemble import single_use
+    from .deadline import VariantTimeout, time_limit
     row = {name: math.nan for name in plan.outputs}
+    limit = plan.analysis.get("time_limit")
     try:
-        with warnings.catch_warnings(), single_use():   # each variant's model is built and run once
-            warnings.simplefilter("ignore")      # assembly notes and redundancy reports, once per variant
-            res = run_analysis(build_model(plan, params), plan.analysis, needs_diagnostics(plan))
-            if getattr(res, "success", True):
-                row.update(evaluate_outputs(plan.outputs, res))
-                status, message = "ok", "ok"
-            else:
-                status, message = "failed", str(getattr(res, "message", "analysis failed"))
-    except Exception as exc:  # noqa: BLE001 - a failing variant is a row with its error, never a crash
-        status, message = "error", f"{type(exc).__name__}: {exc}"
+        with time_limit(limit) as watch:
+            try:
+                with warnings.catch_warnings(), single_use():   # each variant's model is built and run once
+                    warnings.simplefilter("ignore")      # assembly notes and redundancy reports, once per variant
+                    res = run_analysis(build_model(plan, params), plan.analysis, needs_diagnostics(plan))
+                    if getattr(res, "success", True):
+                        row.update(evaluate_outputs(plan.outputs, res))
+                        status, message = "ok", "ok"
+                    else:
+                        status, message = "failed", str(getattr(res, "message", "analysis failed"))
+            except Exception as exc:  # noqa: BLE001 - a failing variant is a row with its error, never a crash
+                status, message = "error", f"{type(exc).__name__}: {exc}"
+    except VariantTimeout:
+        status, message = "failed", ""
+    if watch.fired:   # the run stopped on the limit (its outputs so far discarded: the row is not 'ok')
+        row = {name: math.nan for name in plan.outputs}
+        status, message = "failed", (f"stopped by the study's time limit (analysis.time_limit = {limit:g} s of "
+                                     f"wall time per variant)")
     row.update(status=status, message=message, wall_time=time.perf_counter() - t0)
     return row
 
