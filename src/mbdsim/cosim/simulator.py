@@ -129,8 +129,11 @@ class Simulator:
         if name not in self._inputs:
             raise ModelError(f"input '{name}'", "name", f"the model has no input {name!r} (inputs: "
                              f"{', '.join(self._inputs) or 'none; declare them with Model.add_input'})")
-        from ..model._check import scalar
-        v = scalar(f"input '{name}'", "value", value)
+        if value.__class__ is float and value - value == 0.0:   # a finite float (the loop's usual case)
+            v = value
+        else:
+            from ..model._check import scalar
+            v = scalar(f"input '{name}'", "value", value)
         if v != self._inputs[name]:
             self._inputs[name] = v
             for arr, k in self._slots[name]:
@@ -156,20 +159,27 @@ class Simulator:
     def step(self, dt: float) -> float:
         """Advance by dt [s] > 0 (inputs held constant; internal steps as the error control needs);
         returns the new time [s]."""
-        from ..model._check import scalar
-        return self.advance_to(self.time + scalar("Simulator.step", "dt", dt, 0.0, strict=True))
+        if not (dt.__class__ is float and 0.0 < dt < np.inf):
+            from ..model._check import scalar
+            dt = scalar("Simulator.step", "dt", dt, 0.0, strict=True)
+        return self.advance_to(float(self._st[0]) + dt)
 
     def advance_to(self, t: float) -> float:
         """Advance to time t [s] (>= the current time), FMUs sampled at their communication steps on the
         way; returns the time reached (earlier than t only when a sensor with action "stop" was met)."""
-        from ..model._check import scalar
-        t = scalar("Simulator.advance_to", "t", t)
+        if not (t.__class__ is float and t - t == 0.0):
+            from ..model._check import scalar
+            t = scalar("Simulator.advance_to", "t", t)
         if self.stopped is not None:
             raise ModelError("Simulator", "time", f"the run was stopped by sensor '{self.stopped.name}' at "
                              f"t = {self.stopped.time:.12g} s (restore an earlier state to go on)")
-        if t < self.time - _ROUND * max(1.0, abs(self.time)):
+        if t < self._st[0] - _ROUND * max(1.0, abs(self._st[0])):
             raise ModelError("Simulator.advance_to", "t", f"{t!r} s is before the current time {self.time!r} s "
                              "(restore an earlier state() to go back)")
+        if not self._fmus:
+            if t - self._st[0] > _ROUND * max(1.0, abs(t)):
+                self._advance(t)
+            return float(self._st[0])
         while self.stopped is None and t - self.time > _ROUND * max(1.0, abs(t)):
             nxt = min([t] + [f.next_time for f in self._fmus])
             self._advance(nxt)
