@@ -19,8 +19,13 @@ import re
 import shutil
 import tempfile
 from pathlib import Path
+from typing import TYPE_CHECKING, Union
 
 from ..errors import ModelError
+
+if TYPE_CHECKING:
+    from .._types import PathLike
+    from ..model.model import Model
 
 _SKIP = ("inputs", "outputs", "name", "planar")   # sections and fields that are not parameters
 
@@ -57,7 +62,7 @@ def _identifier(name: str) -> str:
     return "Mbdsim_" + s
 
 
-def export_fmu(model, path, rtol: float | None = None, step_size: float = 1e-3) -> Path:
+def export_fmu(model: Union[Model, PathLike], path: PathLike, rtol: float | None = None, step_size: float = 1e-3) -> Path:
     """Write an FMI 2.0 co-simulation FMU of `model` (a Model or a model file path) to `path` (.fmu) and
     return its path. rtol: the Simulator's tolerance inside the FMU (default: simulate's "auto"; an
     importer's relative tolerance from fmi2SetupExperiment overrides it); step_size [s]: the default

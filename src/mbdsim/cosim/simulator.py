@@ -17,6 +17,7 @@ The model must be one the compiled core carries (as simulate's method "auto"); F
 from __future__ import annotations
 
 import dataclasses
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -24,6 +25,10 @@ from ..errors import ModelError, SolverError
 from ..solvers import fastdop, pyloads
 from ..solvers.fastdyn import INTERRUPTED
 from ._fastcall import Bound
+
+if TYPE_CHECKING:
+    from ..model.model import Model
+    from ..results.result import Result
 
 MAX_STEPS_PER_CALL = 10_000_000   # internal steps of one step()/advance_to(), at most (simulate's budget)
 _ROUND = 1e-12                    # relative: a target time this close to the current one is reached
@@ -63,7 +68,7 @@ class Simulator:
     rtol / 20, atol in the same ratio); start_time [s]. ModelError when the model is not one the compiled
     core carries (a Python-callable load is fine; joint friction, path constraints are not)."""
 
-    def __init__(self, model, rtol: float | None = None, start_time: float = 0.0):
+    def __init__(self, model: Model, rtol: float | None = None, start_time: float = 0.0):
         from ..solvers.assembly import assemble_state
         from ..solvers.checks import check_initial_contacts
         from ..solvers.compiled_run import CompiledRun
@@ -275,7 +280,7 @@ class Simulator:
         for fmu, s in zip(self._fmus, state.fmus):
             fmu.load(s)
 
-    def result(self):
+    def result(self) -> Result:
         """The Result of every sample so far (the start and the end of each step); accelerations and
         multipliers at a sample use the inputs held over the step that ended there (the first: those at
         the start). res.stats["inputs"]: {input: values (n,)} held at each sample."""
