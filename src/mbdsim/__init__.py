@@ -34,6 +34,7 @@ _LAZY = {
     "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
     "AccuracyWarning": ".solvers.autoswitch",
+    "Simulator": ".cosim.simulator", "SimulatorState": ".cosim.simulator", "export_fmu": ".cosim.fmu_export",
 }
 
 
@@ -64,5 +65,6 @@ __all__ = [
     "expressions", "functions", "parse",
     "plot", "animate",
     "Study", "load_study", "plot_study", "sensitivity",
+    "Simulator", "SimulatorState", "export_fmu",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]

@@ -292,7 +292,23 @@ def schema_cmd(out: Optional[Path] = typer.Option(None, "--out", "-o", metavar="
 
 
 def register(app: typer.Typer) -> None:
-    """Add run, info and schema to the mbdsim Typer app."""
+    """Add run, info, schema and export-fmu to the mbdsim Typer app."""
     app.command("run")(run_cmd)
     app.command("info")(info_cmd)
     app.command("schema")(schema_cmd)
+    app.command("export-fmu")(export_fmu_cmd)
+
+
+def export_fmu_cmd(model: Path = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml or .json)."),
+                   out: Path = typer.Argument(..., metavar="OUT", help="FMU file to write (.fmu)."),
+                   rtol: Optional[float] = typer.Option(None, "--rtol", help="Simulator tolerance inside the FMU."),
+                   step: float = typer.Option(1e-3, "--step", help="Default communication step [s]."),
+                   debug: bool = DEBUG_OPT) -> None:
+    """Write an FMI 2.0 co-simulation FMU of a model file (inputs, outputs, numeric fields as parameters).
+
+    The importing tool needs a Python with mbdsim installed (the FMU runs it through pythonfmu)."""
+    def go():
+        import mbdsim as mb
+        path = mb.export_fmu(_load(model), out, rtol=rtol, step_size=step)
+        _console().print(f"FMU written: {path}")
+    _guard(go, debug)

@@ -135,11 +135,13 @@ class Builder:
         s = self.spec
         self.path = ("ground",)
         self.add_markers(self.model.ground, s.ground.markers)
-        for section, items, fn in (("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
+        for section, items, fn in (("inputs", s.inputs, lambda i: self.model.add_input(i.name, i.value)),
+                                   ("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
                                    ("joints", s.joints, self.add_joint), ("motions", s.motions, self.add_motion),
                                    ("forces", s.forces, self.add_element),
                                    ("constraints", s.constraints, self.add_constraint),
-                                   ("sensors", s.sensors, self.add_sensor)):
+                                   ("sensors", s.sensors, self.add_sensor),
+                                   ("outputs", s.outputs, lambda o: self.model.add_output(o.name, o.expression))):
             for k, item in enumerate(items):
                 self.path = (section, k)
                 try:

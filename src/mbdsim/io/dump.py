@@ -282,6 +282,11 @@ def model_to_dict(model) -> dict:
          "forces": [_element(e) for e in model.forces.values()]}
     d["constraints"] = [_constraint(c) for c in getattr(model, "coord_constraints", {}).values()]
     d["sensors"] = [_sensor(s) for s in getattr(model, "sensors", {}).values()]
+    d["inputs"] = [{"name": i.name, "value": i.value} for i in getattr(model, "inputs", {}).values()]
+    d["outputs"] = [{"name": o.name, "expression": o.text} for o in getattr(model, "outputs", {}).values()]
+    for f in getattr(model, "fmus", {}).values():   # an FMU is code: model files never carry (and run) one
+        raise ModelError(f"fmu '{f.name}'", "path", "an FMU runs its own code, so model files do not carry FMUs; "
+                         "store the model without it and add it after loading (Model.add_fmu)")
     if getattr(model, "planar", None) is not None:
         d["planar"] = True if np.allclose(model.planar, [0, 0, 1]) else _unit(model.planar)
     return {k: v for k, v in d.items() if v != [] or k == "bodies"}

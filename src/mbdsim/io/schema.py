@@ -240,7 +240,8 @@ class PointOnCurveSpec(Spec):
     curve: CurveSpec
 
 
-from .schema_extra import EXTRA_JOINTS, ConstraintSpec, JointForceSpec, LineForceSpec, SensorSpec  # noqa: E402
+from .schema_extra import (EXTRA_JOINTS, ConstraintSpec, InputSpec, JointForceSpec, LineForceSpec,  # noqa: E402
+                           OutputSpec, SensorSpec)
 
 JointSpec = Annotated[Union[(AxisJointSpec, InlineSpec, SphericalSpec, AtPointSpec, UniversalSpec, PlanarSpec,
                              FixedSpec, PointOnCurveSpec,
@@ -396,6 +397,7 @@ class ModelSpec(Spec):
     gravity: V("m/s**2") = [0.0, 0.0, 0.0]
     planar: Union[bool, V("")] = False     # True: a 2D mechanism in the xy plane (or its plane normal)
     ground: GroundSpec = GroundSpec()
+    inputs: list[InputSpec] = []       # scalars that expressions read by name (a Simulator sets them)
     bodies: list[BodySpec] = []
     particles: list[ParticleSpec] = []
     joints: list[JointSpec] = []
@@ -403,10 +405,11 @@ class ModelSpec(Spec):
     forces: list[ElementSpec] = []
     constraints: list[ConstraintSpec] = []   # couplers, gears, user constraints
     sensors: list[SensorSpec] = []
+    outputs: list[OutputSpec] = []     # measured signals (expressions of the state)
 
 
 SECTIONS = {"bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
-            "constraints": "constraint", "sensors": "sensor"}
+            "constraints": "constraint", "sensors": "sensor", "inputs": "input", "outputs": "output"}
 
 
 def json_schema() -> dict:

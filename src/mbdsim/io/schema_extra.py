@@ -102,3 +102,19 @@ class JointForceSpec(Spec):
     joint: Name
     value: Raw
     dof: Optional[Literal["rotation", "translation"]] = None
+
+
+class InputSpec(Spec):
+    """A scalar input (issue 33) that load, sensor and output expressions read by name; `value`: its value
+    in simulate and at the start of a Simulator (SI units of whatever reads it)."""
+
+    name: Name
+    value: Number = 0.0
+
+
+class OutputSpec(Spec):
+    """A measured signal (issue 33): an expression of the state and inputs, as load expressions use."""
+
+    name: Name
+    expression: str
+

@@ -15,7 +15,8 @@ order (marker i relative to marker j, components in the axes of marker k):
 Arguments name a body (its centre-of-mass frame: CM origin, body axes) or a marker as body.marker;
 j and k default to ground. Differences are taken in ground (Adams' reference frame l = ground).
 Variables: t and TIME [s]; the coordinate of every revolute, screw (angle [rad], continuous) and
-translational joint (slide [m]) by its name, and its rate as <joint>_dot [rad/s, m/s].
+translational joint (slide [m]) by its name, and its rate as <joint>_dot [rad/s, m/s]; the model's
+inputs (Model.add_input) by name.
 """
 from __future__ import annotations
 
@@ -40,6 +41,7 @@ ANGLES = {"AX": 13, "AY": 14, "AZ": 15}
 ACCEL = {"ACCX": 16, "ACCY": 17, "ACCZ": 18}
 MEASURE_KIND = {**POSITION, **VELOCITY, **ANGULAR, **ANGLES, **ACCEL}
 JOINT_ANGLE, JOINT_ANGLE_RATE, JOINT_SLIDE, JOINT_SLIDE_RATE = 20, 21, 22, 23
+INPUT = 30   # a model input (Model.add_input): Measure("input", i=<input name>)
 WITH_K = {"DX", "DY", "DZ", "VX", "VY", "VZ", "WX", "WY", "WZ", "ACCX", "ACCY", "ACCZ"}
 # the coordinate a one-coordinate joint's name reads in an expression (joint-kind registry)
 JOINT_DOF = {n: k.axis_dofs[0] for n, k in JOINT_KINDS.items() if k.ncoord == 1 and k.axis_dofs}
@@ -61,6 +63,8 @@ class Measure:
 
     @property
     def kind(self) -> int:
+        if self.name == "input":
+            return INPUT
         if self.joint is not None:
             return (JOINT_ANGLE if self.dof == "rotation" else JOINT_SLIDE) + int(self.rate)
         return MEASURE_KIND[self.name]
@@ -182,12 +186,15 @@ def parse_load(model, text, entity, field, allow_acc=False) -> LoadExpr:
     reserved = reserved_names()
     joints = {v: m for v, m in joint_variables(model).items() if v not in reserved}
     hook = _Hook(model, allow_acc)
+    inputs = [v for v in getattr(model, "inputs", {}) if v not in reserved and v not in joints]
     try:
-        e = parse(text, (*TIME_NAMES, *joints), measures=hook)
+        e = parse(text, (*TIME_NAMES, *joints, *inputs), measures=hook)
     except (ExpressionError, ValueError) as exc:
         raise ModelError(entity, field, f"{exc} (measures: {', '.join(MEASURE_KIND)} of bodies and "
-                         f"body.marker; variables: t, TIME, the joints {', '.join(joints) or '(none)'})") from None
+                         f"body.marker; variables: t, TIME, the joints {', '.join(joints) or '(none)'}"
+                         f"{'; inputs ' + ', '.join(inputs) if inputs else ''})") from None
     used = {v: m for v, m in joints.items() if e.depends_on(v)}
+    used.update({v: Measure("input", i=v) for v in inputs if e.depends_on(v)})
     used.update(hook.found)
     return LoadExpr(e, used)
 

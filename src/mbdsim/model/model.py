@@ -16,6 +16,7 @@ from .joints import Joint, Motion, joint_initial
 from .couplers import CouplersMixin
 from .joints_extra import JointsExtraMixin
 from .sensors import SensorsMixin
+from .signals import FmuMixin, SignalsMixin
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -23,7 +24,8 @@ if TYPE_CHECKING:
                           TimeFunction, Vector)
 
 
-class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin):
+class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMixin, CouplersMixin, SensorsMixin,
+            SignalsMixin, FmuMixin):
     """A mechanism description in SI units; `gravity` [m/s^2] in ground axes."""
 
     def __getstate__(self):

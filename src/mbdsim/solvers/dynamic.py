@@ -146,6 +146,8 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     """The analysis of `simulate` (its docstring has the arguments), without the monitors; with `out`, the
     streamed compiled run (NotStreamable when the model needs another path)."""
     check_model(model, "simulate")
+    for name in getattr(model, "fmus", {}):   # FMUs are sampled in the Simulator's step loop only
+        raise ModelError(f"fmu '{name}'", "path", "FMUs run in the step loop of mbdsim.Simulator, not in simulate")
     method = "auto" if method is None else method
     if not isinstance(method, str):
         raise ModelError("simulate", "method", f"expected a method name, got {method!r}")

@@ -90,6 +90,8 @@ class CompiledModel:
     #                           solvers.pyloads from inside the kernels (Work slot 48): Python callables and
     #                           what cannot be packed here (`_called_back`)
     python_drivers: tuple = ()   # driver indices (into the packed driver functions) called back the same way
+    input_slots: tuple = ()   # (input name, index into exprloads[14]): where the expression programs hold each
+    #                           model input (Model.add_input) as a constant; mbdsim.Simulator writes them
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -314,7 +316,8 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     bushings, loads = _loads(sys, pyl)
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES) and e.name not in pyl]
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
-    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors) if exl or sensors else \
+    input_slots = []
+    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors, input_slots) if exl or sensors else \
         (exprloads_pack.empty(), 4)
     topo = system_topology(sys, rows)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
@@ -324,7 +327,8 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
+                         tuple(input_slots))
 
 
 def _candidates(sys, topo) -> np.ndarray:

@@ -112,9 +112,36 @@ def _joint_measure(sys, m, mode, tree, fr):
     return kind, (g.bi, g.bj, 0), v, jq, jc
 
 
-def pack(sys, elems, mode, tree, state, sensors=()):
+def _compile(expr, slots, inputs, found):
+    """`exprvm.compile_expr` of `expr` with the model inputs it reads (variable name -> input name in
+    `inputs`) as constants holding their current values; appends (program-local constant index, input
+    name) to `found`, so that `mbdsim.Simulator.set_input` can write the constants between steps."""
+    from . import exprvm
+    from .._exprtree import Var
+    if not inputs:
+        return exprvm.compile_expr(expr, slots)
+    values = {v: float(sys_value) for v, sys_value in inputs.items()}
+
+    class _Emitter(exprvm._Emitter):
+        def emit(self, n):
+            if isinstance(n, Var) and n.name in values:
+                self.consts.append(values[n.name])
+                found.append((len(self.consts) - 1, n.name))
+                self.push(exprvm.CONST, len(self.consts) - 1)
+                return
+            super().emit(n)
+
+    em = _Emitter(dict(slots))
+    em.emit(getattr(expr, "node", expr))
+    return exprvm.Program(np.array(em.code, dtype=np.int64).reshape(-1, 2), np.array(em.consts, dtype=float),
+                          np.array(em.tables, dtype=float), max(em.max_depth, 1))
+
+
+def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
     """(ex, stack size) of the expression loads `elems` and the Sensors `sensors` (expression signals);
-    NotCompiled (from system.compiled) when one cannot be compiled."""
+    NotCompiled (from system.compiled) when one cannot be compiled. Model inputs read by the expressions are
+    constants of the packed programs: with `input_slots` (a list), (input name, index into ex[14], the
+    packed constants) is appended for each place an input is read."""
     from . import exprvm
     from .compiled import NotCompiled
     from .frames import body_frames
@@ -125,10 +152,17 @@ def pack(sys, elems, mode, tree, state, sensors=()):
         fr = Frames(f1.r[None], f1.A[None], f1.rd[None], f1.w[None])
     measures, ms, loads, progs = {}, [], [], []
 
+    model_inputs = getattr(sys.model, "inputs", {})
+    local_inputs = []   # (program index, local constant index, input name)
+
     def program(elem, v, what="load"):
         if isinstance(v, LoadExpr):
             slots = {n: 0 for n in TIME_NAMES}
+            inputs = {}
             for var, m in v.measures.items():
+                if m.name == "input":
+                    inputs[var] = model_inputs[m.i].value
+                    continue
                 if m not in measures:
                     measures[m] = len(measures)
                     try:
@@ -136,7 +170,9 @@ def pack(sys, elems, mode, tree, state, sensors=()):
                     except _NotCompiled as exc:
                         raise NotCompiled(f"{what} '{elem.name}' reads {exc}") from None
                 slots[var] = 1 + measures[m]
-            progs.append(exprvm.compile_expr(v.expr, slots))
+            found = []
+            progs.append(_compile(v.expr, slots, inputs, found))
+            local_inputs.extend((len(progs) - 1, k, name) for k, name in found)
         elif callable(v):
             raise NotCompiled(f"{what} '{elem.name}' is a Python callable")
         else:
@@ -172,6 +208,9 @@ def pack(sys, elems, mode, tree, state, sensors=()):
     if not loads and not sn:
         return empty(), 4
     pk = exprvm.pack(progs)
+    if input_slots is not None and local_inputs:
+        offset = np.concatenate([[0], np.cumsum([len(p.consts) for p in progs])])
+        input_slots.extend((name, int(offset[p] + k)) for p, k, name in local_inputs)
     i = np.int64
     nm = len(ms)
     ex = (np.array([m[0] for m in ms], i).reshape(nm), np.array([m[1] for m in ms], i).reshape(nm, 3),

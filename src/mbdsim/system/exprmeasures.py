@@ -53,6 +53,8 @@ def measure_values(sys, fr, m, joint_value=None) -> np.ndarray:
     """Values (N,) of Measure m on time-axis Frames; `joint_value(joint, dof, rate)` gives joint
     coordinates and rates (N,) for joint measures."""
     name = m.name
+    if name == "input":   # a model input (Model.add_input): its value, constant here
+        return np.full(fr.r.shape[0], float(sys.model.inputs[m.i].value))
     if m.joint is not None:
         return np.asarray(joint_value(m.joint, m.dof, m.rate), dtype=float)
     if name in POSITION or name in VELOCITY:
