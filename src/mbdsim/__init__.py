@@ -1,7 +1,7 @@
 """mbdsim: 3D multibody dynamics in Python (SI units throughout).
 
 Public API (a contract; everything else may change): Model and its add_* methods, the analyses
-(simulate, kinematics, assemble, equilibrium), Result, contact shapes and path curves, the error
+(simulate, kinematics, assemble, equilibrium), Result, the importers (from_urdf, from_mjcf), contact shapes and path curves, the error
 types, and the Adams-style function library (STEP, STEP5, HAVSIN, IMPACT, BISTOP, POLY, SHF, AKISPL)
 with the safe expression parser `parse`.
 """
@@ -34,6 +34,7 @@ _LAZY = {
     "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
     "AccuracyWarning": ".solvers.autoswitch",
+    "from_urdf": ".importers", "from_mjcf": ".importers", "ImportApproximationWarning": ".importers",
 }
 
 
@@ -64,5 +65,6 @@ __all__ = [
     "expressions", "functions", "parse",
     "plot", "animate",
     "Study", "load_study", "plot_study", "sensitivity",
+    "from_urdf", "from_mjcf", "ImportApproximationWarning",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]

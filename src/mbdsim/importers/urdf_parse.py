@@ -221,8 +221,6 @@ def _joint(doc, el) -> UJoint:
             raise doc.error(lim, entity, "upper", f"the upper limit {hi!r} is below the lower limit {lo!r}")
         if hi > lo:
             jt.lower, jt.upper = lo, hi
-    elif lim is None and jtype in ("revolute", "prismatic"):
-        raise doc.error(el, entity, "limit", f"a {jtype} joint needs a <limit> (URDF specification)")
     dyn = el.find("dynamics")
     if dyn is not None:
         jt.damping = _number(doc, dyn, "damping", entity, 0.0, minimum=0.0)
