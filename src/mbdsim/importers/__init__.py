@@ -11,6 +11,11 @@ from __future__ import annotations
 
 from importlib import import_module
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from .._types import PathLike, Vector
+    from ..model.model import Model
 
 from ..errors import ModelFileError
 from ._common import ImportApproximationWarning, VisualShape
@@ -25,20 +30,22 @@ IMPORTERS = {
 }
 
 
-def from_urdf(path, floating_base=False, gravity=(0.0, 0.0, -9.81), initial_displacement=None,
-              initial_velocity=None, **options):
+def from_urdf(path: PathLike, floating_base: bool = False, gravity: Vector = (0.0, 0.0, -9.81),
+              initial_displacement: dict[str, Any] | None = None, initial_velocity: dict[str, Any] | None = None,
+              **options: Any) -> Model:
     """A Model from a URDF file; see mbdsim.importers.urdf.from_urdf."""
     from .urdf import from_urdf as load
     return load(path, floating_base, gravity, initial_displacement, initial_velocity, **options)
 
 
-def from_mjcf(path, initial_displacement=None, initial_velocity=None, **options):
+def from_mjcf(path: PathLike, initial_displacement: dict[str, Any] | None = None,
+              initial_velocity: dict[str, Any] | None = None, **options: Any) -> Model:
     """A Model from a MuJoCo MJCF file; see mbdsim.importers.mjcf.from_mjcf."""
     from .mjcf import from_mjcf as load
     return load(path, initial_displacement, initial_velocity, **options)
 
 
-def importer_for(path):
+def importer_for(path: PathLike) -> Any:
     """The importer function of `path`'s extension, None for mbdsim's own model files."""
     suffix = Path(path).suffix.lower()
     target = IMPORTERS.get(suffix)
@@ -48,7 +55,7 @@ def importer_for(path):
     return getattr(import_module(module), func)
 
 
-def load_any(path):
+def load_any(path: PathLike) -> Model:
     """A Model from any model file by extension: .yaml/.yml/.json (mbdsim.load_model) or an imported
     format of IMPORTERS (.urdf, .xml/.mjcf, ...); ModelFileError naming the file otherwise."""
     load = importer_for(path)
