@@ -24,6 +24,11 @@ RESERVED = ("run", "status", "message", "wall_time", "worker", "study_id")
 def _model_source(model):
     """(base data, factory, source name) of the model argument."""
     if isinstance(model, (str, Path)):
+        from ..importers import importer_for
+        load = importer_for(model)
+        if load is not None:   # an imported format (URDF, MJCF, ...): its model data
+            from ..io import model_to_dict
+            return model_to_dict(load(model)), None, str(model)
         from ..io.files import read
         data, _, source = read(model)
         return data, None, source
