@@ -33,7 +33,7 @@ _LAZY = {
     "OutputError": ".studies.measures", "InertiaWarning": ".model._check",
     "InitialPenetrationWarning": ".solvers.checks", "MonitorWarning": ".results.diagnostics",
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
-    "AccuracyWarning": ".solvers.autoswitch",
+    "AccuracyWarning": ".solvers.autoswitch", "from_adm": ".importers.adm",
 }
 
 
@@ -54,7 +54,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
-    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model",
+    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model", "from_adm",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",
