@@ -99,7 +99,8 @@ def load_model_file(path: Path):
             _fail(f"{str(path)!r}: reading model files needs mbdsim.load_model, which this install lacks; "
                   "give a results file (.csv/.parquet) or call mb.animate(model) from Python")
     try:
-        return loader(path)
+        from mbdsim.importers import importer_for
+        return (importer_for(path) or loader)(path)   # an Adams dataset (.adm) by its extension
     except mbdsim.MbdsimError as exc:
         _fail(f"model file {str(path)!r}: {exc}")
 

@@ -191,8 +191,6 @@ def _velocities(imp, st, a, cm, poses, pid):
         wm = cm if "WM" not in a else (poses[imp.ident(st, a, "WM")][1:3] if imp.ident(st, a, "WM") in poses else
                                        imp.fail(st, "WM", "no such marker"))
         w = wm[1] @ np.array([0.0 if x is None else x for x in ws])
-        if any(x is None for x in ws):
-            imp.note(st, "angular velocity components not given are taken as 0")
     v = None
     if any(x is not None for x in vs):
         vm = cm if "VM" not in a else (poses[imp.ident(st, a, "VM")][1:3] if imp.ident(st, a, "VM") in poses else
@@ -200,6 +198,4 @@ def _velocities(imp, st, a, cm, poses, pid):
         v = np.array([0.0 if x is None else x for x in vs])
         if w is not None:
             v = v + np.cross(w, cm[0] - vm[0])
-        if any(x is None for x in vs):
-            imp.note(st, "velocity components not given are taken as 0")
     return v, w

@@ -24,6 +24,10 @@ RESERVED = ("run", "status", "message", "wall_time", "worker", "study_id")
 def _model_source(model):
     """(base data, factory, source name) of the model argument."""
     if isinstance(model, (str, Path)):
+        from ..importers import importer_for
+        if importer_for(model) is not None:   # a foreign file (.adm): imported, then as a model's data
+            from ..io import model_to_dict
+            return model_to_dict(importer_for(model)(model)), None, Path(model).name
         from ..io.files import read
         data, _, source = read(model)
         return data, None, source
