@@ -14,6 +14,7 @@ docs/import-adm.md.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import ModelFileError
 from . import adm_forces as forces
@@ -21,6 +22,10 @@ from . import adm_joints as joints
 from . import adm_parts as parts
 from .adm_context import AdmImport
 from .adm_lexer import read_statements
+
+if TYPE_CHECKING:
+    from .._types import PathLike
+    from ..model.model import Model
 
 __all__ = ["from_adm", "IGNORED", "REFUSED"]
 
@@ -36,8 +41,10 @@ ORDER = ("UNITS", "VARIABLE", "PART", "MARKER", "ACCGRAV", "GRAPHICS", "JOINT", 
          "SFORCE", "SPRINGDAMPER", "BUSHING", "FIELD", "VFORCE", "VTORQUE", "GFORCE", "FRICTION", "CONTACT")
 
 
-def from_adm(path) -> "object":
-    """Read the Adams dataset at `path` and build an mbdsim.Model in SI units (see the module docstring).
+def from_adm(path: PathLike) -> Model:
+    """Read the Adams/Solver dataset at `path` (.adm) and build an mbdsim.Model in SI units: lengths in m,
+    masses in kg, forces in N, times in s, angles in rad, whatever the dataset's UNITS; positions and
+    axes in ground at t=0, as in every Model.  Entities take the dataset's Adams View names.
 
     The model gets `import_notes`: a list of what was approximated or ignored.  Errors:
     ModelFileError naming the file, the line and the statement (an unknown statement, argument or
