@@ -247,3 +247,69 @@ def test_cli_run_and_info(tmp_path):
     bad = _adm(tmp_path, "PART/1, GROUND\nWIDGET/1", "bad.adm")
     r = CliRunner().invoke(app, ["info", str(bad)])
     assert r.exit_code == 2 and "bad.adm, line 3" in r.output and "WIDGET" in r.output
+
+
+GROUND_MM = r"""
+UNITS/SYSTEM=MMKS
+ACCGRAV/KGRAVITY=-9810
+PART/1, GROUND
+MARKER/10, PART=1
+MARKER/11, PART=1, QP=0, 500, 0
+MARKER/12, PART=1, QP=0, 1000, 0, REULER=90D, 90D, 0
+MARKER/13, PART=1, QP=0, 1500, 0
+"""
+BALL = GROUND_MM + r"""
+PART/2, MASS=1, CM=20, IP=400, 400, 400, QG=0, 0, 20
+MARKER/20, PART=2
+GRAPHICS/1, ELLIPSOID, CM=20, XSCALE=40, YSCALE=40, ZSCALE=40
+GRAPHICS/2, PLANE, RM=10, XMIN=-100, XMAX=100, YMIN=-100, YMAX=100
+CONTACT/1, IGEOM=1, JGEOM=2, IMPACT, STIFFNESS=1E5, EXPONENT=1.5, DAMPING=10, DMAX=0.1
+"""
+PARTS = GROUND_MM + r"""
+! torsional oscillator about z
+PART/3, MASS=1, CM=30, IP=1000, 1000, 2000, QG=0, 500, 0
+MARKER/30, PART=3
+JOINT/1, REVOLUTE, I=30, J=11
+SPRINGDAMPER/1, ROTATIONAL, I=30, J=11, KT=8000, CT=0, ANGLE=10D
+! block on a rail along x with friction and a push
+PART/4, MASS=2, CM=40, IP=100, 100, 100, QG=0, 1000, 0
+MARKER/40, PART=4
+MARKER/41, PART=4, REULER=90D, 90D, 0
+JOINT/2, TRANSLATIONAL, I=41, J=12
+FRICTION/1, JOINT=2, MU_STATIC=0.5, MU_DYNAMIC=0.4, STICTION_TRANSITION_VELOCITY=1
+SFORCE/1, I=40, J=12, TRANSLATIONAL, ACTIONONLY, FUNCTION=5
+! slider driven by a velocity motion in mm/s, a VFORCE and a VTORQUE
+PART/5, MASS=1, CM=50, IP=100, 100, 100, QG=0, 1500, 0
+MARKER/50, PART=5
+MARKER/51, PART=5, REULER=90D, 90D, 0
+MARKER/52, PART=1, QP=0, 1500, 0, REULER=90D, 90D, 0
+JOINT/3, TRANSLATIONAL, I=51, J=52
+MOTION/1, JOINT=3, TRANSLATION, VELOCITY, FUNCTION=100
+VFORCE/1, I=50, JFLOAT=13, RM=10, FX=0\ FY=1\ FZ=0
+VTORQUE/1, I=50, JFLOAT=13, RM=10, TX=0\ TY=0\ TZ=0.5
+FIELD/1, I=50, J=13, KMATRIX=10,0,0,0,0,0, 0,10,0,0,0,0, 0,0,10,0,0,0, 0,0,0,0,0,0, 0,0,0,0,0,0, 0,0,0,0,0,0
+"""
+
+
+def test_contact_in_millimetres(tmp_path):
+    """A ball resting on a plane (GRAPHICS ELLIPSOID and PLANE, IMPACT contact in N/mm^1.5): its rest
+    penetration is (m g / k)^(1/e)."""
+    m = mb.from_adm(_adm(tmp_path, BALL))
+    with pytest.warns(mb.AccuracyWarning):
+        res = mb.simulate(m, 1.0, output_step=0.01)
+    k = 1e5 * 1e-3 ** -1.5                                      # N/mm^1.5 -> N/m^1.5
+    assert res.position("PART_2")[-1, 2] == pytest.approx(0.02 - (9.81 / k) ** (1 / 1.5), abs=1e-8)
+
+
+def test_springdamper_friction_motion_closed_forms(tmp_path):
+    """In millimetres: a rotational SPRINGDAMPER (theta = a0 (1 - cos w t)), FRICTION holding a block against
+    a 5 N ACTIONONLY SFORCE below mu_s m g, a VELOCITY motion of 100 mm/s; VFORCE, VTORQUE and a diagonal
+    FIELD are read."""
+    m = mb.from_adm(_adm(tmp_path, PARTS))
+    assert any("FIELD" in n for n in m.import_notes) and any("STICTION" in n for n in m.import_notes)
+    res = mb.simulate(m, 1.0, output_step=0.01)
+    w = np.sqrt(8.0 / 2e-3)                                     # KT 8000 N mm/rad, Izz 2000 kg mm^2
+    assert np.abs(res.joint_coordinate("JOINT_1") - np.radians(10) * (1 - np.cos(w * res.time))).max() < 1e-9
+    assert np.abs(res.position("PART_4")[:, 0]).max() < 1e-12
+    assert res.friction_force("FRICTION_1")[-1] == pytest.approx(-5.0)
+    assert res.joint_coordinate("JOINT_3")[-1] == pytest.approx(0.1, abs=1e-9)
