@@ -35,7 +35,7 @@ _LAZY = {
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
     "AccuracyWarning": ".solvers.autoswitch",
     "Simulator": ".cosim.simulator", "SimulatorState": ".cosim.simulator", "export_fmu": ".cosim.fmu_export",
-    "from_urdf": ".importers", "from_mjcf": ".importers", "ImportApproximationWarning": ".importers",
+    "from_urdf": ".importers", "from_mjcf": ".importers", "from_adm": ".importers.adm", "ImportApproximationWarning": ".importers",
 }
 
 
@@ -56,7 +56,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
-    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model",
+    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model", "from_adm",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",

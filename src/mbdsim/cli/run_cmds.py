@@ -32,7 +32,7 @@ import typer
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 OUT_SUFFIXES = (".parquet", ".csv")
 
-MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml, .json, or imported: .urdf, .xml/.mjcf).")
+MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml, .json, or imported: .urdf, .xml/.mjcf, .adm).")
 DEBUG_OPT = typer.Option(False, "--debug", help="Show the Python traceback of an error.")
 ALL_MARKERS_OPT = typer.Option(False, "--markers", help="Add every marker's columns to --out: "
                                "<body>.<marker>.x [m] .y .z, orientation, velocity, acceleration.")

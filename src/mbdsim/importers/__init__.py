@@ -20,13 +20,14 @@ if TYPE_CHECKING:
 from ..errors import ModelFileError
 from ._common import ImportApproximationWarning, VisualShape
 
-__all__ = ["from_urdf", "from_mjcf", "load_any", "IMPORTERS", "ImportApproximationWarning", "VisualShape"]
+__all__ = ["from_urdf", "from_mjcf", "from_adm", "load_any", "IMPORTERS", "ImportApproximationWarning", "VisualShape"]
 
 # extension -> "module:function" of the importer (called with the path alone)
 IMPORTERS = {
     ".urdf": "mbdsim.importers.urdf:from_urdf",
     ".xml": "mbdsim.importers.mjcf:from_mjcf",
     ".mjcf": "mbdsim.importers.mjcf:from_mjcf",
+    ".adm": "mbdsim.importers.adm:from_adm",
 }
 
 
@@ -43,6 +44,12 @@ def from_mjcf(path: PathLike, initial_displacement: dict[str, Any] | None = None
     """A Model from a MuJoCo MJCF file; see mbdsim.importers.mjcf.from_mjcf."""
     from .mjcf import from_mjcf as load
     return load(path, initial_displacement, initial_velocity, **options)
+
+
+def from_adm(path: PathLike) -> Model:
+    """A Model from an Adams dataset (.adm), in SI units (mbdsim.importers.adm.from_adm)."""
+    from .adm import from_adm as _from_adm
+    return _from_adm(path)
 
 
 def importer_for(path: PathLike) -> Any:
