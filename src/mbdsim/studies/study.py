@@ -64,6 +64,22 @@ def _check_schema(data: dict, source: str, entity: str) -> None:
         raise ModelError(entity, "path", f"makes the model data invalid: {err}") from None
 
 
+def _check_units(base: dict, name: str, spec, source: str) -> None:
+    """The units a path parameter is written in against the field it sets ("1 m" for a mass is refused,
+    ModelError naming the parameter and 'values'): each value with a unit is put into the model data
+    as written and checked by the model-file schema (the design itself holds SI numbers)."""
+    from .design import quantity_texts
+    for text in quantity_texts(spec):
+        probe = copy.deepcopy(base)
+        apply_path(probe, name, text, source)
+        try:
+            _check_schema(probe, source, f"study parameter '{name}'")
+        except ModelError as exc:
+            why = str(exc).split("makes the model data invalid: ")[-1]
+            raise ModelError(f"study parameter '{name}'", "values", f"{text!r} does not fit the field it sets "
+                             f"({why})") from None
+
+
 class Study:
     """A parameter study: variants of `model`, each run through `analysis`, measured by `outputs`.
 
@@ -129,6 +145,7 @@ class Study:
             if is_path(name):
                 apply_path(probe, name, first[name], self.plan.source)
                 _check_schema(probe, self.plan.source, f"study parameter '{name}'")
+                _check_units(self.plan.base, name, parameters[name], self.plan.source)
             elif not re.search(r"\{[^{}]*\b" + re.escape(name) + r"\b[^{}]*\}", text):
                 raise ModelError(f"study parameter '{name}'", "name", "is neither a path into the model "
                                  "(section.item.field) nor used in a 'set' template ({" + name + "})")
