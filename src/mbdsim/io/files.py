@@ -34,8 +34,8 @@ def file_kind(path: Path, entity: str = "file") -> str:
         return "yaml"
     if suffix in JSON_SUFFIXES:
         return "json"
-    raise ModelFileError(entity, "path", f"unknown model file extension {suffix!r}; use .yaml, .yml or .json",
-                         str(path))
+    raise ModelFileError(entity, "path", f"unknown model file extension {suffix!r}; use .yaml, .yml or .json "
+                         "(or import .urdf, .xml/.mjcf, .adm: mb.from_urdf, mb.from_mjcf, mb.from_adm)", str(path))
 
 
 def _item_name(node) -> str | None:

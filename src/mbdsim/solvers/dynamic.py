@@ -229,7 +229,7 @@ def _streamed(sys, rep, times, method, rtol, atol, max_step, progress, out, resu
         rt, at = AUTO_LOCAL * rt, AUTO_LOCAL * at
     try:
         return _with_history(stream.stream_compiled(sys, rep, times, rt, at, max_step, progress, out, resume,
-                                                    monitor, markers), times[0])
+                                                    monitor, markers, stiff_check=method == "auto"), times[0])
     except NotCompiled as exc:
         raise NotStreamable(str(exc)) from None
 

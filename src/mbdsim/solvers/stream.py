@@ -199,13 +199,15 @@ def last_row(cols: dict) -> dict:
 
 # ----------------------------------------------------------------------------- compiled streaming
 def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume, monitor=True,
-                    markers=False) -> Result:
+                    markers=False, stiff_check=False) -> Result:
     """Compiled DOP853 over `times` in chunks of CHUNK_ROWS outputs written to `out` (see module doc);
-    raises NotCompiled when the model needs the reference path. Returns a Result holding the last chunk
+    raises NotCompiled when the model needs the reference path, and (stiff_check) when the model turns
+    out stiff before the first part is written (the files made are removed: the caller's whole-file
+    writer runs "auto" with its implicit hand-over instead). Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
     from . import fastdop, pyloads
     from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
-    from .fastdyn import INTERRUPTED
+    from .fastdyn import INTERRUPTED, STIFF
     if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
         from ..system.compiled import NotCompiled
         raise NotCompiled("sensors are not streamed in parts")
@@ -258,7 +260,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                 tout = np.asarray(times[g0:g0 + L], float)
                 status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
                                           run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
-                                          run.stats, K, F, sc, False, SY, ST, nsv, False)
+                                          run.stats, K, F, sc, stiff_check and chunk == 0 and state is None, SY,
+                                          ST, nsv, False)
                 if status == 0 and got == L and g0 + L < nout and \
                         times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
                     # the last step covered outputs beyond the window: redo it from the saved state into a
@@ -277,6 +280,10 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         except results_stream.ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
             status, run.run_error = PROGRESS_FAILED, exc
         status, run.run_error = pyloads.settle(run.pyloads, status, run.run_error)
+        if status == STIFF and chunk == 0:   # nothing written yet: the in-memory run hands over to HHT
+            _discard(path, csv)
+            from ..system.compiled import NotCompiled
+            raise NotCompiled("the model is stiff: run in memory with the implicit hand-over")
         tout = np.asarray(times[g0:g0 + iout], float)
         i1 = g0 + iout
         rows = Y[:iout]
@@ -328,6 +335,17 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     res.error = error
     res.diagnostics = diag
     return res
+
+
+def _discard(path, csv) -> None:
+    """Remove what a streamed run made before its first part (the empty CSV file, or the dataset
+    directory with its metadata only)."""
+    if csv is not None:
+        path.unlink(missing_ok=True)
+        return
+    for p in path.iterdir():
+        p.unlink()
+    path.rmdir()
 
 
 def _write_meta(path, fp, times, rtol, atol, digests):
