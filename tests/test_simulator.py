@@ -281,3 +281,17 @@ def test_driver_inputs_state_restore_and_errors(tmp_path):
         _slider_crank(velocity="sin(w_cmd*t)")
     with pytest.raises(ModelError, match="motion 'spin'.*velocity"):
         _slider_crank(velocity="w_other")
+
+
+def test_restore_without_inputs_gives_the_outputs_of_the_restored_state():
+    m = mb.Model("free_pendulum", gravity=(0, -G, 0))
+    m.add_body("rod", mass=M, inertia=(0.01, IZZ, IZZ), position=(L, 0, 0))
+    m.add_revolute("pin", "ground", "rod", (0, 0, 0), (0, 0, 1))
+    m.add_output("theta", "pin")
+    sim = mb.Simulator(m)
+    sim.step(0.05)
+    saved, before = sim.state(), sim.output("theta")
+    sim.step(0.2)
+    assert sim.output("theta") < before < 0.0
+    sim.restore(saved)
+    assert sim.output("theta") == before

@@ -315,6 +315,7 @@ class Simulator:
         self._fresh, self._reproject = fresh, reproject
         for d, values in zip(self._driver_list(), drivers):
             d.load(values)
+        self._out.stale = True   # the outputs at the restored state (a model without inputs too)
         del self._times[state.n:], self._rows[state.n:], self._held[state.n:]
         self.stopped = None
         for fmu, s in zip(self._fmus, state.fmus):
