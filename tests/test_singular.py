@@ -133,3 +133,24 @@ def test_dead_centre_with_near_massless_links_is_still_flagged():
     model.add_motion("push", "slide", displacement=f"{float(C)!r}*(2*{TC}*t - t**2)")
     res, _, warned = timed_kinematics(model)
     assert [r["time"] for r in res.stats["singular"]] == [0.5] and len(warned) == 1
+
+
+@pytest.mark.parametrize("mass, length", [(1e-6, 1e-4), (1e6, 1e3), (1e100, 1.0), (1e-100, 1.0), (1.0, 1e-6)])
+def test_thresholds_are_relative_to_the_model_scale(mass, length):
+    """Issue 35: a 1 mg, 0.1 mm pendulum (and masses of 1e+-100 kg) runs and is tabled: a uniform rod
+    released from horizontal pulls on its pin with m g / 4 at t = 0 (a_cm = 3 g / 4), and its
+    reactions, accelerations and the table are finite whatever the scale."""
+    import warnings
+    m = mb.Model("p", gravity=(0.0, -9.81, 0.0))
+    inertia = mass * length ** 2 / 12.0
+    rod = m.add_body("rod", mass, inertia=(inertia, inertia, inertia), position=(length / 2, 0.0, 0.0))
+    m.add_revolute("pin", m.ground, rod, (0, 0, 0), (0, 0, 1))
+    period = 2 * np.pi * np.sqrt(2 * length / 3 / 9.81)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.simulate(m, period / 4, period / 40)
+        df = res.to_dataframe()
+    assert res.success and np.isfinite(df.to_numpy()).all()
+    F = np.asarray(res.reaction_force("pin", on="rod"))
+    assert F[0] / (mass * 9.81) == pytest.approx([0.0, 0.25, 0.0], abs=1e-9)
+    assert res.acceleration("rod")[0, 1] / 9.81 == pytest.approx(-0.75, rel=1e-9)

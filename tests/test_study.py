@@ -480,3 +480,16 @@ def test_time_limit_turns_a_stuck_or_endless_variant_into_a_failed_row():
     with pytest.raises(ModelError) as err:
         mb.Study(_stuck_or_slow, {"mode": [0]}, {"a": "final(joint_coordinate('pin'))"}, analysis={"end_time": 1.0, "time_limit": -1})
     assert err.value.field == "time_limit"
+
+
+def test_path_parameter_units_are_checked_against_the_field():
+    """Issue 35: '[1 m, 2 m]' for a mass was converted to SI numbers and accepted; the units written are
+    now checked against the field the path sets, the parameter and 'values' named."""
+    out = {"a": "final(joint_coordinate('pin'))"}
+    for spec in (["1 m", "2 m"], {"values": [1, 2], "unit": "m"}, {"range": ["1 s", "2 s"], "num": 2}):
+        with pytest.raises(ModelError) as err:
+            mb.Study("examples/pendulum.yaml", {"bodies.rod.mass": spec}, out, analysis={"end_time": 0.1})
+        assert (err.value.entity, err.value.field) == ("study parameter 'bodies.rod.mass'", "values")
+        assert "is not a mass" in str(err.value)
+    ok = mb.Study("examples/pendulum.yaml", {"bodies.rod.mass": ["1 kg", "2000 g"]}, out, analysis={"end_time": 0.1})
+    assert ok.design["bodies.rod.mass"].tolist() == [1.0, 2.0]

@@ -1,7 +1,7 @@
 """mbdsim: 3D multibody dynamics in Python (SI units throughout).
 
 Public API (a contract; everything else may change): Model and its add_* methods, the analyses
-(simulate, kinematics, assemble, equilibrium), Result, contact shapes and path curves, the error
+(simulate, kinematics, assemble, equilibrium), Result, the importers (from_urdf, from_mjcf), contact shapes and path curves, the error
 types, and the Adams-style function library (STEP, STEP5, HAVSIN, IMPACT, BISTOP, POLY, SHF, AKISPL)
 with the safe expression parser `parse`.
 """
@@ -35,6 +35,7 @@ _LAZY = {
     "IndeterminateReactionWarning": ".system.determinacy", "ProgressError": ".results.stream",
     "AccuracyWarning": ".solvers.autoswitch",
     "Simulator": ".cosim.simulator", "SimulatorState": ".cosim.simulator", "export_fmu": ".cosim.fmu_export",
+    "from_urdf": ".importers", "from_mjcf": ".importers", "from_adm": ".importers.adm", "ImportApproximationWarning": ".importers",
 }
 
 
@@ -55,7 +56,7 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
-    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model",
+    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model", "from_adm",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",
@@ -66,5 +67,6 @@ __all__ = [
     "plot", "animate",
     "Study", "load_study", "plot_study", "sensitivity",
     "Simulator", "SimulatorState", "export_fmu",
+    "from_urdf", "from_mjcf", "ImportApproximationWarning",
     "STEP", "STEP5", "HAVSIN", "IMPACT", "BISTOP", "POLY", "SHF", "AKISPL", "Akima", "CubicSplineTable",
 ]

@@ -32,7 +32,7 @@ import typer
 EXIT_OK, EXIT_FAILED, EXIT_BAD_INPUT, EXIT_INTERRUPTED = 0, 1, 2, 130
 OUT_SUFFIXES = (".parquet", ".csv")
 
-MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml or .json).")
+MODEL_ARG = typer.Argument(..., metavar="MODEL", help="Model file (.yaml, .yml, .json, or imported: .urdf, .xml/.mjcf, .adm).")
 DEBUG_OPT = typer.Option(False, "--debug", help="Show the Python traceback of an error.")
 ALL_MARKERS_OPT = typer.Option(False, "--markers", help="Add every marker's columns to --out: "
                                "<body>.<marker>.x [m] .y .z, orientation, velocity, acceleration.")
@@ -94,7 +94,8 @@ def _load(path: Path):
     import mbdsim as mb
     if not os.path.lexists(path):   # anything else (a FIFO, a device, too large) is refused by load_model
         _fail(f"model file {str(path)!r} does not exist", EXIT_BAD_INPUT)
-    return mb.load_model(path)
+    from ..importers import load_any   # .yaml/.yml/.json, or an imported format (.urdf, .xml/.mjcf, ...)
+    return load_any(path)
 
 
 def _rank_dof(model, with_report=False):

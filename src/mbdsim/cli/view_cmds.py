@@ -88,18 +88,11 @@ def plot_cmd(
 
 
 def load_model_file(path: Path):
-    """A Model from a model file, via `mbdsim.load_model` (mbdsim.io) when this install has it."""
+    """A Model from a model file (mbdsim.importers.load_any: .yaml/.yml/.json or an imported format)."""
     import mbdsim
-
-    loader = getattr(mbdsim, "load_model", None)
-    if loader is None:
-        try:
-            from mbdsim.io import load_model as loader  # type: ignore[no-redef]
-        except ImportError:
-            _fail(f"{str(path)!r}: reading model files needs mbdsim.load_model, which this install lacks; "
-                  "give a results file (.csv/.parquet) or call mb.animate(model) from Python")
+    from mbdsim.importers import load_any
     try:
-        return loader(path)
+        return load_any(path)
     except mbdsim.MbdsimError as exc:
         _fail(f"model file {str(path)!r}: {exc}")
 

@@ -102,6 +102,18 @@ def shape_mass_properties(entity: str, shape, density, mass, inertia):
         raise ModelError(entity, exc.field, str(exc).split(": ", 1)[-1]) from None
 
 
+MASS_RANGE = (1e-150, 1e150)   # kg, kg m^2: beyond, products of masses, lengths and accelerations over/underflow
+
+
+def _in_range(entity, field, x, unit) -> None:
+    """ModelError unless x is 0 or within MASS_RANGE: a mass of 1e300 kg ran and then could not be tabled
+    (its reactions overflow double precision); inside the range every threshold of the solvers is relative."""
+    lo, hi = MASS_RANGE
+    if x != 0.0 and not lo <= x <= hi:
+        raise ModelError(entity, field, f"{x:g} {unit} is outside what double-precision dynamics can carry "
+                         f"({lo:g} .. {hi:g} {unit})")
+
+
 def make_body(name, mass, inertia, position, orientation, velocity, angular_velocity, particle=False) -> Body:
     """Validate user input and build a Body (or a particle when particle=True).
 
@@ -113,6 +125,8 @@ def make_body(name, mass, inertia, position, orientation, velocity, angular_velo
     inertia = (0.0, 0.0, 0.0) if inertia is None else inertia
     m = scalar(entity, "mass", mass, minimum=0.0, strict=particle)
     J = np.zeros((3, 3)) if particle else inertia_matrix(entity, inertia)
+    _in_range(entity, "mass", m, "kg")
+    _in_range(entity, "inertia", float(np.max(np.abs(J))), "kg m^2")
     try:
         R = np.eye(3) if particle else as_matrix(orientation)
     except ValueError as exc:

@@ -43,7 +43,12 @@ class ForceElementsMixin:
         """Bushing between two markers (a Marker or (body, point in ground at t=0)), Adams BUSHING semantics.
 
         stiffness (kx, ky, kz [N/m], ktx, kty, ktz [N m/rad]), damping (cx, cy, cz [N s/m], ctx, cty, ctz
-        [N m s/rad]) and preload (Fx, Fy, Fz [N], Tx, Ty, Tz [N m]) in marker_i axes; see mbdsim Bushing."""
+        [N m s/rad]) and preload (Fx, Fy, Fz [N], Tx, Ty, Tz [N m]) in marker_i axes; see mbdsim Bushing.
+        As in Adams, the torque is -K a - C w + T0 with `a` the rotation vector of marker_j relative to
+        marker_i (small-angle semantics): with unequal rotational stiffnesses ktx, kty, ktz this torque is
+        not the gradient of any potential once the rotation is finite, so such a bushing exchanges energy
+        with the bodies (a few percent of its elastic energy over large rotations, whatever the
+        tolerance): the run monitor then does not check the energy balance (res.diagnostics.notes)."""
         entity = f"bushing '{name}'"
         mi, mj = self._location(entity, "marker_i", marker_i), self._location(entity, "marker_j", marker_j)
         if mi.body is mj.body:

@@ -352,8 +352,9 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
             if item not in table:
                 raise ModelError(entity, field, f"no {field} named {item!r} in the model")
             return table[item]
-        if not any(item is v for v in table.values()):
-            raise ModelError(entity, field, f"{item!r} is not part of this model")
+        name = getattr(item, "name", None)
+        if not (isinstance(name, str) and table.get(name) is item) and not any(item is v for v in table.values()):
+            raise ModelError(entity, field, f"{item!r} is not part of this model")   # (O(1) when it is)
         return item
 
     def _location(self, entity, field, at) -> Marker:

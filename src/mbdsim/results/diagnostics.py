@@ -112,6 +112,10 @@ def _energy_terms(res):
             return None, f"energy balance not checked: element '{e.name}' has no energy bookkeeping"
         if getattr(ev, "needs_lambda", False):
             return None, f"energy balance not checked: friction '{e.name}' needs the multipliers"
+        kt = getattr(e, "stiffness", None) if type(e).__name__ == "Bushing" else None
+        if kt is not None and np.ptp(np.asarray(kt, float)[3:]) > 1e-12 * np.max(np.asarray(kt, float)[3:]):
+            return None, (f"energy balance not checked: bushing '{e.name}' has unequal rotational stiffnesses "
+                          "(Adams' small-angle BUSHING torque -K a is not conservative for finite rotations)")
     T, V = res.kinetic_energy(), res.potential_energy()
     P_d = dissipation_power(sys, res.frames, res.time) if any(
         hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None

@@ -296,7 +296,7 @@ class Result:
         jt = self._joint(joint) if not (isinstance(joint, str) and joint in self.system.owner_rows) else joint
         body = None if on is None else ms.resolve_body(self.system, on, "on")
         lam = self.lambda_
-        F, T = joint_reaction(self.system, self.q, lam, jt, body, A=self.frames.A, J=jacobians_of(self.system, lam))
+        F, T = joint_reaction(self.system, self.q, lam, jt, body, J=jacobians_of(self.system, lam), fr=self.frames)
         return self._express(F, frame), self._express(T, frame)
 
     @property

@@ -141,6 +141,13 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
 
 def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     """assemble_state without the cache."""
+    from .assembly_large import consistent_tree
+    fast = consistent_tree(sys, q0, v0, t, tol)   # a large consistent tree: no dense matrix (issue 35)
+    if fast is not None:
+        rows, phi = fast
+        notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
+        return AssemblyReport(sys, t, q0.copy(), v0.copy(), rows, sys.nv - len(rows), [], {}, {},
+                              float(np.max(np.abs(phi), initial=0.0)), [], notes, {})
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:

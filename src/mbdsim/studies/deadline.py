@@ -1,6 +1,6 @@
 """The per-variant time limit of a study (`analysis.time_limit` [s] of wall time).
 
-A watchdog timer raises `VariantTimeout` in the thread running the variant (CPython's
+A watchdog timer raises `_VariantTimeout` in the thread running the variant (CPython's
 PyThreadState_SetAsyncExc) once the limit has passed. It is a KeyboardInterrupt, so every place that
 already ends a run cleanly on Ctrl-C ends it on the limit too: the compiled step loop between its
 chunks, a Python callable called back from it, the reference path; the analysis returns its
@@ -16,7 +16,7 @@ import threading
 from contextlib import contextmanager
 
 
-class VariantTimeout(KeyboardInterrupt):
+class _VariantTimeout(KeyboardInterrupt):
     """Raised in a study variant's thread when its time limit has passed (see the module docstring)."""
 
 
@@ -33,7 +33,7 @@ def _raise_in(thread_id: int, exc) -> int:
 
 @contextmanager
 def time_limit(seconds: float | None):
-    """Run the block with a watchdog: after `seconds` [s] of wall time VariantTimeout is raised in this
+    """Run the block with a watchdog: after `seconds` [s] of wall time _VariantTimeout is raised in this
     thread (None: no limit). Yields the watch: `.fired` tells whether the limit ended the block."""
     watch = _Watch()
     if seconds is None:
@@ -45,7 +45,7 @@ def time_limit(seconds: float | None):
         with lock:
             if watch.active:
                 watch.fired = True
-                _raise_in(tid, VariantTimeout)
+                _raise_in(tid, _VariantTimeout)
 
     timer = threading.Timer(float(seconds), fire)
     timer.daemon = True

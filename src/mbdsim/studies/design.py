@@ -151,6 +151,24 @@ def _from_dict(name, spec: dict) -> ParameterSpec:
     return ParameterSpec(name, dist=dist, describe=text)
 
 
+def quantity_texts(spec) -> list[str]:
+    """The values of a parameter spec as written with their units ("2 m", or "1 <unit>" for a spec with a
+    'unit'), for checking their dimension against the field a parameter path sets (Study): [] for
+    plain numbers, expressions and distributions given as objects."""
+    if isinstance(spec, dict):
+        if isinstance(spec.get("unit"), str):
+            return [f"1 {spec['unit']}"]
+        spec = list(spec.get("values", ())) + list(spec.get("range", ()) if not isinstance(spec.get("range"), str) else ())
+    items = list(spec) if isinstance(spec, (list, tuple)) else [spec]
+    out = []
+    for v in items:
+        if isinstance(v, str):
+            m = _QUANTITY.match(v)
+            if m is not None and m.group(2) and v not in out:
+                out.append(v)
+    return out
+
+
 def parse_parameter(name: str, spec) -> ParameterSpec:
     """ParameterSpec from the forms listed in the module docstring; raises ModelError naming it."""
     if not isinstance(name, str) or not name:

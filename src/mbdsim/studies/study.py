@@ -24,6 +24,11 @@ RESERVED = ("run", "status", "message", "wall_time", "worker", "study_id")
 def _model_source(model):
     """(base data, factory, source name) of the model argument."""
     if isinstance(model, (str, Path)):
+        from ..importers import importer_for
+        load = importer_for(model)
+        if load is not None:   # an imported format (URDF, MJCF, ...): its model data
+            from ..io import model_to_dict
+            return model_to_dict(load(model)), None, str(model)
         from ..io.files import read
         data, _, source = read(model)
         return data, None, source
@@ -57,6 +62,22 @@ def _check_schema(data: dict, source: str, entity: str) -> None:
     except ValidationError as exc:
         err = diagnose.from_validation(exc, data, source, None)
         raise ModelError(entity, "path", f"makes the model data invalid: {err}") from None
+
+
+def _check_units(base: dict, name: str, spec, source: str) -> None:
+    """The units a path parameter is written in against the field it sets ("1 m" for a mass is refused,
+    ModelError naming the parameter and 'values'): each value with a unit is put into the model data
+    as written and checked by the model-file schema (the design itself holds SI numbers)."""
+    from .design import quantity_texts
+    for text in quantity_texts(spec):
+        probe = copy.deepcopy(base)
+        apply_path(probe, name, text, source)
+        try:
+            _check_schema(probe, source, f"study parameter '{name}'")
+        except ModelError as exc:
+            why = str(exc).split("makes the model data invalid: ")[-1]
+            raise ModelError(f"study parameter '{name}'", "values", f"{text!r} does not fit the field it sets "
+                             f"({why})") from None
 
 
 class Study:
@@ -124,6 +145,7 @@ class Study:
             if is_path(name):
                 apply_path(probe, name, first[name], self.plan.source)
                 _check_schema(probe, self.plan.source, f"study parameter '{name}'")
+                _check_units(self.plan.base, name, parameters[name], self.plan.source)
             elif not re.search(r"\{[^{}]*\b" + re.escape(name) + r"\b[^{}]*\}", text):
                 raise ModelError(f"study parameter '{name}'", "name", "is neither a path into the model "
                                  "(section.item.field) nor used in a 'set' template ({" + name + "})")

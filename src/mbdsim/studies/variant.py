@@ -122,7 +122,7 @@ def run_variant(plan: Plan, params: dict) -> dict:
     message and wall time [s].  Never raises for a problem of the variant itself."""
     t0 = time.perf_counter()
     from ..system.assemble import single_use
-    from .deadline import VariantTimeout, time_limit
+    from .deadline import _VariantTimeout, time_limit
     row = {name: math.nan for name in plan.outputs}
     limit = plan.analysis.get("time_limit")
     try:
@@ -138,7 +138,7 @@ def run_variant(plan: Plan, params: dict) -> dict:
                         status, message = "failed", str(getattr(res, "message", "analysis failed"))
             except Exception as exc:  # noqa: BLE001 - a failing variant is a row with its error, never a crash
                 status, message = "error", f"{type(exc).__name__}: {exc}"
-    except VariantTimeout:
+    except _VariantTimeout:
         status, message = "failed", ""
     if watch.fired:   # the run stopped on the limit (its outputs so far discarded: the row is not 'ok')
         row = {name: math.nan for name in plan.outputs}

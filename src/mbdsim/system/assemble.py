@@ -64,7 +64,6 @@ class System:
     frame_rigid: np.ndarray    # (nbody+1,) bool
     mass: np.ndarray           # (nbody+1,) [kg]
     inertia_B: np.ndarray      # (nbody+1, 3, 3) [kg m^2] about the CM, body axes
-    M: np.ndarray              # (nv, nv) constant mass matrix
     groups: list
     row_owner: list            # name of the joint/motion of each row
     owner_rows: dict           # name -> row indices
@@ -95,6 +94,17 @@ class System:
 
     def __repr__(self) -> str:
         return f"System({self.model.name!r}: nq={self.nq}, nv={self.nv}, nc={self.nc})"
+
+    @property
+    def M(self) -> np.ndarray:
+        """The constant mass matrix (nv, nv) [kg, kg m^2]: masses on the translation blocks, inertias
+        about the CM in body axes on the rotation blocks, zero for the massless auxiliary coordinates.
+        Built on first use (kept in `derived`): the compiled path never needs it, so a 10,000-body
+        chain does not allocate 60,000 x 60,000 doubles (issue 35)."""
+        M = self.derived.get("mass matrix")
+        if M is None:
+            M = self.derived["mass matrix"] = mass_matrix(self)
+        return M
 
     @property
     def kernel_rows(self) -> bool:
@@ -163,20 +173,15 @@ def _assemble_system(model) -> System:
     nv = len(v0)
     mass = np.array([0.0] + [b.mass for b in bodies])
     J = np.zeros((len(bodies) + 1, 3, 3))
-    M = np.zeros((nv, nv))
     for k, b in enumerate(bodies):
-        a = v_adr[k + 1]
-        M[range(a, a + 3), range(a, a + 3)] = b.mass
         if not b.is_particle:
             J[k + 1] = b.inertia
-            M[a + 3:a + 6, a + 3:a + 6] = b.inertia
     specs, geoms = _row_specs(model, fid)
     geoms.update(pgeoms)
     cspecs, psi0, psid0, caux_q, caux_v = coord_specs(model, fid, geoms, len(q0), len(v0))
     if len(psi0):   # continuous angles of coupled joints (issue 11), massless like the path parameters
         q0, v0, nv = q0 + psi0, v0 + psid0, nv + len(psi0)
         aux_q, aux_v = np.concatenate([aux_q, caux_q]), np.concatenate([aux_v, caux_v])
-        M = np.pad(M, ((0, len(psi0)), (0, len(psi0))))
     locks = lock_specs(model, geoms)
     specs += pspecs + cspecs + locks
     groups, owners, owner_rows = _groups(specs, fid)
@@ -186,12 +191,23 @@ def _assemble_system(model) -> System:
     as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
     sys = System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                  as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),
-                 np.array([False] + [not b.is_particle for b in bodies]), mass, J, M, groups, owners,
+                 np.array([False] + [not b.is_particle for b in bodies]), mass, J, groups, owners,
                  owner_rows, geoms, np.array(q0, dtype=float), np.array(v0, dtype=float), aux_q, aux_v,
                  np.arange(len(owners) - len(locks), len(owners)), {s.owner: s.fn for s in locks},
                  not_compiled)
     sys.derived["packed"] = pack_rows(sys)   # the rows for the compiled kernels (system.packing)
     return sys
+
+
+def mass_matrix(sys) -> np.ndarray:
+    """Dense constant mass matrix (nv, nv) of a System (see System.M)."""
+    M = np.zeros((sys.nv, sys.nv))
+    for f in range(1, sys.nbody + 1):
+        a = int(sys.frame_v_adr[f])
+        M[range(a, a + 3), range(a, a + 3)] = sys.mass[f]
+        if sys.frame_rigid[f]:
+            M[a + 3:a + 6, a + 3:a + 6] = sys.inertia_B[f]
+    return M
 
 
 def joint_geometry(joint, fid) -> JointGeom:

@@ -173,6 +173,19 @@ def jacobians(sys, q) -> np.ndarray:
                                   sys.nv)
 
 
+def jacobian_blocks(sys, fr, rows):
+    """Compact Jacobian rows (N, len(rows), 2, 6) of constraint `rows` at the Frames `fr` (N samples):
+    block 0 on the row's frame bi, block 1 on bj (sys.derived["packed"] kinds), in the velocity
+    variables' axes; None when a row is not a kernel kind (the caller uses `jacobians`)."""
+    if not sys.kernel_rows:
+        return None
+    kind, bi, bj, V, par, drv, fns = _packed(sys)
+    rows = np.asarray(rows, dtype=np.int64)
+    R, A = np.ascontiguousarray(fr.r, dtype=float), np.ascontiguousarray(fr.A, dtype=float)
+    return kernels.jacobian_blocks(R, A, kind[rows], bi[rows], bj[rows], np.ascontiguousarray(V[rows]),
+                                   par[rows], drv[rows], len(fns), sys.frame_rigid)
+
+
 def constraint_terms_numpy(sys, q, v, t, jacobian=True):
     """constraint_terms group by group through the primitives' Rows and `scatter_jacobian` (the same row
     maths, `kernels.row_terms`, as the compiled path, scattered by numpy: the cross-check of the packed

@@ -295,6 +295,22 @@ def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_
     return out
 
 
+@njit(cache=True)
+def jacobian_blocks(R, A, kind, bi_, bj_, V, par, drv, nd, rigid):
+    """Compact Jacobian rows Jc (N, nr, 2, 6) of the rows given (kind ... drv sliced to them; column block
+    0 on frame bi_, 1 on bj_, in the velocity variables' axes as `scatter_dense` places them) at the
+    frames R (N, nf, 3), A (N, nf, 3, 3): O(N nr), whatever the size of the system (the reactions of
+    one joint of a 10,000-body chain do not build its 60,000-column Jacobian)."""
+    N, nr, nf = R.shape[0], kind.shape[0], R.shape[1]
+    out = np.zeros((N, nr, 2, 6))
+    rd, w = np.zeros((nf, 3)), np.zeros((nf, 3))
+    z = np.zeros(max(nd, 1))
+    phi, nu, gamma = np.zeros(nr), np.zeros(nr), np.zeros(nr)
+    for n in range(N):
+        rows_kernel(R[n], A[n], rd, w, kind, bi_, bj_, V, par, drv, z, z, z, rigid, phi, out[n], nu, gamma)
+    return out
+
+
 @njit(cache=True, _nrt=False)
 def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
     """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..errors import ModelError
-from .equations import jacobians
+from .equations import _packed, jacobian_blocks, jacobians
 from .frames import body_frames
 
 
@@ -38,28 +38,37 @@ def jacobians_of(sys, lambda_):
     return None
 
 
-def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None):
+def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None, fr=None):
     """Force [N] and torque [N m] (N, 3), ground axes, that `joint` (a Joint or motion name) exerts on `on`.
 
     Optional precomputed geometry of the samples q (N, nq): A (N, nbody + 1, 3, 3) body rotation
-    matrices (Frames.A), J (N, nc, nv) constraint Jacobians; computed here when not given (and kept for
-    the next reaction read from the same `lambda_` array, `keep_jacobians`)."""
-    if J is None:
-        J = jacobians_of(sys, lambda_)
-        if J is None:
-            J = jacobians(sys, q)
-            keep_jacobians(sys, lambda_, J)
+    matrices (Frames.A), J (N, nc, nv) constraint Jacobians, fr the samples' Frames. Without J (nor
+    Jacobians kept for this `lambda_` array, `keep_jacobians`) only the joint's own rows are evaluated
+    at the frames (`equations.jacobian_blocks`): O(N) per joint, so the reactions of every joint of an
+    N-body chain cost O(N^2) no longer O(N^3); the dense Jacobians remain for rows the kernels lack."""
     name = joint if isinstance(joint, str) else joint.name
     rows, geom = _rows_and_geometry(sys, name)
     body = on if on is not None else (joint.body_j if not isinstance(joint, str) else None)
     fid = geom.bj if body is None else sys.fid.get(body, -1)
     if fid not in (geom.bi, geom.bj):
         raise ModelError(f"joint '{name}'", "on", f"{body!r} is not one of the joint's bodies")
+    if A is None and fr is not None:
+        A = fr.A
+    if J is None:
+        J = jacobians_of(sys, lambda_)
+    blocks = None
+    if J is None:
+        fr = body_frames(sys, np.atleast_2d(q)) if fr is None else fr
+        blocks = jacobian_blocks(sys, fr, rows)
+        A = fr.A if A is None else A
+        if blocks is None:
+            J = jacobians(sys, q)
+            keep_jacobians(sys, lambda_, J)
     if fid == 0:  # ground: the opposite of the load on the other body, reduced to the same point
         other = geom.bi if geom.bj == 0 else geom.bj
-        F, T = _load_on(sys, q, lambda_, rows, other, geom, A, J)
+        F, T = _load_on(sys, q, lambda_, rows, other, geom, A, J, blocks)
         return -F, -T
-    return _load_on(sys, q, lambda_, rows, fid, geom, A, J)
+    return _load_on(sys, q, lambda_, rows, fid, geom, A, J, blocks)
 
 
 def _rows_and_geometry(sys, name):
@@ -80,16 +89,25 @@ def _rows_and_geometry(sys, name):
     return found
 
 
-def _load_on(sys, q, lambda_, rows, fid, geom, A=None, J=None):
+def _load_on(sys, q, lambda_, rows, fid, geom, A=None, J=None, blocks=None):
     """Constraint force [N] and torque about the joint point [N m] (N, 3), ground axes, of `rows` on frame
-    fid, for all samples at once."""
+    fid, for all samples at once; `blocks`: the rows' compact Jacobians (equations.jacobian_blocks),
+    else the dense J (computed when None)."""
     s_B = geom.s_j if fid == geom.bj else geom.s_i
     a = int(sys.frame_v_adr[fid])
     q = np.atleast_2d(q)
     rigid = bool(sys.frame_rigid[fid])
-    J = jacobians(sys, q) if J is None else J
+    width = 6 if rigid else 3
     lam = np.asarray(lambda_)[:, rows]                        # (N, nr)
-    Jb = J[:, rows, a:a + (6 if rigid else 3)]                 # (N, nr, 3 or 6): the body's columns
+    if blocks is not None:                                     # (N, nr, 2, 6): the row's side on fid
+        _, bi, bj = _packed(sys)[:3]
+        Jb = np.zeros((len(q), len(rows), width))
+        for side, b in ((0, bi), (1, bj)):
+            on = b[rows] == fid
+            Jb[:, on, :] = blocks[:, on, side, :width]
+    else:
+        J = jacobians(sys, q) if J is None else J
+        Jb = J[:, rows, a:a + width]                           # (N, nr, 3 or 6): the body's columns
     Q = -np.einsum("nri,nr->ni", Jb, lam)                      # force (ground), torque about CM (body axes)
     F = Q[:, :3]
     if not rigid:

@@ -60,7 +60,8 @@ class BushingEval:
     @staticmethod
     def potential(sys, fr, elem):
         """1/2 x.K x - F0.x + 1/2 a.K a - T0.a [J] (exact for the translations and for isotropic
-        rotational stiffness; small-angle otherwise)."""
+        rotational stiffness; small-angle otherwise: Adams' torque -K a with unequal rotational
+        stiffnesses has no potential for finite rotations, and the run monitor skips the energy balance)."""
         x, _, a, *_ = bushing_state(sys, fr, elem)
         k, f0 = elem.stiffness, elem.preload
         return (0.5 * np.einsum("ni,i,ni->n", x, k[:3], x) - x @ f0[:3]

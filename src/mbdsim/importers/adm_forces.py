@@ -1,0 +1,235 @@
+"""Force statements of an .adm dataset -> mbdsim loads and force elements (SI).
+
+SFORCE TRANSLATIONAL: a line force (positive repels, as in Adams); ACTIONONLY: a force on I along J's z.
+SFORCE ROTATIONAL / SPRINGDAMPER ROTATIONAL: a torque on I about J's z and its reaction on J.
+SPRINGDAMPER TRANSLATIONAL: a spring-damper (FORCE is the preload, repelling positive).  BUSHING:
+mbdsim's bushing (Adams semantics; rotations as a rotation vector, equal to Adams' small angles to
+first order).  FIELD: diagonal matrices without free-length offsets in rotation -> a bushing;
+otherwise refused.  VFORCE/VTORQUE/GFORCE: expression components in the RM marker's axes on I, the
+reaction on the JFLOAT marker's part at I's current position (as a force at the floating marker's
+initial point plus the moment of the offset).  FRICTION: mbdsim's event-driven joint friction (the
+stiction transition parameters are approximated by exact stick/slip).  CONTACT: sphere-sphere and
+sphere-plane GRAPHICS (ELLIPSOID with equal scales, PLANE) with the IMPACT law.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from ..errors import ModelError
+
+
+def _par(text):
+    return f"({text})"
+
+
+def _pair_loads(imp, st, name, mi, ref_j, frame, force, torque):
+    """Force components `force` (3 texts or None) at marker `mi` and torque `torque` on its body, in the axes
+    of `frame`; the reaction (when ref_j is on a moving body) on ref_j's body: -force at ref_j plus the
+    moment -(r x F) of the offset r = I - ref_j, and -torque."""
+    m = imp.model
+    if force is not None:
+        m.add_force(f"{name}_force" if torque is not None else name, mi, list(force), frame=frame)
+    if torque is not None:
+        m.add_torque(f"{name}_torque" if force is not None else name, mi.body, list(torque), frame=frame)
+    if ref_j is None or ref_j.body.is_ground:
+        return
+    k = f"{frame.body.name}.{frame.name}" if frame is not None else "ground"
+    i, j = f"{mi.body.name}.{mi.name}", f"{ref_j.body.name}.{ref_j.name}"
+    if force is not None:
+        m.add_force(f"{name}_reaction", ref_j, [f"-{_par(c)}" for c in force], frame=frame)
+        r = [f"DX({i}, {j}, {k})", f"DY({i}, {j}, {k})", f"DZ({i}, {j}, {k})"]
+        F = [_par(c) for c in force]
+        moment = [f"-({r[1]}*{F[2]} - {r[2]}*{F[1]})", f"-({r[2]}*{F[0]} - {r[0]}*{F[2]})",
+                  f"-({r[0]}*{F[1]} - {r[1]}*{F[0]})"]
+        if torque is not None:
+            moment = [f"{mm} - {_par(t)}" for mm, t in zip(moment, torque)]
+        m.add_torque(f"{name}_reaction_torque", ref_j.body, moment, frame=frame)
+    elif torque is not None:
+        m.add_torque(f"{name}_reaction_torque", ref_j.body, [f"-{_par(t)}" for t in torque], frame=frame)
+
+
+def sforce(imp, st) -> None:
+    """SFORCE/id, I=, J=, TRANSLATIONAL|ROTATIONAL [, ACTIONONLY], FUNCTION=."""
+    a, fl = imp.args(st, ("I", "J", "FUNCTION"), ("TRANSLATIONAL", "ROTATIONAL", "ACTIONONLY"))
+    mi, mj = imp.marker(st, a, "I"), imp.marker(st, a, "J", fixed=False)
+    rot = "ROTATIONAL" in fl
+    f = imp.expression(st, a, "FUNCTION", "torque" if rot else "force")
+    name = imp.name(st, f"SFORCE_{st.id}")
+    try:
+        if rot:
+            _pair_loads(imp, st, name, mi, None if "ACTIONONLY" in fl else mj, mj, None, ["0", "0", f])
+        elif "ACTIONONLY" in fl:
+            imp.model.add_force(name, mi, ["0", "0", f], frame=mj)
+        else:
+            imp.model.add_line_force(name, mi, mj, f"-({f})")
+    except ModelError as exc:
+        imp.model_error(st, exc, a["FUNCTION"].line)
+
+
+def springdamper(imp, st) -> None:
+    """SPRINGDAMPER/id, I=, J=, TRANSLATIONAL (K, C, LENGTH, FORCE) | ROTATIONAL (KT, CT, ANGLE, TORQUE)."""
+    a, fl = imp.args(st, ("I", "J", "K", "C", "LENGTH", "FORCE", "KT", "CT", "ANGLE", "TORQUE"),
+                     ("TRANSLATIONAL", "ROTATIONAL"))
+    mi, mj = imp.marker(st, a, "I"), imp.marker(st, a, "J")
+    name = imp.name(st, f"SPRINGDAMPER_{st.id}")
+    try:
+        if "ROTATIONAL" in fl:
+            kt = imp.num(st, a, "KT", 0.0, "rot_stiffness")
+            ct = imp.num(st, a, "CT", 0.0, "rot_damping")
+            a0 = imp.num(st, a, "ANGLE", 0.0, "angle")
+            t0 = imp.num(st, a, "TORQUE", 0.0, "torque")
+            i, j = f"{mi.body.name}.{mi.name}", f"{mj.body.name}.{mj.name}"
+            t = f"-({kt!r})*(AZ({i}, {j}) - ({a0!r})) - ({ct!r})*WZ({i}, {j}, {j}) + ({t0!r})"
+            _pair_loads(imp, st, name, mi, mj, mj, None, ["0", "0", t])
+            imp.note(st, "rotational spring-damper read as torques in AZ(I, J) (within +-180 deg, no turn count) "
+                     "and WZ(I, J, J)")
+        else:
+            k = imp.num(st, a, "K", 0.0, "stiffness")
+            c = imp.num(st, a, "C", 0.0, "damping")
+            L0 = imp.num(st, a, "LENGTH", None, "length")
+            f0 = imp.num(st, a, "FORCE", 0.0, "force")
+            imp.model.add_spring_damper(name, mi, mj, k, c, free_length=L0, preload=-f0)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+
+
+def bushing(imp, st) -> None:
+    """BUSHING/id, I=, J=, STIFFNESS, DAMPING, TSTIFFNESS, TDAMPING, FORCE, TORQUE (on I, in J's axes)."""
+    a, _ = imp.args(st, ("I", "J", "STIFFNESS", "DAMPING", "TSTIFFNESS", "TDAMPING", "FORCE", "TORQUE"))
+    mi, mj = imp.marker(st, a, "I"), imp.marker(st, a, "J")
+    k = imp.nums(st, a, "STIFFNESS", 3, [0.0] * 3, "stiffness") + imp.nums(st, a, "TSTIFFNESS", 3, [0.0] * 3,
+                                                                           "rot_stiffness")
+    c = imp.nums(st, a, "DAMPING", 3, [0.0] * 3, "damping") + imp.nums(st, a, "TDAMPING", 3, [0.0] * 3, "rot_damping")
+    p = imp.nums(st, a, "FORCE", 3, [0.0] * 3, "force") + imp.nums(st, a, "TORQUE", 3, [0.0] * 3, "torque")
+    try:
+        imp.model.add_bushing(imp.name(st, f"BUSHING_{st.id}"), mj, mi, k, c, p)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+    if any(k[3:]) or any(c[3:]):
+        imp.note(st, "rotations as a rotation vector (Adams: small angles; equal to first order)")
+
+
+def field(imp, st) -> None:
+    """FIELD/id, I=, J=, KMATRIX (36), CMATRIX (36) or CRATIO, LENGTH (6), FORCE (6): diagonal -> bushing."""
+    a, _ = imp.args(st, ("I", "J", "KMATRIX", "CMATRIX", "CRATIO", "LENGTH", "FORCE"), ignored=("ROUTINE",))
+    mi, mj = imp.marker(st, a, "I"), imp.marker(st, a, "J")
+    K = np.array(imp.nums(st, a, "KMATRIX", 36, [0.0] * 36)).reshape(6, 6)
+    C = np.array(imp.nums(st, a, "CMATRIX", 36, [0.0] * 36)).reshape(6, 6)
+    if "CRATIO" in a:
+        C = imp.num(st, a, "CRATIO") * K
+    off = lambda M: M - np.diag(np.diag(M))   # noqa: E731
+    if np.any(off(K)) or np.any(off(C)):
+        imp.fail(st, "KMATRIX" if np.any(off(K)) else "CMATRIX", "a FIELD with coupling (off-diagonal) terms is "
+                 "not supported; mbdsim reads diagonal FIELDs as bushings")
+    L = imp.nums(st, a, "LENGTH", 6, [0.0] * 6)
+    # SI: translational rows in length units, rotational in rad
+    su = np.array([imp.units.scale("force")] * 3 + [imp.units.scale("torque")] * 3)
+    du = np.array([imp.units.length] * 3 + [1.0] * 3)
+    k, c = np.diag(K) * su / du, np.diag(C) * su / du * imp.units.time
+    f0 = np.array(imp.nums(st, a, "FORCE", 6, [0.0] * 6)) * su
+    preload = f0 + k * np.array(L) * du    # -K (x - L) + F0 = -K x + (F0 + K L)
+    try:
+        imp.model.add_bushing(imp.name(st, f"FIELD_{st.id}"), mj, mi, k, c, preload)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+    imp.note(st, "diagonal FIELD read as a bushing (rotations as a rotation vector)")
+
+
+def vector_force(imp, st) -> None:
+    """VFORCE (FX FY FZ), VTORQUE (TX TY TZ), GFORCE (both): on I in RM's axes, reaction on JFLOAT's part."""
+    keys = {"VFORCE": ("FX", "FY", "FZ"), "VTORQUE": ("TX", "TY", "TZ"),
+            "GFORCE": ("FX", "FY", "FZ", "TX", "TY", "TZ")}[st.name]
+    a, _ = imp.args(st, ("I", "JFLOAT", "RM") + keys)
+    mi, rm = imp.marker(st, a, "I"), imp.marker(st, a, "RM", required=False, fixed=False)
+    jf = imp.marker(st, a, "JFLOAT", fixed=False)
+    for kk in keys:
+        if kk not in a:
+            imp.fail(st, kk, f"is required for {st.name}")
+    force = [imp.expression(st, a, kk, "force") for kk in keys if kk.startswith("F")] or None
+    torque = [imp.expression(st, a, kk, "torque") for kk in keys if kk.startswith("T")] or None
+    try:
+        _pair_loads(imp, st, imp.name(st, f"{st.name}_{st.id}"), mi, jf, rm, force, torque)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+
+
+def friction(imp, st) -> None:
+    """FRICTION/id, JOINT=, MU_STATIC, MU_DYNAMIC and the joint's friction arms -> Model.add_friction."""
+    a, _ = imp.args(st, ("JOINT", "MU_STATIC", "MU_DYNAMIC", "PIN_RADIUS", "FRICTION_ARM", "BENDING_REACTION_ARM",
+                         "FRICTION_FORCE_PRELOAD", "FRICTION_TORQUE_PRELOAD", "REACTION_ARM", "INITIAL_OVERLAP"),
+                    ignored=("STICTION_TRANSITION_VELOCITY", "TRANSITION_VELOCITY_COEFFICIENT",
+                             "MAX_STICTION_DEFORMATION", "MAX_FRICTION_FORCE", "MAX_FRICTION_TORQUE", "EFFECT",
+                             "INPUTS", "BALL_RADIUS", "OVERLAP_DELTA", "FRICTION_MODEL"))
+    jid = imp.ident(st, a, "JOINT")
+    jt = imp.joints.get(jid)
+    if jt is None:
+        imp.fail(st, "JOINT", f"no JOINT/{jid} in the dataset")
+    params = {}
+    if jt.kind == "revolute":
+        for key, p, q in (("PIN_RADIUS", "pin_radius", "length"), ("FRICTION_ARM", "friction_arm", "length"),
+                          ("BENDING_REACTION_ARM", "bending_arm", "length"),
+                          ("FRICTION_TORQUE_PRELOAD", "preload", "torque")):
+            if key in a:
+                params[p] = imp.num(st, a, key, None, q)
+    else:
+        for key, p, q in (("FRICTION_FORCE_PRELOAD", "preload", "force"), ("INITIAL_OVERLAP", "effective_length",
+                                                                            "length"),
+                          ("REACTION_ARM", "reaction_arm", "length")):
+            if key in a:
+                params[p] = imp.num(st, a, key, None, q)
+    try:
+        imp.model.add_friction(imp.name(st, f"FRICTION_{st.id}"), jt, imp.num(st, a, "MU_STATIC", 0.0),
+                               imp.num(st, a, "MU_DYNAMIC", 0.0), **params)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+    imp.note(st, "stick/slip by events (exact Coulomb); Adams' stiction transition parameters are not used")
+
+
+def contact(imp, st, graphics: dict) -> None:
+    """CONTACT/id, IGEOM=, JGEOM=, IMPACT, STIFFNESS, DAMPING, DMAX, EXPONENT [, COULOMB_FRICTION, MU_*]."""
+    from ..model.shapes import Plane, Sphere
+    a, fl = imp.args(st, ("IGEOM", "JGEOM", "STIFFNESS", "DAMPING", "DMAX", "EXPONENT", "MU_STATIC", "MU_DYNAMIC",
+                          "COULOMB_FRICTION", "STICTION_TRANSITION_VELOCITY", "FRICTION_TRANSITION_VELOCITY"),
+                     ("IMPACT",), ignored=("AUGMENTED_LAGRANGIAN_FORMULATION",))
+    shapes = []
+    for key in ("IGEOM", "JGEOM"):
+        gid = imp.ident(st, a, key)
+        g = graphics.get(gid)
+        if g is None:
+            imp.fail(st, key, f"no GRAPHICS/{gid} of a kind mbdsim can collide (ELLIPSOID with equal scales, PLANE)",
+                     a[key].line)
+        kind, marker, size = g
+        shapes.append(Sphere(marker.body, size, marker.point) if kind == "sphere" else
+                      Plane(marker.body, marker.point, marker.orientation[:, 2]))
+    e = imp.num(st, a, "EXPONENT", 1.0)
+    k = imp.num(st, a, "STIFFNESS", None) or imp.fail(st, "STIFFNESS", "is required")
+    k *= imp.units.force / imp.units.length ** e
+    mu = imp.num(st, a, "MU_DYNAMIC", 0.0) if "COULOMB_FRICTION" in a and \
+        a["COULOMB_FRICTION"].values[0].upper() == "ON" else 0.0
+    vt = imp.num(st, a, "FRICTION_TRANSITION_VELOCITY", 1.0, "velocity") if mu else 1e-3
+    try:
+        imp.model.add_contact(imp.name(st, f"CONTACT_{st.id}"), shapes[0], shapes[1], k, e,
+                              imp.num(st, a, "DAMPING", 0.0, "damping"), imp.num(st, a, "DMAX", 1e-3 / imp.units.length,
+                                                                                 "length"), mu, vt)
+    except ModelError as exc:
+        imp.model_error(st, exc)
+    if mu:
+        imp.note(st, "Coulomb friction regularised below FRICTION_TRANSITION_VELOCITY with MU_DYNAMIC "
+                 "(MU_STATIC not used)")
+
+
+def graphics(imp, st, table: dict) -> None:
+    """GRAPHICS/id, ELLIPSOID (CM=, XSCALE=YSCALE=ZSCALE= diameters) or PLANE (RM=): kept for CONTACT."""
+    a, fl = imp.args(st, ("CM", "RM", "XSCALE", "YSCALE", "ZSCALE", "XMIN", "XMAX", "YMIN", "YMAX", "CORNER", "X",
+                          "Y", "Z", "LENGTH", "RADIUS", "RANGE", "SIDES", "SEG", "TOP", "BOTTOM", "CRM", "FILE",
+                          "SCALE", "ELEMENT", "CID", "CSEG", "ETYPE", "EMARKER", "FORCE", "EID", "ANGLE",
+                          "MINOR_RADIUS", "MAJOR_RADIUS", "RECTANGLE"),
+                     ("ELLIPSOID", "PLANE", "CYLINDER", "BOX", "FRUSTUM", "CIRCLE", "ARC", "OUTLINE", "POINT",
+                      "TORUS", "EXTERNAL", "CURVE", "SPDP", "DEFAULT"))
+    if "ELLIPSOID" in fl:
+        m = imp.marker(st, a, "CM")
+        d = [imp.num(st, a, k, None, "length") for k in ("XSCALE", "YSCALE", "ZSCALE")]
+        if None not in d and max(d) - min(d) <= 1e-12 * max(d):
+            table[st.id] = ("sphere", m, 0.5 * d[0])
+    elif "PLANE" in fl:
+        table[st.id] = ("plane", imp.marker(st, a, "RM"), None)
