@@ -57,7 +57,9 @@ class TimeFunction:
     """A driver function of time: ``value(t)`` [unit], ``d1(t)`` [unit/s], ``d2(t)`` [unit/s^2].
 
     t may be a float (float returned) or a numpy array (array returned). ``expr`` is the parsed
-    :class:`~mbdsim.expressions.Expr` when the function came from a string, else None.
+    :class:`~mbdsim.expressions.Expr` when the function came from a string, else None; ``symbolic`` the
+    driver's trees in t and the model inputs it reads when it reads any (mbdsim.model.input_drivers: the
+    value/d1/d2 here are those with the inputs' declared values).
     """
 
     f: Callable[[Any], Any]
@@ -65,6 +67,7 @@ class TimeFunction:
     f_d2: Callable[[Any], Any]
     description: str = ""
     expr: Any = field(default=None, compare=False)
+    symbolic: Any = field(default=None, compare=False)   # a driver reading model inputs (model.input_drivers)
 
     def value(self, t):
         return _shape_out(_apply(self.f, t), t)

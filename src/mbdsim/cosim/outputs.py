@@ -35,7 +35,10 @@ class ExprPrograms:
 
     def __init__(self, sys, run, rep, slots, exprs: dict):
         self.names = list(exprs)
+        self.index = {n: k for k, n in enumerate(self.names)}
         self.stale, self._values = True, np.zeros(len(self.names))
+        self.yo = np.zeros(run.state_size)   # scratch of the evaluator (a normalised copy of the state)
+        self.arrays = None                   # the kernels' tuples with these programs as the sensors'
         if not self.names:
             return
         cm = run.cm
@@ -47,8 +50,22 @@ class ExprPrograms:
         a, w = cm.arrays(), run.work.arrays()
         self._a = a[:43] + (ex,) + a[44:]
         self._w = w[:44] + (exprloads_pack.work(ex, stack),) + w[45:]
-        self._yo = np.zeros(run.state_size)
+        self.arrays = (self._a, self._w)
         self._eval = Bound(fastdop._sensor_g)
+
+    @property
+    def buffer(self) -> np.ndarray:
+        """The array the values are evaluated into (in the order of `names`)."""
+        return self._values
+
+    def read(self, name: str) -> float:
+        """The last evaluated value of expression `name` (ModelError for a name that is not one)."""
+        k = self.index.get(name)
+        if k is None:
+            from ..errors import ModelError
+            raise ModelError(f"output '{name}'", "name", f"the model has no output {name!r} (outputs: "
+                             f"{', '.join(self.names) or 'none; declare them with Model.add_output'})")
+        return float(self._values[k])
 
     def values(self, t: float, y) -> dict:
         """{name: value} at time t [s] and integrator state y."""
@@ -66,5 +83,5 @@ class ExprPrograms:
 
     def _update(self, t, y):
         if self.stale and self.names:
-            self._eval(self._a, self._w, float(t), y, self._yo, self._values)
+            self._eval(self._a, self._w, float(t), y, self.yo, self._values)
             self.stale = False

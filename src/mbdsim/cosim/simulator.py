@@ -8,9 +8,13 @@
 
 Each `step(dt)` runs the compiled, error-controlled DOP853 of `simulate` (mbdsim.solvers.fastdop.run: as
 many internal steps as the tolerance needs, projection onto the constraints, sensors watched) from the
-current state to t + dt with the inputs held constant; between steps Python only writes the inputs into
-the constants of the compiled expression programs (mbdsim.system.exprloads_pack) and reads the outputs
-(one compiled evaluation). Nothing is re-assembled or re-compiled. Times in s, SI units throughout.
+current state to t + dt with the inputs held constant, in one compiled call on arrays packed once
+(mbdsim.cosim._stepper: the derivative at the step's start after an input changed, the run, the outputs
+at its end); between steps Python only writes the inputs into the constants of the compiled expression
+and driver programs (mbdsim.system.exprloads_pack, mbdsim.cosim.drivers: motion drivers reading inputs
+keep a velocity driver's displacement continuous, and a displacement driver's jump re-projects the state
+at the step's start) and reads the outputs. Nothing is re-assembled or re-compiled. Times in s, SI
+units throughout.
 The model must be one the compiled core carries (as simulate's method "auto"); FMUs added with
 `Model.add_fmu` run in the loop at their communication steps (mbdsim.cosim.fmu_import).
 """
@@ -24,6 +28,7 @@ import numpy as np
 from ..errors import ModelError, SolverError
 from ..solvers import fastdop, pyloads
 from ..solvers.fastdyn import INTERRUPTED
+from . import _stepper
 from ._fastcall import Bound
 
 if TYPE_CHECKING:
@@ -91,13 +96,16 @@ class Simulator:
         ex = list(run.cm.exprloads)
         if len(ex) > 14:   # the inputs are constants of these programs: this Simulator's own copy
             ex[14] = ex[14].copy()
-        run.cm = dataclasses.replace(run.cm, exprloads=tuple(ex))
+        consts = run.cm.consts.copy() if run.cm.driver_slots else run.cm.consts   # drivers reading inputs
+        run.cm = dataclasses.replace(run.cm, exprloads=tuple(ex), consts=consts)
         self._run = run
         self._a, self._w = run.cm.arrays(), run.work.arrays()
         self._inputs = {n: float(i.value) for n, i in getattr(model, "inputs", {}).items()}
         self._slots = {n: [] for n in self._inputs}   # input -> [(array, index)] written by set_input
         for name, k in run.cm.input_slots:
             self._slots[name].append((ex[14], k))
+        from .drivers import driver_constants
+        self._drivers = driver_constants(run, self._slots)   # input -> [DriverConstants]
         from .outputs import ExprPrograms
         self._out = ExprPrograms(sys, run, rep, self._slots,
                                  {n: o.text for n, o in getattr(model, "outputs", {}).items()})
@@ -115,8 +123,16 @@ class Simulator:
         self._fresh = False   # f is the derivative at the current state with the current inputs
         self._times, self._rows, self._held = [t0], [y0.copy()], [self._input_vector()]
         self.stopped = None   # the SensorEvent of a sensor with action "stop", once met
-        self._kernel = Bound(fastdop.run)
-        self._rhs = Bound(fastdop.rhs)
+        self._reproject = False   # an input read by a motion driver changed: project at the step's start
+        out = self._out
+        self._box = _stepper.pack(
+            cm=self._a, wk=self._w, cmo=out.arrays[0] if out.names else self._a,
+            wko=out.arrays[1] if out.names else self._w, co=fastdop.COEFFS, st=self._st, y=self._y,
+            f=self._f, tout=self._tout, Y=self._Y, K=self._K, F=self._F, sc=self._sc, SY=self._SY, ST=self._ST,
+            ns=self._ns, stats=run.stats, yo=out.yo, values=out.buffer,
+            par=np.array([run.rtol, run.atol, run.max_step]), watch=self._watch, n_out=len(out.names))
+        self._kernel = Bound(_stepper.advance)
+        self._outputs = Bound(_stepper.outputs)
         from .fmu_import import FmuRunner
         self._fmus = [FmuRunner(link, self, t0) for link in getattr(model, "fmus", {}).values()]
         for fmu in self._fmus:
@@ -141,6 +157,9 @@ class Simulator:
             v = scalar(f"input '{name}'", "value", value)
         if v != self._inputs[name]:
             self._inputs[name] = v
+            for drv in self._drivers.get(name, ()):   # motion drivers reading it: anchors moved at t
+                drv.set(float(self._st[0]), name, v)
+                self._reproject = self._reproject or drv.reprojects
             for arr, k in self._slots[name]:
                 arr[k] = v
             self._fresh = False
@@ -154,11 +173,19 @@ class Simulator:
 
     def output(self, name: str) -> float:
         """The model output `name` (Model.add_output) at the current time and state."""
-        return self._out.value(name, self.time, self._y)
+        out = self._out
+        if out.stale:
+            self._outputs(self._box)
+            out.stale = False
+        return out.read(name)
 
     def outputs(self) -> dict:
         """{output name: value} of every model output at the current time and state."""
-        return self._out.values(self.time, self._y)
+        out = self._out
+        if out.stale:
+            self._outputs(self._box)
+            out.stale = False
+        return dict(zip(out.names, out.buffer.tolist()))
 
     # ------------------------------------------------------------------ stepping
     def step(self, dt: float) -> float:
@@ -167,7 +194,12 @@ class Simulator:
         if not (dt.__class__ is float and 0.0 < dt < np.inf):
             from ..model._check import scalar
             dt = scalar("Simulator.step", "dt", dt, 0.0, strict=True)
-        return self.advance_to(float(self._st[0]) + dt)
+        t = float(self._st[0]) + dt
+        if self._fmus or self.stopped is not None:
+            return self.advance_to(t)
+        if dt > _ROUND * max(1.0, abs(t)):   # (the loop's usual case: no FMU, not stopped)
+            self._advance(t)
+        return float(self._st[0])
 
     def advance_to(self, t: float) -> float:
         """Advance to time t [s] (>= the current time), FMUs sampled at their communication steps on the
@@ -194,32 +226,33 @@ class Simulator:
         return self.time
 
     def _advance(self, t1: float) -> None:
-        """One macro step of the compiled DOP853 from the current state to t1 [s] (one output there)."""
-        run, a, w, st, y, f = self._run, self._a, self._w, self._st, self._y, self._f
-        if st[1] > 0.0 and not self._fresh:   # the loads changed with the inputs: f at the step's start again
-            self._rhs(a, w, st[0], y, f, True)
-        Y, tout = self._Y, self._tout
-        tout[0], tout[1] = st[0], t1
+        """One macro step of the compiled DOP853 from the current state to t1 [s] (one output there, and
+        the model's outputs evaluated there: mbdsim.cosim._stepper.advance)."""
+        run = self._run
+        fresh, reproject = self._fresh, self._reproject
         iout, status = 1, 0
         max_steps = int(run.stats[0]) + MAX_STEPS_PER_CALL
+        events = run.sensors
         try:
             while iout < 2 and status in (0, fastdop.EVENTS_FULL):
-                run._take_events()
-                status, iout = self._kernel(a, w, fastdop.COEFFS, st, y, f, t1, tout, iout, Y, run.rtol, run.atol,
-                                            run.max_step, max_steps, 1 << 30, 1e-12, run.stats, self._K, self._F,
-                                            self._sc, False, self._SY, self._ST, self._ns, self._watch)
+                if events:
+                    run._take_events()
+                status, iout = self._kernel(self._box, t1, fresh, reproject, max_steps)
+                fresh, reproject = True, False
         except KeyboardInterrupt:
             status = INTERRUPTED
-        status, run.run_error = pyloads.settle(run.pyloads, status, run.run_error)
-        run._take_events()
-        self._fresh = True
-        self._out.stale = True
+        if status != 0:
+            status, run.run_error = pyloads.settle(run.pyloads, status, run.run_error)
+        if events:
+            run._take_events()
+        self._fresh, self._reproject = True, False
+        self._out.stale = not (status == 0 and iout == 2)
         if status == fastdop.SENSOR_STOP:
             self._stop(t1)
             return
         if status != 0 or iout < 2:
             self._fail(status, t1)
-        self._record(t1, Y[1])
+        self._record(t1, self._Y[1])
 
     def _record(self, t, row):
         Y = self._Y
@@ -248,6 +281,10 @@ class Simulator:
             error = SolverError(f"the step to t = {t1:.12g} s did not reach its end", time=float(self._st[0]))
         raise error
 
+    def _driver_list(self) -> list:
+        """Each DriverConstants once (a driver may read several inputs)."""
+        return list({id(d): d for ds in self._drivers.values() for d in ds}.values())
+
     def _input_vector(self) -> tuple:
         return tuple(self._inputs.values())
 
@@ -256,7 +293,8 @@ class Simulator:
         """A copy of everything the next steps depend on; `restore(state)` reinstates it (trial moves,
         model-predictive control). FMUs are saved through FMI 2.0 getFMUstate when they can."""
         data = (self._st.copy(), self._y.copy(), self._f.copy(), self._run.stats.copy(), self._Y[0].copy(),
-                _copy(self._w), self._fresh, len(self._run.sensor_events))
+                _copy(self._w), self._fresh, len(self._run.sensor_events), self._reproject,
+                tuple(d.save() for d in self._driver_list()))
         return SimulatorState(self.time, data, dict(self._inputs), len(self._times),
                               tuple(f.save() for f in self._fmus))
 
@@ -266,7 +304,7 @@ class Simulator:
         if not isinstance(state, SimulatorState) or len(state.data[1]) != len(self._y) or \
                 len(state.fmus) != len(self._fmus):
             raise ModelError("Simulator.restore", "state", "expected a state() of this Simulator")
-        st, y, f, stats, row, w, fresh, nev = state.data
+        st, y, f, stats, row, w, fresh, nev, reproject, drivers = state.data
         self._st[:], self._y[:], self._f[:], self._run.stats[:], self._Y[0] = st, y, f, stats, row
         _put(self._w, w)
         self._fresh = fresh
@@ -274,7 +312,10 @@ class Simulator:
         for name, v in state.inputs.items():
             self._inputs[name] = np.nan   # written whatever the current value
             self.set_input(name, v)
-        self._fresh = fresh
+        self._fresh, self._reproject = fresh, reproject
+        for d, values in zip(self._driver_list(), drivers):
+            d.load(values)
+        self._out.stale = True   # the outputs at the restored state (a model without inputs too)
         del self._times[state.n:], self._rows[state.n:], self._held[state.n:]
         self.stopped = None
         for fmu, s in zip(self._fmus, state.fmus):

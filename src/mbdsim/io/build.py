@@ -233,7 +233,7 @@ class Builder:
             return value
         from ..expressions import ExpressionError, parse
         try:
-            parse(value)
+            parse(value, ("t",) + tuple(getattr(self.model, "inputs", {})))   # t and the model's inputs
             return value
         except ExpressionError as exc:
             try:

@@ -166,6 +166,8 @@ def _path(pc) -> dict:
 def _source(entity, field, tf):
     """The number or expression text a TimeFunction was made from, else ModelError (a callable)."""
     from ..timefunctions import _Constant
+    if getattr(tf, "symbolic", None) is not None:   # a driver reading model inputs: its text as given
+        return tf.symbolic.text
     if tf.expr is not None:
         return tf.expr.text
     if isinstance(tf.f, _Constant):

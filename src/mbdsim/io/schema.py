@@ -251,7 +251,9 @@ JointSpec = Annotated[Union[(AxisJointSpec, InlineSpec, SphericalSpec, AtPointSp
 # ----------------------------------------------------------------------------- motions
 class MotionSpec(Spec):
     """Exactly one of displacement / velocity / acceleration: a number [rad or m (per s, s^2)] or an
-    expression string in t [s], e.g. "pi/6*(1-cos(pi*t/2))"; a constant may carry units ("60 deg/s")."""
+    expression string in t [s], e.g. "pi/6*(1-cos(pi*t/2))"; a constant may carry units ("60 deg/s").
+    The expression may read the model's inputs by name ("w_cmd"): a Simulator holds them over each step
+    (a velocity or acceleration driver stays continuous when they change, a displacement driver jumps)."""
 
     name: Name
     joint: Name

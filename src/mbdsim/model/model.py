@@ -194,7 +194,11 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
 
         Give exactly one of displacement, velocity (with initial_displacement) or acceleration (with
         initial_displacement and initial_velocity): a callable of t, a number or an expression string
-        in t (safe whitelist parser, never eval'd).  `dof` picks "rotation" (the default) or "translation"
+        in t (safe whitelist parser, never eval'd). An expression may also read the model's inputs
+        (Model.add_input, declared before): held constant over each step of mbdsim.Simulator, a velocity
+        or acceleration driver then keeps its displacement continuous when an input changes, a
+        displacement driver jumps (the state is re-projected at the step's start); see
+        mbdsim.model.input_drivers.  `dof` picks "rotation" (the default) or "translation"
         on a cylindrical joint; other one-DOF joints drive their only coordinate.
         """
         from ..expressions import double_integrated, integrated, time_function
@@ -213,17 +217,22 @@ class Model(ExprLoadsMixin, ForceElementsMixin, FrictionPathMixin, JointsExtraMi
                 if other.joint is jt and other.dof == dof:
                     raise ModelError(entity, "joint", f"the {dof} of joint '{jt.name}' is already driven by "
                                      f"motion '{other.name}'; a coordinate takes one motion")
+            from .input_drivers import input_driver, reads_inputs
+            inputs = {n: i.value for n, i in getattr(self, "inputs", {}).items()}
             try:
-                if callable(f) and not hasattr(f, "d1"):
-                    from ._check import check_time_callable
-                    check_time_callable(entity, kind, f)
-                given = tf = time_function(f)
                 x0 = scalar(entity, "initial_displacement", initial_displacement)
                 v0 = scalar(entity, "initial_velocity", initial_velocity)
-                if kind == "velocity":
-                    tf = integrated(tf, x0)
-                elif kind == "acceleration":
-                    tf = double_integrated(tf, x0, v0)
+                if reads_inputs(f, inputs):   # an expression of t and model inputs (Simulator.set_input)
+                    given = tf = input_driver(kind, f, inputs, x0, v0)[0]
+                else:
+                    if callable(f) and not hasattr(f, "d1"):
+                        from ._check import check_time_callable
+                        check_time_callable(entity, kind, f)
+                    given = tf = time_function(f)
+                    if kind == "velocity":
+                        tf = integrated(tf, x0)
+                    elif kind == "acceleration":
+                        tf = double_integrated(tf, x0, v0)
                 float(tf.value(0.0))
             except ModelError:
                 raise

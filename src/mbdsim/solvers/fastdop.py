@@ -2,7 +2,8 @@
 
 The whole step loop runs in compiled code: stages (the O(N) equations of motion of `fastdyn`), the
 error norm, step-size control, coordinate projection after every accepted step, the outputs at the
-requested times (dense output, then projection; accelerations and multipliers after the run, on
+requested times (dense output, then projection; an output at a step's end is that step's projected
+state, no dense output computed; accelerations and multipliers after the run, on
 demand: `outputs_at`) and the model's expression sensors (`_watch`: crossings located on the step's
 dense output). Python is re-entered only when a chunk of outputs is written, after a bounded amount of work
 (EVALS_PER_RETURN: Ctrl-C within a fraction of a second), when the sensor event buffer is full, at a
@@ -380,12 +381,13 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 if stats[5] >= 6:
                     stats[4] = 0
         have_F = False
-        if tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):   # outputs inside this step
+        tol_end = 1e-14 * max(1.0, abs(t_new))
+        if tout[iout] < t_new - tol_end:   # outputs inside this step (those at its end: below)
             _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
             stats[2] += 3
             have_F = True
-            while iout < tout.shape[0] and tout[iout] <= t_new + 1e-14 * max(1.0, abs(t_new)):
-                to = min(tout[iout], t_new)
+            while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
+                to = tout[iout]
                 _dense(F, y, t, h, to, yo)
                 s_ = project(cm, wk, to, yo[:nq], yo[nq:], proj_tol, False)
                 stats[3] += 1
@@ -428,6 +430,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             if not np.isfinite(y[i]):
                 st[0], st[1] = t, h
                 return NONFINITE, iout
+        while iout < tout.shape[0] and tout[iout] <= t_new + tol_end:   # outputs at the step's end: its
+            write_state(cm, wk, y, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])   # projected state,
+            iout += 1                                                    # no dense output needed
+            written += 1
         t = t_new
         h *= fac
         if s_ != OK:

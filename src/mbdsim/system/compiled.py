@@ -92,6 +92,8 @@ class CompiledModel:
     python_drivers: tuple = ()   # driver indices (into the packed driver functions) called back the same way
     input_slots: tuple = ()   # (input name, index into exprloads[14]): where the expression programs hold each
     #                           model input (Model.add_input) as a constant; mbdsim.Simulator writes them
+    driver_slots: tuple = ()  # (driver index, input or anchor name, index into consts): the constants of the
+    #                           motion drivers that read model inputs (model.input_drivers)
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -180,25 +182,36 @@ def _singular_masses(M6) -> bool:
 
 
 def _driver_programs(fns):
-    """Packed value/d1/d2 programs of every driver function, and the indices of the drivers that have
+    """Packed value/d1/d2 programs of every driver function, the indices of the drivers that have
     none (Python callables, integrals without a closed form): their programs are zeros and the kernels
-    call them back (solvers.pyloads writes their values over the programs' at every evaluation)."""
+    call them back (solvers.pyloads writes their values over the programs' at every evaluation), and
+    (driver index, input or anchor name, index into the packed constants) of each constant of a driver
+    reading model inputs (model.input_drivers; mbdsim.Simulator writes them between steps)."""
     if not fns:
         return (np.zeros((0, 2), np.int64), np.zeros(0), np.zeros(0), np.zeros(0, np.int64), np.zeros(0, np.int64),
-                4, ())
+                4, (), ())
     try:
         from . import exprvm
     except ImportError:
         raise NotCompiled("the expression compiler (system.exprvm) is not available") from None
-    progs, called = [], []
+    progs, called, slots = [], [], []
     for d, fn in enumerate(fns):
-        p = exprvm.time_programs(fn)
+        sym = getattr(fn, "symbolic", None)
+        if sym is not None:   # a driver reading model inputs: inputs and anchors as constants (written later)
+            p = []
+            for node in (sym.value, sym.d1, sym.d2):
+                found = []
+                p.append(exprloads_pack._compile(node, {"t": 0}, sym.constants, found))
+                base = sum(len(q.consts) for q in progs) + sum(len(q.consts) for q in p[:-1])
+                slots.extend((d, name, base + k) for k, name in found)
+        else:
+            p = exprvm.time_programs(fn)
         if p is None:
             called.append(d)
             p = (exprvm.constant_program(0.0),) * 3
         progs.extend(p)
     pk = exprvm.pack(progs)
-    return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size), tuple(called)
+    return pk.code, pk.consts, pk.tables, pk.start, pk.end, int(pk.stack_size), tuple(called), tuple(slots)
 
 
 def python_loads(sys) -> tuple:
@@ -305,7 +318,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         packed = sys.derived["packed"] = packing.pack_rows(sys)
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
-    code, consts, tables, start, end, stack, pyd = _driver_programs(fns)
+    code, consts, tables, start, end, stack, pyd, dslots = _driver_programs(fns)
     rows = np.asarray(rows, dtype=np.int64)
     dense = int(_singular_masses(M6[1:]))
     mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
@@ -328,7 +341,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots))
+                         tuple(input_slots), dslots)
 
 
 def _candidates(sys, topo) -> np.ndarray:
