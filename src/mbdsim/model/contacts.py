@@ -93,9 +93,12 @@ def kind_of(shape) -> str:
 
 def make_pairs(entity, shapes_i, shapes_j) -> list:
     """All (i, j) pairs on two different bodies; ModelError for an unsupported pair or none at all."""
-    pairs = []
+    pairs, seen = [], set()
     for a in shapes_i:
         for b in shapes_j:
+            if (id(b), id(a)) in seen or (id(a), id(b)) in seen:
+                continue   # a pair in both lists once only
+            seen.add((id(a), id(b)))
             if a.body is b.body:
                 if len(shapes_i) == 1 and len(shapes_j) == 1:
                     raise ModelError(entity, "shape_j", "the two shapes are on the same body")

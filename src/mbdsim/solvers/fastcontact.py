@@ -29,8 +29,8 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
-from .fastnarrow import (BOX, CAPSULE, HULL, PLANE, SPHERE, candidate, face, inside_except, n_candidates, pose,
-                         segments_closest, support_depth, to_ground)
+from .fastnarrow import (BOX, CAPSULE, HULL, PLANE, SPHERE, candidate, dir_local, face, inside_except, n_candidates,
+                         pose, segments_closest, support_depth, to_ground, to_local)
 
 RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
 NREC = 15
@@ -149,18 +149,53 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     _against(sc, pair, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec)
     if kind[xs] != BOX and kind[xs] != HULL:
         return
-    # the reference's vertices strictly inside the incident polyhedron, down to its deepest level
-    level = m0 * q0 + m1 * q1 + m2 * q2 - best
-    tol = -1e-6 * rad[xs] - 1e-12
+    # the reference's vertices inside the incident polyhedron, their depth the way out of it along -m
+    # (those where an incident vertex already pressed, e.g. two equal faces flush, are not counted twice)
+    tol = 1e-6 * rad[xs] + 1e-12
     for k in range(sv[rs, 1] - sv[rs, 0]):
         v0, v1, v2 = to_ground(Pr, verts[sv[rs, 0] + k, 0], verts[sv[rs, 0] + k, 1], verts[sv[rs, 0] + k, 2])
         if not inside_except(Px, planes, spl[xs, 0], spl[xs, 1] - spl[xs, 0], -1, v0, v1, v2, tol):
             continue
-        d = m0 * v0 + m1 * v1 + m2 * v2 - level
-        if d > 0.0:
-            h = 0.5 * d
-            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
-                   sign * m0, sign * m1, sign * m2, d)
+        d = _exit_depth(Px, planes, spl[xs, 0], spl[xs, 1], v0, v1, v2, m0, m1, m2)
+        if not d > 0.0 or _pressed(Px, Pr, verts, sv[xs, 0], sv[xs, 1], planes, spl[rs, 0], spl[rs, 1], gbest,
+                                   v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
+            continue
+        h = 0.5 * d
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
+               sign * m0, sign * m1, sign * m2, d)
+
+
+@njit(cache=True, _nrt=False)
+def _exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
+    """Distance [m] from the point v inside a polyhedron (pose P) to its surface along -m."""
+    y0, y1, y2 = to_local(P, v0, v1, v2)
+    u0, u1, u2 = dir_local(P, m0, m1, m2)
+    best = np.inf
+    for g in range(p0_, p1_):
+        nm = planes[g, 0] * u0 + planes[g, 1] * u1 + planes[g, 2] * u2
+        if nm < -1e-12:
+            t = (planes[g, 0] * y0 + planes[g, 1] * y1 + planes[g, 2] * y2 - planes[g, 3]) / nm
+            if t < best:
+                best = t
+    return best
+
+
+@njit(cache=True, _nrt=False)
+def _pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
+    """Whether an incident vertex that `_against` used (below the reference face g, inside the reference)
+    lies on the normal line through the reference vertex v (within tol [m])."""
+    for k in range(x0_, x1_):
+        u0, u1, u2 = to_ground(Px, verts[k, 0], verts[k, 1], verts[k, 2])
+        if not m0 * (q0 - u0) + m1 * (q1 - u1) + m2 * (q2 - u2) > 0.0:
+            continue
+        if not inside_except(Pr, planes, p0_, p1_ - p0_, g, u0, u1, u2, tol):
+            continue
+        e0, e1, e2 = u0 - v0, u1 - v1, u2 - v2
+        en = e0 * m0 + e1 * m1 + e2 * m2
+        e0, e1, e2 = e0 - en * m0, e1 - en * m1, e2 - en * m2
+        if e0 * e0 + e1 * e1 + e2 * e2 <= tol * tol:
+            return True
+    return False
 
 
 @njit(cache=True, _nrt=False)
