@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.contacts import ShapeContact
 from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
 from . import exprloads_pack, jointtree, packing
@@ -90,6 +91,8 @@ class CompiledModel:
     #                           solvers.pyloads from inside the kernels (Work slot 48): Python callables and
     #                           what cannot be packed here (`_called_back`)
     python_drivers: tuple = ()   # driver indices (into the packed driver functions) called back the same way
+    shape_contacts: tuple = ()   # arrays()[46]: shape contacts (geometry.pack.pack_contacts, issue 30) and an
+    #                              empty record buffer (0, NREC) with its counter (solvers.fastcontact)
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -102,7 +105,8 @@ class CompiledModel:
                 # 33, 34: the rows' vectors and parameters as `kernels.rows_kernel` takes them (33 is 14
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
-                *self.bushings, self.tree, self.exprloads, self.contacts, self.cand)
+                *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
+                self.shape_contacts or _shape_contacts(None, ()))
 
 
 @dataclass
@@ -168,6 +172,17 @@ def _contacts(sys) -> tuple:
     return (arr(0, (n, 2), np.int64), arr(1, (n,), np.int64), arr(2, (n, 2, 3)), arr(3, (n, 3)), arr(4, (n, 8)))
 
 
+def _shape_contacts(sys, skip) -> tuple:
+    """The model's shape contacts (model.contacts.ShapeContact, but those named in `skip`) for
+    `fastcontact.shape_contacts`: geometry.pack.pack_contacts plus an empty record buffer and its counter."""
+    from ..geometry.pack import empty_contacts, pack_contacts
+    from ..solvers.fastcontact import NREC
+    elems = [] if sys is None else [e for e in sys.model.forces.values()
+                                    if type(e) is ShapeContact and e.name not in skip]
+    sc = pack_contacts(sys, elems) if elems else empty_contacts()
+    return (*sc, np.zeros((0, NREC)), np.zeros(1, np.int64))
+
+
 def _singular_masses(M6) -> bool:
     """True when a body's 6x6 mass matrix (stack (n, 6, 6)) has an eigenvalue <= 1e-12 of its largest
     entry (one batched eigvalsh)."""
@@ -227,7 +242,7 @@ def _called_back(sys, mode, tree, state) -> tuple:
                 exprloads_pack.pack(sys, [e], mode, tree, state, ())
             except NotCompiled:
                 out.append(e.name)
-        elif not isinstance(e, (Force, Torque, Bushing, Contact, SpringDamper)):
+        elif not isinstance(e, (Force, Torque, Bushing, Contact, SpringDamper, ShapeContact)):
             from .force_elements import evaluator
             if not getattr(evaluator(e), "needs_lambda", False):
                 out.append(e.name)
@@ -251,8 +266,8 @@ def _loads(sys, skip=()):
             mi, mj = e.marker_i, e.marker_j
             bu.append(((sys.fid[mi.body], sys.fid[mj.body]), (mi.s_B, mj.s_B), (mi.R_BM, mj.R_BM),
                        e.stiffness, e.damping, e.preload))
-        elif type(e) is Contact:
-            continue   # packed by _contacts
+        elif type(e) is Contact or type(e) is ShapeContact:
+            continue   # packed by _contacts / _shape_contacts
         elif type(e) is SpringDamper:
             sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
@@ -324,7 +339,8 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd)
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
+                         _shape_contacts(sys, pyl))
 
 
 def _candidates(sys, topo) -> np.ndarray:
