@@ -33,20 +33,24 @@ def cam_model(w, geometry="cylinder"):
     face = fol.add_shape("face", mb.Box((0.08, 0.04, 0.02)))
     H = 0.2
     m.add_spring_damper("spring", (m.ground, (0, 0, H)), (fol, (0, 0, z0)), KS, 0.0, free_length=H - z0 + F0 / KS)
-    m.add_contact("cam", cam_shape, face, KC, 1.0, 50.0, 1e-6, mu=0.0)
+    m.add_contact("touch", cam_shape, face, KC, 1.0, 50.0, 1e-6, mu=0.0)
     return m, z0
 
 
 @pytest.mark.parametrize("geometry", ["cylinder", "convex"])
 def test_follower_lift_follows_the_eccentric_profile(geometry):
-    w = 0.7 * lift_off_speed()
+    # a polygonal cam shakes the follower at n w with accelerations of about R pi^2 w^2 / 2 (whatever n):
+    # turned slowly enough for the spring to hold the follower on it
+    w = (0.7 if geometry == "cylinder" else 0.15) * lift_off_speed()
     m, z0 = cam_model(w, geometry)
     T = 2 * np.pi / w
     res = mb.simulate(m, T, T / 100, method="dop853", rtol=1e-8)
     assert res.success
     lift = res.position("follower")[:, 2] - z0
     ref = E_CAM * (1 - np.cos(w * res.time))
-    tol = 2e-3 * E_CAM if geometry == "cylinder" else 5e-3 * E_CAM   # (a 64-gon: its radius varies 0.1 %)
+    # a 64-gon: its height varies by R (1 - cos(pi / 64)) = 0.4 % of the stroke, and each corner passing under
+    # the follower kicks it (a jump of the profile's slope, 0.02 m/s) into a small bounce
+    tol = 2e-3 * E_CAM if geometry == "cylinder" else 2e-2 * E_CAM
     assert np.max(np.abs(lift - ref)) < tol, np.max(np.abs(lift - ref)) / E_CAM
 
 
