@@ -51,7 +51,7 @@ class Capsule:
         rho, r, L = _density("capsule", density), self.radius, self.length
         mc, mh = rho * np.pi * r * r * L, rho * 2.0 / 3.0 * np.pi * r ** 3
         i_ax = 0.5 * mc * r * r + 2 * 0.4 * mh * r * r
-        i_tr = mc * (3 * r * r + L * L) / 12.0 + 2 * mh * (0.4 * r * r + 0.5 * L * L + 0.375 * L * r)
+        i_tr = mc * (3 * r * r + L * L) / 12.0 + 2 * mh * (0.4 * r * r + 0.25 * L * L + 0.375 * L * r)
         R = axis_frame(self.axis)
         return float(mc + 2 * mh), R @ np.diag([i_tr, i_tr, i_ax]) @ R.T
 
