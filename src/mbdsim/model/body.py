@@ -11,7 +11,10 @@ from ._check import inertia_matrix, scalar, vec3
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from typing import Any
+
     from .._types import Orientation, Vector
+    from ..geometry.shape import Shape
 
 
 @dataclass(eq=False)
@@ -61,8 +64,8 @@ class Body:
     angular_velocity_given: bool = False
     shapes: dict = field(default_factory=dict)
 
-    def add_shape(self, name: str, geometry, center: Vector | None = None, orientation: Orientation = None,
-                  density: float | None = None):
+    def add_shape(self, name: str, geometry: Any, center: Vector | None = None, orientation: Orientation = None,
+                  density: float | None = None) -> Shape:
         """Place `geometry` (mb.Box, mb.Cylinder, mb.Capsule, mb.Ellipsoid, mb.Sphere(radius=...),
         mb.ConvexMesh, mb.Mesh) on this body: its origin at `center` [m] and its axes `orientation`
         (geometry -> ground), both in ground at t=0 (defaults: the body's centre of mass and axes).

@@ -391,7 +391,7 @@ class Result:
         from .energy import dissipated_energy
         return dissipated_energy(self)
 
-    def contact_points(self, contact: str | Any):
+    def contact_points(self, contact: str | Any) -> pd.DataFrame:
         """Shape contact per point (DataFrame: time, pair, shapes, point, normal, penetration, forces, slip)."""
         from .contacts import contact_points
         return contact_points(self, contact)
