@@ -21,7 +21,8 @@ _LAZY = {
     "Body": ".model", "Force": ".model", "Joint": ".model", "Marker": ".model", "Model": ".model",
     "Motion": ".model", "SpringDamper": ".model", "Torque": ".model",
     "Curve": ".model.curves", "Spline": ".model.curves", "Plane": ".model.shapes", "Sphere": ".model.shapes",
-    "Box": ".model.shapes", "Cylinder": ".model.shapes", "load_model": ".io", "save_model": ".io",
+    "Box": ".model.shapes", "Cylinder": ".model.shapes", "Capsule": ".geometry", "Ellipsoid": ".geometry",
+    "ConvexMesh": ".geometry", "Mesh": ".geometry", "load_model": ".io", "save_model": ".io",
     "Result": ".results",
     "AssemblyReport": ".solvers.assembly", "RedundantConstraintWarning": ".solvers.assembly",
     "InitialConditionWarning": ".solvers.assembly", "SingularConfigurationWarning": ".solvers.kinematic",
@@ -56,7 +57,8 @@ __version__ = "0.1.0"
 
 __all__ = [
     "Model", "Body", "Marker", "Joint", "Motion", "Force", "Torque", "SpringDamper", "Result",
-    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "load_model", "save_model", "from_adm",
+    "Curve", "Spline", "Sphere", "Plane", "Box", "Cylinder", "Capsule", "Ellipsoid", "ConvexMesh", "Mesh",
+    "load_model", "save_model", "from_adm",
     "simulate", "kinematics", "assemble", "equilibrium", "AssemblyReport",
     "quasi_static", "linearize", "Linearization", "UnstableEquilibriumWarning",
     "MbdsimError", "ModelError", "ModelFileError", "AssemblyError", "SolverError", "EvaluationError",

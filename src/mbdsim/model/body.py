@@ -11,7 +11,10 @@ from ._check import inertia_matrix, scalar, vec3
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from typing import Any
+
     from .._types import Orientation, Vector
+    from ..geometry.shape import Shape
 
 
 @dataclass(eq=False)
@@ -59,6 +62,19 @@ class Body:
     markers: dict = field(default_factory=dict)
     velocity_given: bool = False
     angular_velocity_given: bool = False
+    shapes: dict = field(default_factory=dict)
+
+    def add_shape(self, name: str, geometry: Any, center: Vector | None = None, orientation: Orientation = None,
+                  density: float | None = None) -> Shape:
+        """Place `geometry` (mb.Box, mb.Cylinder, mb.Capsule, mb.Ellipsoid, mb.Sphere(radius=...),
+        mb.ConvexMesh, mb.Mesh) on this body: its origin at `center` [m] and its axes `orientation`
+        (geometry -> ground), both in ground at t=0 (defaults: the body's centre of mass and axes).
+        Returns the mbdsim.geometry.Shape, usable by Model.add_contact and drawn by the viewer.  With
+        `density` [kg/m^3] the solid's mass [kg] and inertia about the body's centre of mass [kg m^2]
+        (parallel-axis term included) are added to the body's (the body's position stays its centre of
+        mass: place shapes with a density so that their centroid is there)."""
+        from ..geometry.shape import add_shape
+        return add_shape(self, name, geometry, center, orientation, density)
 
     def add_marker(self, name: str, point: Vector | None = None, orientation: Orientation = None) -> Marker:
         """Add a frame fixed on this body; point [m] and orientation (marker->ground) in ground at t=0."""

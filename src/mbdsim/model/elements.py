@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import ModelError
 from ._check import scalar, vector
 from .element_specs import Bushing, Contact, Stop, TorsionSpring
-from .shapes import attach
+from .shapes import AttachedShape, attach
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -58,24 +58,48 @@ class ForceElementsMixin:
         return self.add_element(Bushing(name, mi, mj, k, c, _six(entity, "preload", preload)))
 
     def add_contact(self, name: str, shape_i: Any, shape_j: Any, stiffness: float, exponent: float, damping: float,
-                    penetration: float, mu: float = 0.0, friction_velocity: float = 1e-3) -> Contact:
-        """Compliant contact between an mb.Sphere and an mb.Plane or two spheres (Adams IMPACT law).
+                    penetration: float, mu: float = 0.0, friction_velocity: float = 1e-3, *,
+                    restitution: float | None = None, mu_static: float | None = None,
+                    mu_dynamic: float | None = None, stiction_velocity: float | None = None,
+                    transition_velocity: float | None = None) -> Any:
+        """Compliant contact between shapes (Adams IMPACT law, or POISSON with `restitution`).
 
+        shape_i, shape_j: a shape of Body.add_shape (box, cylinder, capsule, ellipsoid, sphere, convex or
+        triangle mesh), an mb.Sphere(body, radius, center) or an mb.Plane(body, point, normal), or a list of
+        them on either side (every pair between the lists on two different bodies; the broad phase prunes).
         stiffness k [N/m^e] >= 0, exponent e > 0, damping c_max [N s/m] >= 0 reached at `penetration`
-        d [m] > 0, Coulomb coefficient mu >= 0 regularised below `friction_velocity` [m/s] > 0."""
+        d [m] > 0, applied at each contact point; `restitution` (0..1): the POISSON law instead of the
+        damping (a mass leaves a contact with restitution times its approach speed).  Friction: Coulomb
+        `mu` >= 0 regularised below `friction_velocity` [m/s] > 0, or Adams' `mu_static`, `mu_dynamic`
+        with `stiction_velocity` (default 1e-4 m/s) and `transition_velocity` [m/s] (default 10 times it).
+        A sphere-sphere or sphere-plane pair without the new options stays the exact issue-3 Contact;
+        anything else is a ShapeContact (model.contacts, solvers.fastcontact)."""
+        from .contacts import ShapeContact, friction_options, make_pairs, shape_list
         entity = f"contact '{name}'"
-        si = self._shape(entity, "shape_i", shape_i)
-        sj = self._shape(entity, "shape_j", shape_j)
-        if si.body is sj.body:
-            raise ModelError(entity, "shape_j", "the two shapes are on the same body")
-        if si.kind == "plane" and sj.kind == "plane":
-            raise ModelError(entity, "shape_j", "plane-plane contact is not supported (use a sphere)")
-        spec = Contact(name, si, sj, scalar(entity, "stiffness", stiffness, minimum=0.0),
-                       scalar(entity, "exponent", exponent, minimum=0.0, strict=True),
-                       scalar(entity, "damping", damping, minimum=0.0),
-                       scalar(entity, "penetration", penetration, minimum=0.0, strict=True),
-                       scalar(entity, "mu", mu, minimum=0.0),
-                       scalar(entity, "friction_velocity", friction_velocity, minimum=0.0, strict=True))
+        lists = isinstance(shape_i, (list, tuple)) or isinstance(shape_j, (list, tuple))
+        si = [self._shape(entity, "shape_i", s) for s in shape_list(entity, "shape_i", shape_i)]
+        sj = [self._shape(entity, "shape_j", s) for s in shape_list(entity, "shape_j", shape_j)]
+        if not si or not sj:
+            raise ModelError(entity, "shape_i" if not si else "shape_j", "the list of shapes is empty")
+        law = (scalar(entity, "stiffness", stiffness, minimum=0.0),
+               scalar(entity, "exponent", exponent, minimum=0.0, strict=True),
+               scalar(entity, "damping", damping, minimum=0.0),
+               scalar(entity, "penetration", penetration, minimum=0.0, strict=True),
+               scalar(entity, "mu", mu, minimum=0.0),
+               scalar(entity, "friction_velocity", friction_velocity, minimum=0.0, strict=True))
+        eps = None if restitution is None else scalar(entity, "restitution", restitution, minimum=0.0)
+        if eps is not None and eps > 1.0:
+            raise ModelError(entity, "restitution", f"must be between 0 and 1, got {restitution!r}")
+        fr = friction_options(entity, law[4], law[5], mu_static, mu_dynamic, stiction_velocity, transition_velocity)
+        legacy = not lists and eps is None and fr[0] is None and all(isinstance(s, AttachedShape) for s in si + sj)
+        if legacy:
+            a, b = si[0], sj[0]
+            if a.body is b.body:
+                raise ModelError(entity, "shape_j", "the two shapes are on the same body")
+            if a.kind == "plane" and b.kind == "plane":
+                raise ModelError(entity, "shape_j", "plane-plane contact is not supported (use a sphere)")
+            return self.add_element(Contact(name, a, b, *law))
+        spec = ShapeContact(name, make_pairs(entity, si, sj), *law, eps, *fr, shapes_i=si, shapes_j=sj)
         return self.add_element(spec)
 
     def add_stop(self, name: str, joint: JointRef, lower: float | None = None, upper: float | None = None,
@@ -127,12 +151,15 @@ class ForceElementsMixin:
         return dof
 
     def _shape(self, entity, field, shape):
+        from ..geometry.shape import Shape
         body = self._lookup(getattr(shape, "body", None), self.bodies, entity, field) \
-            if hasattr(shape, "body") else None
+            if getattr(shape, "body", None) is not None else None
         if body is None:
-            raise ModelError(entity, field, f"expected mb.Sphere or mb.Plane, got {shape!r}")
+            raise ModelError(entity, field, "expected a shape of Body.add_shape, an mb.Sphere(body, radius) or "
+                             f"an mb.Plane, got {shape!r}")
+        if isinstance(shape, Shape):
+            return shape
         return attach(entity, field, shape, body)
-
 
 def _six(entity, field, values, minimum=None) -> np.ndarray:
     a = vector(entity, field, values, 6, " (x, y, z, rx, ry, rz)")

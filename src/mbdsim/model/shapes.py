@@ -21,14 +21,22 @@ if TYPE_CHECKING:
 @dataclass(eq=False, init=False)
 class Sphere:
     """A sphere of `radius` [m] fixed on `body` (a Body, particle or body name), centre `center` [m]
-    in ground at t=0 (default: the body's centre of mass)."""
+    in ground at t=0 (default: the body's centre of mass).  `mb.Sphere(radius=r)` (no body) is a geometry
+    centred on its origin, placed with `Body.add_shape`."""
 
     body: Any
     radius: float
     center: np.ndarray | None
 
-    def __init__(self, body, radius, center=None):
-        entity = f"sphere on {getattr(body, 'name', body)!r}"
+    def __init__(self, body=None, radius=None, center=None):
+        if radius is None and body is not None and not isinstance(body, (str,)) and not hasattr(body, "name"):
+            body, radius = None, body   # mb.Sphere(0.1): the geometry of radius 0.1
+        entity = "sphere" if body is None else f"sphere on {getattr(body, 'name', body)!r}"
+        if radius is None:
+            raise ModelError(entity, "radius", "is required")
+        if body is None and center is not None:
+            raise ModelError(entity, "center", "a sphere geometry is centred on its origin: place it with "
+                             "Body.add_shape(name, mb.Sphere(radius=r), center=...)")
         self.body = body
         self.radius = scalar(entity, "radius", radius, minimum=0.0, strict=True)
         self.center = None if center is None else vec3(entity, "center", center)
@@ -39,6 +47,8 @@ class Sphere:
         return float(m), np.eye(3) * (0.4 * m * self.radius ** 2)
 
     def __repr__(self) -> str:
+        if self.body is None:
+            return f"Sphere(radius={self.radius:g})"
         return f"Sphere({getattr(self.body, 'name', self.body)!r}, r={self.radius:g})"
 
 
@@ -72,19 +82,27 @@ class Cylinder:
     axis: str
 
     def __init__(self, radius, length, axis="z"):
+        from ..geometry.primitives import axis_vector
         self.radius = scalar("cylinder", "radius", radius, minimum=0.0, strict=True)
         self.length = scalar("cylinder", "length", length, minimum=0.0, strict=True)
-        if axis not in ("x", "y", "z"):
-            raise ModelError("cylinder", "axis", f"must be 'x', 'y' or 'z', got {axis!r}")
-        self.axis = axis
+        axis_vector("cylinder", axis)   # "x", "y", "z" or a 3-vector
+        self.axis = axis if isinstance(axis, str) else tuple(float(x) for x in np.asarray(axis, float) /
+                                                              np.linalg.norm(np.asarray(axis, float)))
+
+    @property
+    def axis_vector(self) -> np.ndarray:
+        """The unit axis in the geometry's (body's) axes."""
+        from ..geometry.primitives import axis_vector
+        return axis_vector("cylinder", self.axis)
 
     def mass_properties(self, density: float) -> tuple[float, Array]:
         """(mass [kg], inertia about the centre in body axes 3x3 [kg m^2]) for `density` [kg/m^3]."""
+        from ..geometry.primitives import axis_frame
         r, L = self.radius, self.length
         m = _density(self, density) * np.pi * r * r * L
-        d = np.full(3, m * (3 * r * r + L * L) / 12.0)
-        d["xyz".index(self.axis)] = 0.5 * m * r * r
-        return float(m), np.diag(d)
+        i_tr = m * (3 * r * r + L * L) / 12.0
+        R = axis_frame(self.axis_vector)
+        return float(m), R @ np.diag([i_tr, i_tr, 0.5 * m * r * r]) @ R.T
 
     def __repr__(self) -> str:
         return f"Cylinder(radius={self.radius:g}, length={self.length:g}, axis={self.axis!r})"

@@ -26,7 +26,9 @@ drivers         "<motion>.effort [N m]" (rotation) or "[N]" (translation), Resul
 force elements  "<element>.force [N]" (spring-damper, translational stop, contact: Result.spring_force;
                 translational joint friction) or "<element>.torque [N m]" (torsion spring, rotational
                 stop, revolute joint friction); bushings "<element>.Fx [N]" ... "<element>.Tz [N m]", the
-                load on marker_j's body in marker_i axes.  Applied forces and torques are inputs and
+                load on marker_j's body in marker_i axes; shape contacts "<element>.Fx [N]" .Fy .Fz,
+                ".points [-]", ".penetration [m]", ".slip_velocity [m/s]" (results.contacts).  Applied
+                forces and torques are inputs and
                 are not repeated.
 """
 from __future__ import annotations
@@ -125,6 +127,10 @@ def _element_columns(res, el):
             return {}
         torque = el.joint.kind == "revolute"
         return {f"{name}.{'torque [N m]' if torque else 'force [N]'}": res.friction_force(el)}
+    from ..model.contacts import ShapeContact
+    if isinstance(el, ShapeContact):
+        from .contacts import contact_columns
+        return contact_columns(res, el)
     try:
         ev = evaluator(el)
     except TypeError:

@@ -391,6 +391,16 @@ class Result:
         from .energy import dissipated_energy
         return dissipated_energy(self)
 
+    def contact_points(self, contact: str | Any) -> pd.DataFrame:
+        """Shape contact per point (DataFrame: time, pair, shapes, point, normal, penetration, forces, slip)."""
+        from .contacts import contact_points
+        return contact_points(self, contact)
+
+    def contact_force(self, contact: str | Any) -> Array:
+        """Total shape-contact force [N] on the shape_j side, ground axes, (N, 3)."""
+        from .contacts import contact_force
+        return contact_force(self, contact)
+
     def friction_force(self, friction: str | Any) -> Array:
         """Joint friction force [N] (translational) or torque [N m] (revolute) on body_j along / about the
         joint axis, (N,); it opposes the joint's motion (or the impending motion while sticking)."""

@@ -23,6 +23,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
         return 0.0
 from ..system.exprloads_kernel import expr_loads
 from ..system.kernels import frames_into, quat_step, rows_kernel
+from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
@@ -61,7 +62,7 @@ def _python_drivers(ctl, t):
 def loads_into(cm, wk, t, y, r, A, rd, w, F):
     """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings, the
     loads written as expressions (system.exprloads_kernel; at time t [s], y: the joint-coordinate state on
-    the tree path), contacts and the loads written as Python callables (the callback of solvers.pyloads,
+    the tree path), contacts, shape contacts (solvers.fastcontact) and the loads written as Python callables (the callback of solvers.pyloads,
     reading the frames r, A, rd, w, which must be the work arrays wk[0:4]) into F."""
     loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
                  cm[29], r, A, rd, w, F)
@@ -73,6 +74,9 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
     if cm[44][0].shape[0]:
         ct = cm[44]
         contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F)
+    if cm[46][10].shape[0]:   # shape contacts (issue 30)
+        sc = cm[46]
+        shape_contacts(sc, r, A, rd, w, cm[6], F, sc[12], sc[13])
     if wk[48][1][0] != 0:   # loads written as Python callables (solvers.pyloads), from the frames in wk
         _python_loads(wk[48][0], wk[48][1], t, F)
 

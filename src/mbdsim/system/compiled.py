@@ -12,6 +12,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from ..model.contacts import ShapeContact
 from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
 from . import exprloads_pack, jointtree, packing
@@ -94,6 +95,8 @@ class CompiledModel:
     #                           model input (Model.add_input) as a constant; mbdsim.Simulator writes them
     driver_slots: tuple = ()  # (driver index, input or anchor name, index into consts): the constants of the
     #                           motion drivers that read model inputs (model.input_drivers)
+    shape_contacts: tuple = ()   # arrays()[46]: shape contacts (geometry.pack.pack_contacts, issue 30) and an
+    #                              empty record buffer (0, NREC) with its counter (solvers.fastcontact)
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -106,7 +109,8 @@ class CompiledModel:
                 # 33, 34: the rows' vectors and parameters as `kernels.rows_kernel` takes them (33 is 14
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
-                *self.bushings, self.tree, self.exprloads, self.contacts, self.cand)
+                *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
+                self.shape_contacts or _shape_contacts(None, ()))
 
 
 @dataclass
@@ -170,6 +174,17 @@ def _contacts(sys) -> tuple:
     n = len(rows)
     arr = lambda k, shape, dt=float: np.array([r[k] for r in rows], dtype=dt).reshape(shape)  # noqa: E731
     return (arr(0, (n, 2), np.int64), arr(1, (n,), np.int64), arr(2, (n, 2, 3)), arr(3, (n, 3)), arr(4, (n, 8)))
+
+
+def _shape_contacts(sys, skip) -> tuple:
+    """The model's shape contacts (model.contacts.ShapeContact, but those named in `skip`) for
+    `fastcontact.shape_contacts`: geometry.pack.pack_contacts plus an empty record buffer and its counter."""
+    from ..geometry.pack import empty_contacts, pack_contacts
+    from ..solvers.fastcontact import NREC
+    elems = [] if sys is None else [e for e in sys.model.forces.values()
+                                    if type(e) is ShapeContact and e.name not in skip]
+    sc = pack_contacts(sys, elems) if elems else empty_contacts()
+    return (*sc, np.zeros((0, NREC)), np.zeros(1, np.int64))
 
 
 def _singular_masses(M6) -> bool:
@@ -242,7 +257,7 @@ def _called_back(sys, mode, tree, state) -> tuple:
                 exprloads_pack.pack(sys, [e], mode, tree, state, ())
             except NotCompiled:
                 out.append(e.name)
-        elif not isinstance(e, (Force, Torque, Bushing, Contact, SpringDamper)):
+        elif not isinstance(e, (Force, Torque, Bushing, Contact, SpringDamper, ShapeContact)):
             from .force_elements import evaluator
             if not getattr(evaluator(e), "needs_lambda", False):
                 out.append(e.name)
@@ -266,8 +281,8 @@ def _loads(sys, skip=()):
             mi, mj = e.marker_i, e.marker_j
             bu.append(((sys.fid[mi.body], sys.fid[mj.body]), (mi.s_B, mj.s_B), (mi.R_BM, mj.R_BM),
                        e.stiffness, e.damping, e.preload))
-        elif type(e) is Contact:
-            continue   # packed by _contacts
+        elif type(e) is Contact or type(e) is ShapeContact:
+            continue   # packed by _contacts / _shape_contacts
         elif type(e) is SpringDamper:
             sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
@@ -341,7 +356,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots), dslots)
+                         tuple(input_slots), dslots, _shape_contacts(sys, pyl))
 
 
 def _candidates(sys, topo) -> np.ndarray:

@@ -106,6 +106,10 @@ def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int 
                              "pos": _r(pos[b.name]), "quat": _r(quat)})
     scene.joints = [_joint(j, index) for j in model.joints.values()]
     scene.springs, scene.shapes = _elements(model, index)
+    from ..geometry.visual import body_meshes   # shapes placed with Body.add_shape (issue 30)
+    for b in system.bodies:
+        for d in body_meshes(b):
+            scene.shapes.append({**d, "body": _on(b, index)})
     if signal is not None:
         scene.signal = _signal(sub, signal)
     return scene

@@ -27,4 +27,4 @@ def evaluator(elem):
     raise TypeError(f"no evaluator for force element {elem!r}")
 
 
-from . import bushing, contact, exprloads, stop, torsion  # noqa: E402,F401  (evaluators register themselves)
+from . import bushing, contact, exprloads, shape_contact, stop, torsion  # noqa: E402,F401  (evaluators register themselves)

@@ -70,7 +70,13 @@ for (const j of data.joints) {
 
 for (const sh of data.shapes) {
   let mesh;
-  if (sh.kind === 'sphere') {
+  if (sh.kind === 'mesh') {   // a shape placed with Body.add_shape, tessellated in body axes
+    const geo = new THREE.BufferGeometry();
+    geo.setAttribute('position', new THREE.Float32BufferAttribute(sh.vertices, 3));
+    geo.setIndex(sh.faces);
+    geo.computeVertexNormals();
+    mesh = new THREE.Mesh(geo, material(0xb08d57, { transparent: true, opacity: 0.85, side: THREE.DoubleSide }));
+  } else if (sh.kind === 'sphere') {
     mesh = new THREE.Mesh(new THREE.SphereGeometry(sh.radius, 24, 12),
       new THREE.MeshBasicMaterial({ color: 0x333333, wireframe: true, transparent: true, opacity: 0.25 }));
   } else {

@@ -1,0 +1,249 @@
+"""Compiled shape contact (issue 30): broad phase, narrow phase per pair and the contact law at each point.
+
+`shape_contacts(sc, r, A, rd, w, rigid, F, rec, nrec)` adds the contact loads of every shape pair of the
+packed tuple `sc` (geometry.pack.pack_contacts) into F (nf, 6): force [N] in ground axes, torque [N m]
+about the CM in body axes, from the frames r, A, rd, w (w in ground axes).  With rec (m, NREC) of m > 0
+rows it also records each contact point (see REC_FIELDS; nrec[0] counts them); the step loop passes an
+empty rec.
+
+Broad phase: bounding spheres (a plane: the signed distance of the other shape's bounding sphere), so a
+pair far apart costs a few flops.  Narrow phase (solvers.fastnarrow): against a plane, the candidate points
+of the shape; spheres and capsules by the closest points of their segments; against a box or convex hull,
+the separating-axis test over the polyhedra's face normals picks the reference face of least penetration,
+whose normal is the contact normal of every point: the incident shape's candidate points below it and
+inside the reference (vertices, rim points, ...) and, between two polyhedra, the reference's vertices
+inside the incident one.  Face and line contacts so get several points and the right moments.
+
+Law at each point (depth delta > 0 [m], normal n from shape_i towards shape_j, gap rate gd = n . v_rel):
+IMPACT  Fn = max(0, k delta^e - STEP(delta, 0, 0, d, c_max) gd), or with a coefficient of restitution eps
+(POISSON) Fn = k delta^e (1 - (1 - eps^2) STEP(gd, 0, 0, RESTITUTION_VELOCITY, 1)): the unloading branch
+returns eps^2 of the work of the loading one, so a mass leaves with eps times its approach speed.
+Friction -mu(s) Fn t / s (t: tangential slip velocity, s = |t|): mode 0 (mu, friction_velocity vs)
+mu(s) = mu s / sqrt(s^2 + vs^2); mode 1 (Adams) mu = STEP(s, -vs, -mu_s, vs, mu_s) below the stiction
+velocity vs, STEP(s, vs, mu_s, vt, mu_d) up to the transition velocity vt, mu_d above.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from ..system.exprloads_kernel import _cross, _force as _point_force
+from .fastnarrow import (BOX, CAPSULE, HULL, PLANE, SPHERE, candidate, dir_local, face, inside_except, n_candidates,
+                         pose, segments_closest, support_depth, to_ground, to_local)
+
+RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
+NREC = 15
+REC_FIELDS = ("pair", "x", "y", "z", "nx", "ny", "nz", "penetration", "normal_force", "friction_x",
+              "friction_y", "friction_z", "slip_velocity", "gap_rate", "element")
+PAR_FIELDS = ("stiffness", "exponent", "damping", "penetration", "restitution", "friction_mode", "mu_static",
+              "mu_dynamic", "stiction_velocity", "transition_velocity", "element")
+
+
+@njit(cache=True, _nrt=False)
+def _step(x, x0, h0, x1, h1):
+    """Adams STEP: cubic from h0 at x0 to h1 at x1, constant outside."""
+    if x <= x0:
+        return h0
+    if x >= x1:
+        return h1
+    u = (x - x0) / (x1 - x0)
+    return h0 + (h1 - h0) * u * u * (3.0 - 2.0 * u)
+
+
+@njit(cache=True, _nrt=False)
+def friction_coefficient(s, mode, mu_s, mu_d, vs, vt):
+    """mu(s) of the slip speed s [m/s] >= 0 (module docstring)."""
+    if mode == 0:
+        return mu_s * s / np.sqrt(s * s + vs * vs)
+    if s <= vs:
+        return _step(s, -vs, -mu_s, vs, mu_s)
+    if s <= vt:
+        return _step(s, vs, mu_s, vt, mu_d)
+    return mu_d
+
+
+@njit(cache=True, _nrt=False)
+def normal_force(delta, gd, k, ex, cmax, dpen, eps):
+    """Normal force [N] >= 0 at depth delta > 0 [m] and gap rate gd [m/s] (module docstring)."""
+    if eps < 0.0:
+        u = min(delta / dpen, 1.0)
+        return max(k * delta ** ex - cmax * u * u * (3.0 - 2.0 * u) * gd, 0.0)
+    return k * delta ** ex * (1.0 - (1.0 - eps * eps) * _step(gd, 0.0, 0.0, RESTITUTION_VELOCITY, 1.0))
+
+
+@njit(cache=True, _nrt=False)
+def _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, delta):
+    """The contact law at the point p [m] (normal n from shape_i towards shape_j, depth delta [m]): the force
+    on shape_j's frame at p and its opposite on shape_i's."""
+    pr, pp, sh_f = sc[10], sc[11], sc[0]
+    fi, fj = sh_f[pr[pair, 0]], sh_f[pr[pair, 1]]
+    x0, x1, x2 = _cross(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
+    y0, y1, y2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
+    v0 = rd[fj, 0] + x0 - rd[fi, 0] - y0
+    v1 = rd[fj, 1] + x1 - rd[fi, 1] - y1
+    v2 = rd[fj, 2] + x2 - rd[fi, 2] - y2
+    gd = n0 * v0 + n1 * v1 + n2 * v2
+    Fn = normal_force(delta, gd, pp[pair, 0], pp[pair, 1], pp[pair, 2], pp[pair, 3], pp[pair, 4])
+    t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2
+    s = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+    c = 0.0
+    if pp[pair, 6] > 0.0 or pp[pair, 7] > 0.0:
+        mode = int(pp[pair, 5])
+        if mode == 0:
+            c = pp[pair, 6] * Fn / np.sqrt(s * s + pp[pair, 8] * pp[pair, 8])
+        elif s > 0.0:
+            c = friction_coefficient(s, mode, pp[pair, 6], pp[pair, 7], pp[pair, 8], pp[pair, 9]) * Fn / s
+    G0, G1, G2 = Fn * n0 - c * t0, Fn * n1 - c * t1, Fn * n2 - c * t2
+    _point_force(F, A, fj, p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2], G0, G1, G2, rigid)
+    _point_force(F, A, fi, p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2], -G0, -G1, -G2, rigid)
+    k = nrec[0]
+    if k < rec.shape[0]:
+        vals = (float(pair), p0, p1, p2, n0, n1, n2, delta, Fn, -c * t0, -c * t1, -c * t2, s, gd, pp[pair, 10])
+        for j in range(NREC):
+            rec[k, j] = vals[j]
+        nrec[0] = k + 1
+
+
+@njit(cache=True, _nrt=False)
+def _against(sc, pair, x, ref, g, P, Q, q0, q1, q2, m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec):
+    """Candidate points of shape x (pose P) below the plane (q, outward normal m) of shape `ref` (pose Q;
+    face g of a polyhedron, whose other faces then bound the points; g < 0: a plane); n = sign m."""
+    kind, prm, sv, verts = sc[1], sc[4], sc[6], sc[7]
+    spl, planes, rad = sc[8], sc[9], sc[5]
+    tol = 1e-6 * rad[ref] + 1e-12 if g >= 0 else 0.0
+    for k in range(n_candidates(kind[x], sv[x, 1] - sv[x, 0])):
+        c0, c1, c2 = candidate(kind[x], P, prm[x], verts, sv[x, 0], m0, m1, m2, k)
+        d = m0 * (q0 - c0) + m1 * (q1 - c1) + m2 * (q2 - c2)
+        if not d > 0.0:
+            continue
+        if g >= 0 and not inside_except(Q, planes, spl[ref, 0], spl[ref, 1] - spl[ref, 0], g, c0, c1, c2, tol):
+            continue
+        h = 0.5 * d
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, c0 + h * m0, c1 + h * m1, c2 + h * m2,
+               sign * m0, sign * m1, sign * m2, d)
+
+
+@njit(cache=True, _nrt=False)
+def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+    """Shape a against shape b, at least one of them a box or convex hull: separating axes over the face
+    normals of the polyhedra, then the points of the least-penetration reference face (module docstring)."""
+    kind, prm, sv, verts, spl, planes, rad = sc[1], sc[4], sc[6], sc[7], sc[8], sc[9], sc[5]
+    best, ref, gbest = np.inf, -1, -1
+    for side in range(2):
+        rs, xs = (b, a) if side == 0 else (a, b)
+        if kind[rs] != BOX and kind[rs] != HULL:
+            continue
+        Pr, Px = (Pb, Pa) if side == 0 else (Pa, Pb)
+        for g in range(spl[rs, 1] - spl[rs, 0]):
+            q0, q1, q2, m0, m1, m2 = face(Pr, planes, spl[rs, 0], g)
+            D = support_depth(kind[xs], Px, prm[xs], verts, sv[xs, 0], sv[xs, 1] - sv[xs, 0], q0, q1, q2, m0, m1, m2)
+            if D < best:
+                best, ref, gbest = D, rs, g
+            if not D > 0.0:
+                return   # a separating face: no contact
+    rs, xs = (b, a) if ref == b else (a, b)
+    Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
+    sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
+    q0, q1, q2, m0, m1, m2 = face(Pr, planes, spl[rs, 0], gbest)
+    _against(sc, pair, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec)
+    if kind[xs] != BOX and kind[xs] != HULL:
+        return
+    # the reference's vertices inside the incident polyhedron, their depth the way out of it along -m
+    # (those where an incident vertex already pressed, e.g. two equal faces flush, are not counted twice)
+    tol = 1e-6 * rad[xs] + 1e-12
+    for k in range(sv[rs, 1] - sv[rs, 0]):
+        v0, v1, v2 = to_ground(Pr, verts[sv[rs, 0] + k, 0], verts[sv[rs, 0] + k, 1], verts[sv[rs, 0] + k, 2])
+        if not inside_except(Px, planes, spl[xs, 0], spl[xs, 1] - spl[xs, 0], -1, v0, v1, v2, tol):
+            continue
+        d = _exit_depth(Px, planes, spl[xs, 0], spl[xs, 1], v0, v1, v2, m0, m1, m2)
+        if not d > 0.0 or _pressed(Px, Pr, verts, sv[xs, 0], sv[xs, 1], planes, spl[rs, 0], spl[rs, 1], gbest,
+                                   v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
+            continue
+        h = 0.5 * d
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
+               sign * m0, sign * m1, sign * m2, d)
+
+
+@njit(cache=True, _nrt=False)
+def _exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
+    """Distance [m] from the point v inside a polyhedron (pose P) to its surface along -m."""
+    y0, y1, y2 = to_local(P, v0, v1, v2)
+    u0, u1, u2 = dir_local(P, m0, m1, m2)
+    best = np.inf
+    for g in range(p0_, p1_):
+        nm = planes[g, 0] * u0 + planes[g, 1] * u1 + planes[g, 2] * u2
+        if nm < -1e-12:
+            t = (planes[g, 0] * y0 + planes[g, 1] * y1 + planes[g, 2] * y2 - planes[g, 3]) / nm
+            if t < best:
+                best = t
+    return best
+
+
+@njit(cache=True, _nrt=False)
+def _pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
+    """Whether an incident vertex that `_against` used (below the reference face g, inside the reference)
+    lies on the normal line through the reference vertex v (within tol [m])."""
+    for k in range(x0_, x1_):
+        u0, u1, u2 = to_ground(Px, verts[k, 0], verts[k, 1], verts[k, 2])
+        if not m0 * (q0 - u0) + m1 * (q1 - u1) + m2 * (q2 - u2) > 0.0:
+            continue
+        if not inside_except(Pr, planes, p0_, p1_ - p0_, g, u0, u1, u2, tol):
+            continue
+        e0, e1, e2 = u0 - v0, u1 - v1, u2 - v2
+        en = e0 * m0 + e1 * m1 + e2 * m2
+        e0, e1, e2 = e0 - en * m0, e1 - en * m1, e2 - en * m2
+        if e0 * e0 + e1 * e1 + e2 * e2 <= tol * tol:
+            return True
+    return False
+
+
+@njit(cache=True, _nrt=False)
+def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+    """Spheres and capsules: the closest points of their segments, then as two spheres."""
+    kind, prm = sc[1], sc[4]
+    ha = prm[a, 1] if kind[a] == CAPSULE else 0.0
+    hb = prm[b, 1] if kind[b] == CAPSULE else 0.0
+    a0, a1, a2 = to_ground(Pa, 0.0, 0.0, -ha)
+    b0, b1, b2 = to_ground(Pa, 0.0, 0.0, ha)
+    c0, c1, c2 = to_ground(Pb, 0.0, 0.0, -hb)
+    e0, e1, e2 = to_ground(Pb, 0.0, 0.0, hb)
+    X, Y = segments_closest(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2)
+    d0, d1, d2 = Y[0] - X[0], Y[1] - X[1], Y[2] - X[2]
+    L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    g = L - prm[a, 0] - prm[b, 0]
+    if not g < 0.0:
+        return
+    inv = 1.0 / L if L > 0.0 else 0.0
+    n0, n1, n2 = d0 * inv, d1 * inv, d2 * inv
+    if L == 0.0:
+        n2 = 1.0
+    h = prm[a, 0] + 0.5 * g
+    _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, X[0] + h * n0, X[1] + h * n1, X[2] + h * n2,
+           n0, n1, n2, -g)
+
+
+@njit(cache=True, _nrt=False)
+def shape_contacts(sc, r, A, rd, w, rigid, F, rec, nrec):
+    """Contact loads of every packed shape pair into F (module docstring); records into rec while it has room."""
+    sh_f, kind, sh_c, sh_R, rad, pr = sc[0], sc[1], sc[2], sc[3], sc[5], sc[10]
+    for pair in range(pr.shape[0]):
+        a, b = pr[pair, 0], pr[pair, 1]
+        Pa = pose(r, A, sh_f[a], sh_c[a], sh_R[a])
+        Pb = pose(r, A, sh_f[b], sh_c[b], sh_R[b])
+        if kind[a] == PLANE or kind[b] == PLANE:
+            pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if kind[a] == PLANE else (b, a, Pa, Pb, -1.0)
+            m0, m1, m2 = Q[5], Q[8], Q[11]   # the plane's local z
+            if m0 * (P[0] - Q[0]) + m1 * (P[1] - Q[1]) + m2 * (P[2] - Q[2]) > rad[x]:
+                continue   # broad phase: the bounding sphere clears the plane
+            _against(sc, pair, x, pl, -1, P, Q, Q[0], Q[1], Q[2], m0, m1, m2, sign, r, A, rd, w, rigid, F, rec,
+                     nrec)
+            continue
+        d0, d1, d2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
+        if d0 * d0 + d1 * d1 + d2 * d2 > (rad[a] + rad[b]) ** 2:
+            continue   # broad phase: bounding spheres apart
+        ka, kb = kind[a], kind[b]
+        if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
+            _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        else:
+            _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
