@@ -107,6 +107,22 @@ def test_missing_mesh_is_a_warning_and_primitives_are_visuals():
     assert ("upper", "cylinder") in kinds and ("ground", "box") in kinds
 
 
+def test_visuals_are_placed_on_their_bodies_and_drawn(tmp_path):
+    """Issue 31: the file's visual primitives become shapes on their bodies (Body.add_shape, no density:
+    the inertials stay the mass properties) that the viewer draws where the body is."""
+    import json
+    import re
+    model = _quiet(mb.from_urdf, ARM)
+    upper = model.bodies["upper"]
+    placed = [v for v in model.visuals if v.body == "upper" and v.role == "visual"]
+    assert placed and len(upper.shapes) == len(placed)
+    assert upper.mass == pytest.approx(_quiet(mb.from_urdf, ARM).bodies["upper"].mass)
+    html = mb.animate(model, tmp_path / "arm.html", end_time=0.01)
+    data = json.loads(re.search(r'id="mbdsim-data">(.*?)</script>', Path(html).read_text(), re.S).group(1))
+    moving = sum(len(b.shapes) for b in model.bodies.values() if b is not model.ground)
+    assert len(data["shapes"]) == moving > 0
+
+
 def test_package_mesh_is_resolved(tmp_path):
     (tmp_path / "test_arm" / "meshes").mkdir(parents=True)
     (tmp_path / "test_arm" / "meshes" / "fore.stl").write_text("solid x\nendsolid x\n")

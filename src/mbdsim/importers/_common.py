@@ -99,13 +99,53 @@ class Names:
         return cand
 
 
+def _geometry(v: VisualShape):
+    """The mbdsim geometry of a VisualShape (None for a mesh with unequal axis scales)."""
+    import mbdsim as mb
+    if v.kind == "box":
+        return mb.Box(v.size)
+    if v.kind == "sphere":
+        return mb.Sphere(radius=v.size[0])
+    if v.kind in ("cylinder", "capsule"):
+        return (mb.Cylinder if v.kind == "cylinder" else mb.Capsule)(v.size[0], v.size[1], axis="z")
+    if v.kind == "ellipsoid":
+        return mb.Ellipsoid(v.size)
+    if v.kind == "mesh" and v.file and len(set(float(x) for x in v.scale)) == 1:
+        return mb.Mesh(v.file, scale=float(v.scale[0]))
+    return None
+
+
+def attach_shapes(model, visuals: list, notes: list) -> None:
+    """Place each body's visual geometry (its collision geometry where it has no visual one) on the body
+    with Body.add_shape (no density: the file's inertials stay the mass properties), so that the viewer
+    draws the imported shapes; a shape that cannot be made (a mesh file missing or unreadable, unequal
+    mesh scales) is a note, never a failure. Contacts are not created: Model.add_contact takes them."""
+    drawn = {v.body for v in visuals if v.role == "visual"}
+    for k, v in enumerate(visuals):
+        if v.role != "visual" and v.body in drawn:
+            continue
+        body = model.ground if v.body == getattr(model.ground, "name", None) else model.bodies.get(v.body)
+        if body is None:
+            continue
+        try:
+            geom = _geometry(v)
+            if geom is None:
+                notes.append(f"shape {v.name or k!r} on {v.body!r}: not drawn (mesh scale {tuple(v.scale)})")
+                continue
+            body.add_shape(f"{v.role}_{k}", geom, center=v.point, orientation=v.orientation)
+        except Exception as exc:  # noqa: BLE001 - a drawing only: noted, the import goes on
+            notes.append(f"shape {v.name or k!r} on {v.body!r}: not drawn ({type(exc).__name__}: {exc})")
+
+
 def is_identifier(name: str) -> bool:
     """Whether expressions can read a joint of this name (its coordinate and <name>_dot)."""
     return name.isidentifier()
 
 
 def finish(model, notes: list, visuals: list, source: str) -> None:
-    """Attach the notes and visual shapes to the model and warn once about the approximations."""
+    """Attach the notes and visual shapes to the model (`attach_shapes`: drawn by the viewer) and warn
+    once about the approximations."""
+    attach_shapes(model, visuals, notes)
     model.import_notes = list(notes)
     model.visuals = list(visuals)
     model.source_file = source
