@@ -24,12 +24,13 @@ numba's method.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 from pathlib import Path
 
 _HERE = Path(__file__).parent
-KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py",
+KERNEL_SOURCES = ("_jit.py", "system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py",
                   "solvers/kkt_tree.py", "solvers/kkt_square.py", "solvers/fastloads.py", "solvers/fastdyn.py",
                   "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
                   "solvers/pycall.py")
@@ -45,12 +46,22 @@ def _digest() -> str:
     return h.hexdigest()[:16]
 
 
+@functools.lru_cache(maxsize=None)
+def _file_digest(path: str) -> str:
+    return hashlib.sha1(Path(path).read_bytes()).hexdigest()
+
+
+def base_dir() -> str:
+    """The directory holding every kernel version's cache: $NUMBA_CACHE_DIR if set, else
+    $XDG_CACHE_HOME/mbdsim/numba (default ~/.cache/mbdsim/numba)."""
+    return os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "mbdsim", "numba")
+
+
 def configure() -> str:
     """Point numba's cache at the directory of this kernel version; returns it."""
     import numba
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "mbdsim", "numba")
-    path = os.path.join(base, _digest())
+    path = os.path.join(base_dir(), _digest())
     numba.config.CACHE_DIR = path
     return path
 
@@ -76,6 +87,11 @@ def _package_locator() -> bool:
             super().__init__(py_func, py_file)
             rel = Path(py_file).resolve().parent.relative_to(_HERE.resolve())
             self._cache_path = os.path.join(numba_config().CACHE_DIR, "mbdsim", *rel.parts)
+
+        def get_source_stamp(self):
+            """The source file's content hash: numba's (modification time, size) changes with every clone
+            or copy of an unchanged file, which made numba ignore the whole index."""
+            return _file_digest(self._py_file)
 
         @classmethod
         def from_function(cls, py_func, py_file):
