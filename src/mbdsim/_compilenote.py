@@ -7,8 +7,8 @@ kernels: when a compilation (with the kernels it calls) is still going after DEL
     mbdsim: compiling the numba kernels this analysis uses (once per mbdsim version and machine,
     cached in ~/.cache/mbdsim/numba/...; about 40 s)
 
-and, where `mbdsim._progress.interactive()` (a terminal or a Jupyter kernel), shows a transient bar of the
-kernels compiled. When the compilation ends it prints how long it took. The estimate is that of the last
+(once per process) and, where `mbdsim._progress.interactive()` (a terminal or a Jupyter kernel), shows a
+transient bar of the kernels compiled while each compilation lasts. The estimate is that of the last
 compilation of the same kernel on this machine (kept in `base_dir()/compile-times.json`, whatever the
 version), else ESTIMATE_S. Set MBDSIM_QUIET_COMPILE=1 to silence it. Nothing is printed for loads from the
 cache (a fraction of a second).
@@ -70,7 +70,7 @@ class CompileNote(event.Listener):
     def __init__(self, stream=None) -> None:
         self.stream = stream
         self.depth, self.count, self.top, self.t0 = 0, 0, None, 0.0
-        self.timer, self.bar, self.shown = None, None, False
+        self.timer, self.bar, self.shown, self.said = None, None, False, False
         self.lock = threading.Lock()
 
     def on_start(self, ev) -> None:
@@ -98,12 +98,10 @@ class CompileNote(event.Listener):
             if self.timer is not None:
                 self.timer.cancel()
             seconds = time.monotonic() - self.t0
-            shown, self.timer = self.shown, None
+            self.timer = None
             self._close_bar()
         if seconds >= DELAY:
             _save_time(self.top, seconds, self.count)
-        if shown:
-            self._print(f"mbdsim: compiled {self.count} kernels in {seconds:.0f} s (cached for later runs)")
 
     def _estimate(self) -> tuple[float, int | None]:
         seconds, count = _load_times().get(self.top, (ESTIMATE_S, None))
@@ -116,8 +114,10 @@ class CompileNote(event.Listener):
             self.shown = True
             seconds, count = self._estimate()
             from ._jitcache import CACHE_DIR
-            self._print(f"mbdsim: compiling the numba kernels this analysis uses (once per mbdsim version and "
-                        f"machine, cached in {CACHE_DIR}); about {seconds:.0f} s")
+            if not self.said:   # one line per process; a terminal also gets the bar of each compilation
+                self.said = True
+                self._print(f"mbdsim: compiling the numba kernels this analysis uses (once per mbdsim version and "
+                            f"machine, cached in {CACHE_DIR}); about {seconds:.0f} s")
             self._open_bar(count)
 
     def _print(self, line: str) -> None:

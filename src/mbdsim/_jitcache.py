@@ -9,9 +9,12 @@ NUMBA_CACHE_DIR is respected (the hash is appended below it).
 The cache does not depend on where mbdsim is installed: numba files each module's kernels under a
 hash of the source directory's absolute path, so a second clone, a new virtual environment or a
 moved checkout compiled everything again (214 s on a second clone).  `_PackageCacheLocator` files
-mbdsim's kernels under their path inside the package instead; numba itself still checks each file's
-content hash, its own version and the CPU (its index and data keys), so a changed kernel, another
-numba or another machine never loads a stale entry.
+mbdsim's kernels under their path inside the package instead, and stamps each index with the source
+file's content hash instead of numba's (modification time, size), which every clone, copy or install
+changes (numba then ignored the whole index and compiled again). numba itself still checks each
+function's bytecode hash, its own version and the CPU (its index and data keys), so a changed kernel,
+another numba or another machine never loads a stale entry: the cache is keyed on the kernels' content
+and the machine, not the path. `mbdsim cache info` / `mbdsim cache clear` (mbdsim._cachedir).
 
 Loading a cached kernel: numba's `FunctionCache.load_overload` first refreshes the whole CPU target
 context (imports and installs every typing and lowering registry, numba.np.linalg's check for scipy's
