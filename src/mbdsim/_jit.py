@@ -24,9 +24,9 @@ from numba import njit
 from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
-from . import _jitcache  # noqa: F401  (numba's cache directory and locator, before any kernel is defined)
+from ._jitcache import ENTRY_FLAGS, KERNEL_FLAGS   # (numba's cache directory and locator set on import)
 
-_WRAPPERLESS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+_WRAPPERLESS = KERNEL_FLAGS
 
 
 class _TwinCache(caching.FunctionCache):
@@ -49,6 +49,14 @@ class KernelDispatcher(CPUDispatcher):
 
     def add_overload(self, cres):
         self.overloads[tuple(cres.signature.args)] = cres
+
+    @property
+    def signatures(self) -> list:
+        """The argument types compiled for, by kernels or (Python calls) for the twin, each once."""
+        sigs = list(self.overloads)
+        if self._twin is not None:
+            sigs += [s for s in self._twin.signatures if s not in sigs]
+        return sigs
 
     def python_twin(self) -> CPUDispatcher:
         """The same function compiled with the CPython wrapper (cached under its own file names)."""
@@ -93,7 +101,7 @@ def entry(fn=None, **options):
     def wrap(f):
         opts = _options(options)
         opts.pop("nopython")
-        return njit(no_cfunc_wrapper=True, **opts)(f)
+        return njit(**ENTRY_FLAGS, **opts)(f)
     return wrap if fn is None else wrap(fn)
 
 

@@ -33,14 +33,20 @@ import os
 from pathlib import Path
 
 _HERE = Path(__file__).parent
-KERNEL_SOURCES = ("_jit.py", "system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py",
+KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py",
                   "solvers/kkt_tree.py", "solvers/kkt_square.py", "solvers/fastloads.py", "solvers/fastdyn.py",
                   "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
                   "solvers/pycall.py")
 
 
+# numba's flags of mbdsim's two kinds of kernels (mbdsim._jit: @kernel, @entry); numba's index does not record
+# them, so they are part of the cache directory's key
+KERNEL_FLAGS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+ENTRY_FLAGS = {"no_cfunc_wrapper": True}
+
+
 def _digest() -> str:
-    h = hashlib.sha1()
+    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()))).encode())
     for rel in KERNEL_SOURCES:
         p = _HERE / rel
         if p.exists():
