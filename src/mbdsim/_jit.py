@@ -4,9 +4,10 @@
 Why not plain ``numba.njit(cache=True)``: numba compiles, for every function, a CPython wrapper (unboxing
 each argument from Python objects) and a C wrapper beside the function itself, even for a function that
 only other compiled functions call. The kernels take the compiled model and its work arrays as two
-tuples of about a hundred arrays (`system.compiled`), and the wrappers that unbox them dominated the
-cold compilation: 8-9 s of LLVM for a kernel that reads one number, against 0.5 s without the wrappers;
-about sixty such kernels made a fresh install wait 3-6 minutes (issue 32).
+tuples of about a hundred arrays (`system.compiled`), and the wrappers that unbox them are costly: 8-9 s
+of LLVM for a kernel that reads one number, against 0.5 s without them. Dropping them from the inner
+kernels cut the README example's cold compilation by about a quarter (250 s -> 185 s of CPU, issue 32);
+the rest is numba re-optimising every callee inside each caller (bench/RESULTS.md, Start-up).
 
 * ``@kernel(...)``: ``njit(cache=True, ...)`` without either wrapper. Other kernels call it as usual. A
   call from Python (a test, a debugging session) goes to a twin compiled with the CPython wrapper and
