@@ -9,9 +9,12 @@ NUMBA_CACHE_DIR is respected (the hash is appended below it).
 The cache does not depend on where mbdsim is installed: numba files each module's kernels under a
 hash of the source directory's absolute path, so a second clone, a new virtual environment or a
 moved checkout compiled everything again (214 s on a second clone).  `_PackageCacheLocator` files
-mbdsim's kernels under their path inside the package instead; numba itself still checks each file's
-content hash, its own version and the CPU (its index and data keys), so a changed kernel, another
-numba or another machine never loads a stale entry.
+mbdsim's kernels under their path inside the package instead, and stamps each index with the source
+file's content hash instead of numba's (modification time, size), which every clone, copy or install
+changes (numba then ignored the whole index and compiled again). numba itself still checks each
+function's bytecode hash, its own version and the CPU (its index and data keys), so a changed kernel,
+another numba or another machine never loads a stale entry: the cache is keyed on the kernels' content
+and the machine, not the path. `mbdsim cache info` / `mbdsim cache clear` (mbdsim._cachedir).
 
 Loading a cached kernel: numba's `FunctionCache.load_overload` first refreshes the whole CPU target
 context (imports and installs every typing and lowering registry, numba.np.linalg's check for scipy's
@@ -24,6 +27,7 @@ numba's method.
 """
 from __future__ import annotations
 
+import functools
 import hashlib
 import os
 from pathlib import Path
@@ -35,8 +39,14 @@ KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.p
                   "solvers/pycall.py", "cosim/_stepper.py", "solvers/fastnarrow.py", "solvers/fastcontact.py")
 
 
+# numba's flags of mbdsim's two kinds of kernels (mbdsim._jit: @kernel, @entry); numba's index does not record
+# them, so they are part of the cache directory's key
+KERNEL_FLAGS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
+ENTRY_FLAGS = {"no_cfunc_wrapper": True}
+
+
 def _digest() -> str:
-    h = hashlib.sha1()
+    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()))).encode())
     for rel in KERNEL_SOURCES:
         p = _HERE / rel
         if p.exists():
@@ -45,12 +55,22 @@ def _digest() -> str:
     return h.hexdigest()[:16]
 
 
+@functools.lru_cache(maxsize=None)
+def _file_digest(path: str) -> str:
+    return hashlib.sha1(Path(path).read_bytes()).hexdigest()
+
+
+def base_dir() -> str:
+    """The directory holding every kernel version's cache: $NUMBA_CACHE_DIR if set, else
+    $XDG_CACHE_HOME/mbdsim/numba (default ~/.cache/mbdsim/numba)."""
+    return os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "mbdsim", "numba")
+
+
 def configure() -> str:
     """Point numba's cache at the directory of this kernel version; returns it."""
     import numba
-    base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "mbdsim", "numba")
-    path = os.path.join(base, _digest())
+    path = os.path.join(base_dir(), _digest())
     numba.config.CACHE_DIR = path
     return path
 
@@ -76,6 +96,11 @@ def _package_locator() -> bool:
             super().__init__(py_func, py_file)
             rel = Path(py_file).resolve().parent.relative_to(_HERE.resolve())
             self._cache_path = os.path.join(numba_config().CACHE_DIR, "mbdsim", *rel.parts)
+
+        def get_source_stamp(self):
+            """The source file's content hash: numba's (modification time, size) changes with every clone
+            or copy of an unchanged file, which made numba ignore the whole index."""
+            return _file_digest(self._py_file)
 
         @classmethod
         def from_function(cls, py_func, py_file):

@@ -25,7 +25,7 @@ velocity vs, STEP(s, vs, mu_s, vt, mu_d) up to the transition velocity vt, mu_d 
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
@@ -40,7 +40,7 @@ PAR_FIELDS = ("stiffness", "exponent", "damping", "penetration", "restitution", 
               "mu_dynamic", "stiction_velocity", "transition_velocity", "element")
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _step(x, x0, h0, x1, h1):
     """Adams STEP: cubic from h0 at x0 to h1 at x1, constant outside."""
     if x <= x0:
@@ -51,7 +51,7 @@ def _step(x, x0, h0, x1, h1):
     return h0 + (h1 - h0) * u * u * (3.0 - 2.0 * u)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def friction_coefficient(s, mode, mu_s, mu_d, vs, vt):
     """mu(s) of the slip speed s [m/s] >= 0 (module docstring)."""
     if mode == 0:
@@ -63,7 +63,7 @@ def friction_coefficient(s, mode, mu_s, mu_d, vs, vt):
     return mu_d
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def normal_force(delta, gd, k, ex, cmax, dpen, eps):
     """Normal force [N] >= 0 at depth delta > 0 [m] and gap rate gd [m/s] (module docstring)."""
     if eps < 0.0:
@@ -72,7 +72,7 @@ def normal_force(delta, gd, k, ex, cmax, dpen, eps):
     return k * delta ** ex * (1.0 - (1.0 - eps * eps) * _step(gd, 0.0, 0.0, RESTITUTION_VELOCITY, 1.0))
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, delta):
     """The contact law at the point p [m] (normal n from shape_i towards shape_j, depth delta [m]): the force
     on shape_j's frame at p and its opposite on shape_i's."""
@@ -105,7 +105,7 @@ def _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, d
         nrec[0] = k + 1
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _against(sc, pair, x, ref, g, P, Q, q0, q1, q2, m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec):
     """Candidate points of shape x (pose P) below the plane (q, outward normal m) of shape `ref` (pose Q;
     face g of a polyhedron, whose other faces then bound the points; g < 0: a plane); n = sign m."""
@@ -124,7 +124,7 @@ def _against(sc, pair, x, ref, g, P, Q, q0, q1, q2, m0, m1, m2, sign, r, A, rd, 
                sign * m0, sign * m1, sign * m2, d)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     """Shape a against shape b, at least one of them a box or convex hull: separating axes over the face
     normals of the polyhedra, then the points of the least-penetration reference face (module docstring)."""
@@ -165,7 +165,7 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
                sign * m0, sign * m1, sign * m2, d)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
     """Distance [m] from the point v inside a polyhedron (pose P) to its surface along -m."""
     y0, y1, y2 = to_local(P, v0, v1, v2)
@@ -180,7 +180,7 @@ def _exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
     return best
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
     """Whether an incident vertex that `_against` used (below the reference face g, inside the reference)
     lies on the normal line through the reference vertex v (within tol [m])."""
@@ -198,7 +198,7 @@ def _pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m
     return False
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     """Spheres and capsules: the closest points of their segments, then as two spheres."""
     kind, prm = sc[1], sc[4]
@@ -223,7 +223,7 @@ def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
            n0, n1, n2, -g)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def shape_contacts(sc, r, A, rd, w, rigid, F, rec, nrec):
     """Contact loads of every packed shape pair into F (module docstring); records into rec while it has room."""
     sh_f, kind, sh_c, sh_R, rad, pr = sc[0], sc[1], sc[2], sc[3], sc[5], sc[10]

@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
 from ..system.exprloads_kernel import sensor_values
@@ -48,7 +49,7 @@ COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguou
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _rms(x, scale):
     s = 0.0
     for i in range(x.shape[0]):
@@ -56,7 +57,7 @@ def _rms(x, scale):
     return np.sqrt(s / x.shape[0])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator;
     work, scale, y1: scratch vectors of the state's size."""
@@ -80,7 +81,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     return min(100.0 * h0, h1, max_step)
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     """Accelerations VD and multipliers LAM at the output states Y (rows at `times`), computed after the
     run and only when a result asks for them; returns the number of rows done (< len on failure).
@@ -94,7 +95,7 @@ def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     return times.shape[0]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _dense(F, y_old, t_old, h, t, out):
     x = (t - t_old) / h
     for i in range(out.shape[0]):
@@ -109,7 +110,7 @@ def _dense(F, y_old, t_old, h, t, out):
         out[i] += y_old[i]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _sensor_g(cm, wk, t, y, yo, g):
     """Each expression sensor's signal minus its threshold at the integrator's state y at t [s] into g
     (frames computed here from y: the tree's forward kinematics, or the absolute coordinates with the
@@ -127,7 +128,7 @@ def _sensor_g(cm, wk, t, y, yo, g):
     sensor_values(cm[43], wk[44], t, yo, r, A, rd, w, g)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
     """The time [s] in (t0, t0 + h] at which sensor k's value changes sign on the dense output (F, y0) of
     the step from t0, by the Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the
@@ -169,7 +170,7 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
     return 0.5 * (a + b)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
     """Sensors after the accepted step (t, h) from y to ynew: each sign change of a sensor's value since the
     last accepted step is located on the step's dense output (F, computed here unless have_F); a crossing
@@ -214,7 +215,7 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
     return t_stop, have_F
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _stages(cm, wk, co, t, h, y, K, ys, ynew):
     """The 12 stages of a DOP853 step from y (K[0] = f(t, y) given), ynew and K[12] = f(t + h, ynew);
     False when an evaluation failed."""
@@ -236,7 +237,7 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
     return rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
     """The 7th-order dense output coefficients F (7, n) of an accepted step (3 more evaluations)."""
     A, C, D = co[0], co[2], co[5]
@@ -260,7 +261,7 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
             F[3 + r, i] = h * acc
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk,
         proj_tol, stats, K, F, sc, stiff_check, SY, ST, ns, watch=False):
     """Integrate from st = [t, h] with state y (projected) and f = ydot(t, y) up to t_end (h = 0: the start,
@@ -445,7 +446,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     return OK, iout
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_steps, stats, K, F, sc):
     """Short re-integration in one compiled call (Result.at): from the consistent state y at t0 over all
     of tout (tout[0] == t0 is written as is), then accelerations and multipliers at the outputs; returns
@@ -474,7 +475,7 @@ def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_s
     return status, iout
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     """States, accelerations and multipliers at the times tq (inside [t0, t0 + h]) from the dense output
     of the step (t0, h) redone from its checkpoint y0: the run's own step, so the same solution; status."""

@@ -11,6 +11,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 
 try:   # the expression VM (system.exprvm) compiles drivers; without it drivers stay in Python
     from ..system.exprvm import eval_program
@@ -18,7 +19,7 @@ try:   # the expression VM (system.exprvm) compiles drivers; without it drivers 
 except ImportError:   # pragma: no cover - transitional, until system.exprvm lands
     HAVE_VM = False
 
-    @njit(cache=True, _nrt=False)
+    @kernel(_nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
 from ..system.exprloads_kernel import expr_loads
@@ -34,7 +35,7 @@ OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 
 CALLBACK_FAILED = 11   # a Python-callable load raised (solvers.pyloads keeps the error); 8-10: fastdop
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def drivers_at(cm, wk, t):
     """Driver values f, f', f'' at time t [s] from the compiled expression programs, then those of the drivers
     written as Python callables (the callback of solvers.pyloads writes them into wk[34:37])."""
@@ -50,7 +51,7 @@ def drivers_at(cm, wk, t):
         _python_drivers(wk[48][1], t)
 
 
-@njit(cache=True, _nrt=False, inline="never")
+@kernel(_nrt=False, inline="never")
 def _python_drivers(ctl, t):
     """Call the driver callback (address ctl[2]), which writes the callable drivers' values into the
     driver arrays; ctl[1] = 1 when it failed."""
@@ -58,7 +59,7 @@ def _python_drivers(ctl, t):
         ctl[1] = 1
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def loads_into(cm, wk, t, y, r, A, rd, w, F):
     """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings, the
     loads written as expressions (system.exprloads_kernel; at time t [s], y: the joint-coordinate state on
@@ -81,7 +82,7 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
         _python_loads(wk[48][0], wk[48][1], t, F)
 
 
-@njit(cache=True, _nrt=False, inline="never")
+@kernel(_nrt=False, inline="never")
 def _python_loads(F_ext, ctl, t, F):
     """Call the load callback (address ctl[0]; ctl[1] = 1 when it failed) and add its loads F_ext to F.
     Kept out of `loads_into` (never inlined, small arguments) so that the loads of every other model stay
@@ -93,7 +94,7 @@ def _python_loads(F_ext, ctl, t, F):
             F[f, k] += F_ext[f, k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _constraints(cm, wk, t, q, v):
     """Frames, driver values and constraint rows at (q, v, t) into the work arrays."""
     r_idx, p_idx, rd_idx, w_idx, rigid_fid, rigid = cm[0], cm[1], cm[2], cm[3], cm[4], cm[6]
@@ -105,7 +106,7 @@ def _constraints(cm, wk, t, q, v):
                 wk[34], wk[35], wk[36], rigid, phi, Jc, nu, gamma)
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def residuals(cm, wk, times, Y, idx, rows, val, arg):
     """Run monitor: the largest |phi| [m or rad] over the constraint rows `rows` at the output rows
     Y[idx] = [q, v] (absolute coordinates, times [s]) into val, and the row where it occurs into arg
@@ -125,7 +126,7 @@ def residuals(cm, wk, times, Y, idx, rows, val, arg):
         val[k], arg[k] = best, at
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _factor(cm, wk):
     """Factor the augmented matrix at the rows in wk: dense LU (dims[4] = 1, singular body masses), the
     square Jacobian's LU (dims[4] = 2, zero-DOF models, `kkt_square`; the tree instead where it declines)
@@ -149,7 +150,7 @@ def _factor(cm, wk):
     return _reselect(cm, wk)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _kkt(cm, wk, loop_rows):
     t = cm[30]
     return kkt_factor(wk[5], cm[12], cm[13], cm[7], t[0], t[1], t[2], t[3], t[4], t[5], t[6], t[7], loop_rows,
@@ -157,7 +158,7 @@ def _kkt(cm, wk, loop_rows):
                       wk[20], wk[21], wk[37], wk[38], wk[40], wk[41])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def loop_ratio(wk, n):
     """Smallest over largest pivot of the loop rows' Schur complement in the factorisation in wk (n loop
     rows; `kkt_tree.pivoted_chol`, whose pivots do not increase): 0 when rows were left out, 1 for none."""
@@ -169,7 +170,7 @@ def loop_ratio(wk, n):
     return (LK[0, 0, 0] / LK[0, n - 1, n - 1]) ** 2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _reselect(cm, wk):
     """Choose the loop rows in use (wk[46]) anew among all loop rows of the tree (cm[45]) at the current
     positions: the first pivots of the pivoted Cholesky factorisation of all their Schur complement (the
@@ -194,7 +195,7 @@ def _reselect(cm, wk):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _solve(cm, wk, F, c_rows, x6, lam):
     if cm[31][4] == 1:
         dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
@@ -207,7 +208,7 @@ def _solve(cm, wk, F, c_rows, x6, lam):
               wk[13], wk[14], wk[15], wk[16], wk[18], wk[19], wk[21], F, c_rows, x6, lam, wk[38], wk[41])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def rows_dropped(cm, wk):
     """True when the factorisation in wk left dependent loop rows out of the solve (the tree's pivoted
     Cholesky at a change point, where the constraints do not determine the rates)."""
@@ -216,7 +217,7 @@ def rows_dropped(cm, wk):
     return wk[41][0] < wk[46].shape[0]
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status.
     y: the state the loads read (`loads_into`): q itself on the absolute path, the joint-coordinate state
@@ -240,7 +241,7 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     return OK
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _from6(cm, x6, x):
     """Six slots per frame -> system velocity layout."""
     vadr, rigid = cm[5], cm[6]
@@ -250,7 +251,7 @@ def _from6(cm, x6, x):
             x[vadr[f] + k] = x6[f, k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _to6(cm, x, x6):
     vadr, rigid = cm[5], cm[6]
     for f in range(x6.shape[0]):
@@ -263,13 +264,13 @@ def _to6(cm, x, x6):
             x6[f, k] = x[vadr[f] + k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def qdot_into(cm, q, v, qd):
     """dq/dt: CM velocities and Euler-parameter rates 1/2 p (x) (0, w_B)."""
     qdot_kernel(cm[0], cm[1], cm[2], cm[3], q, v, qd)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
     """`qdot_into` with explicit index arrays."""
     for k in range(r_idx.shape[0]):
@@ -284,7 +285,7 @@ def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
         qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def rhs(cm, wk, t, y, ydot, refactor=True):
     """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded). refactor=False:
     as in `accelerations`. A joint-coordinate tree (dims[5] == 1) has y = [theta, theta_dot] and
@@ -299,7 +300,7 @@ def rhs(cm, wk, t, y, ydot, refactor=True):
     return st
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def tree_rhs(cm, wk, t, y, ydot):
     """Joint-coordinate right-hand side: frames by forward kinematics, loads, articulated-body solve."""
     tw = wk[43]
@@ -316,7 +317,7 @@ def tree_rhs(cm, wk, t, y, ydot):
     return OK
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def write_state(cm, wk, y, yout, prev):
     """The output row (absolute coordinates and velocities, system layout) of the integrator's state y:
     a copy, or for a joint-coordinate tree the forward kinematics (Euler parameters continuous with prev,
@@ -331,7 +332,7 @@ def write_state(cm, wk, y, yout, prev):
     fasttree.to_maximal(cm[42], cm[1], cm[0], cm[2], cm[3], cm[4], r, A, rd, w, yout, prev)
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def read_state(cm, wk, yrow, y):
     """The integrator's state y of an output row (inverse of `write_state`)."""
     if cm[31][5] != 1:
@@ -344,7 +345,7 @@ def read_state(cm, wk, yrow, y):
     fasttree.from_maximal(cm[42], y.shape[0] // 2, r, A, rd, w, y)
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def joint_rows(cm, wk, Y, Yref, YJ):
     """Tree path: the joint state YJ[k] of each output row Y[k] (`read_state`), every angle continued to
     within pi of the reference joint state Yref[k] (Yref[-1] past its rows; e.g. the run's own state at a
@@ -360,13 +361,13 @@ def joint_rows(cm, wk, Y, Yref, YJ):
                 YJ[k, qadr[c]] = ref + (d - 2.0 * np.pi * np.floor((d + np.pi) / (2.0 * np.pi)))
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def increment_into(cm, q, dx6):
     """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) (body-axes rotation vectors), in place."""
     increment_kernel6(cm[0], cm[1], cm[4], q, dx6)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def increment_kernel6(r_idx, p_idx, rigid_fid, q, dx6):
     """`increment_into` with explicit index arrays; dx6 (nf, 6) six slots per frame."""
     for k in range(r_idx.shape[0]):
@@ -377,12 +378,12 @@ def increment_kernel6(r_idx, p_idx, rigid_fid, q, dx6):
         quat_step(q, p_idx, k, dx6[f, 3], dx6[f, 4], dx6[f, 5])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def normalize_into(cm, q):
     normalize_kernel(cm[1], q)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def normalize_kernel(p_idx, q):
     """Unit-normalise the Euler parameters in q."""
     for k in range(p_idx.shape[0]):
@@ -394,7 +395,7 @@ def normalize_kernel(p_idx, q):
             q[p_idx[k, c]] /= n
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def newton_positions(cm, wk, t, q, v, tol):
     """Newton on phi(q, t) = 0 from q, in place (Euler parameters normalised first; mass-weighted
     minimum-norm steps through the KKT factorisation in wk, at most 12), the rows in wk evaluated at the
@@ -433,7 +434,7 @@ def newton_positions(cm, wk, t, q, v, tol):
     return PROJECTION, size, nfactor
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def project(cm, wk, t, q, v, tol, exact_factor=True):
     """Project q onto phi(q, t) = 0 (`newton_positions`) and v onto phi_q v = nu.
     Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`); with
@@ -449,7 +450,7 @@ def project(cm, wk, t, q, v, tol, exact_factor=True):
     return project_velocities(cm, wk, v, exact_factor or nfactor == 0)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def project_velocities(cm, wk, v, refactor=True):
     """v onto phi_q v = nu (mass-weighted minimum-norm correction dv: M dv + J^T mu = 0, J dv = nu - J v)
     in place, with wk holding the constraint rows at the current positions (`_constraints`, after a

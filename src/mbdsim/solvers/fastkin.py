@@ -28,6 +28,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, increment_into, newton_positions,
                       project_velocities, rows_dropped)
 from .kkt_square import square_min_norm
@@ -44,7 +45,7 @@ MAX_SUBSTEPS = 1_000_000   # sub-steps (retries included) of one `advance`: beyo
 # rates; those come from the prediction)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     """Carry the solved state (q, v, vd, lam) at time st[0] [s] to t1 [s] in place; st = [t, h, hp] with
     h the sub-step [s] to try first (np.inf: the whole span) and hp > 0 the length [s] of the previous
@@ -123,7 +124,7 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     return OK
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def min_norm_at(cm, wk, lam):
     """Turn the multipliers lam just solved (`fastdyn.accelerations`, rows and factorisation in wk at
     the same state) into the minimum-norm multipliers of all rows when the square LU is in wk
@@ -136,7 +137,7 @@ def min_norm_at(cm, wk, lam):
                            mn[2])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _solved_at(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     """`advance` to t1 [s], then the minimum-norm multipliers (`min_norm_at`); when no sub-step was
     needed (t1 at the state's time to round-off) the equations are solved again there first, so that the
@@ -151,7 +152,7 @@ def _solved_at(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     return OK, min_norm_at(cm, wk, lam)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _store(q, v, vd, lam, Y, VD, LAM, row):
     """Row `row` of the outputs: [q, v] into Y, vd into VD, the multipliers into LAM."""
     nq = q.shape[0]
@@ -164,7 +165,7 @@ def _store(q, v, vd, lam, Y, VD, LAM, row):
         LAM[row, i] = lam[i]
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
     """Solve the outputs tout[iout:] [s] in turn from the solved state (q, v, vd, lam) at st[0], writing
     [q, v] rows into Y, vd into VD and the multipliers into LAM: the minimum-norm ones of all rows where
@@ -185,7 +186,7 @@ def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, tol, chunk, sta
     return OK, iout
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def states_at(cm, wk, times, Y, VD, LAM, MN, ts, Yo, VDo, LAMo, MNo, tol, stats, S, dx6, a6, p6, q, v, vd, lam,
               st):
     """States, accelerations and multipliers at the times ts [s] (inside the run) into Yo, VDo, LAMo

@@ -13,17 +13,18 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, _rot
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _centre(r, A, f, s):
     """Ground position [m] of the body-axes point s of frame f."""
     x0, x1, x2 = _rot(A, f, s[0], s[1], s[2])
     return r[f, 0] + x0, r[f, 1] + x1, r[f, 2] + x2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F):
     """Compliant contacts (system.force_elements.contact) into F: signed gap g [m] between the shapes, normal
     n from body_i's shape towards body_j's, contact point cp in the middle of the overlap; while g < 0 the
@@ -76,7 +77,7 @@ def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F):
         _point_force(F, A, fi, p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2], -G0, -G1, -G2, rigid)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _rotT(A, f, x0, x1, x2):
     """A[f]^T x (ground -> body axes)."""
     return (A[f, 0, 0] * x0 + A[f, 1, 0] * x1 + A[f, 2, 0] * x2,
@@ -84,7 +85,7 @@ def _rotT(A, f, x0, x1, x2):
             A[f, 0, 2] * x0 + A[f, 1, 2] * x1 + A[f, 2, 2] * x2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, pf_torque, sp_f, sp_s, sp_par,
                  r, A, rd, w, F):
     """Loads of `loads_into` with explicit arrays (six slots per frame); no allocation."""
@@ -142,7 +143,7 @@ def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, p
         _point_force(F, A, fj, sj0, sj1, sj2, -u0, -u1, -u2, rigid)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _rotvec(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     """Rotation vector [rad] of a rotation matrix (angle in [0, pi]), via the unit quaternion."""
     tr = r00 + r11 + r22
@@ -167,7 +168,7 @@ def _rotvec(r00, r01, r02, r10, r11, r12, r20, r21, r22):
     return ang * x / n, ang * y / n, ang * z / n
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def bushings_kernel(bu_f, bu_s, bu_R, bu_k, bu_c, bu_f0, r, A, rd, w, rigid, F, Mi, Mj):
     """Linear six-component bushings (Adams BUSHING semantics, see model.element_specs.Bushing) into F.
     Mi, Mj (3, 3): scratch for the markers' axes in ground."""

@@ -11,7 +11,7 @@ HULL (vertices and planes), MESH (vertices; non-convex).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 
@@ -21,7 +21,7 @@ KIND_NAMES = ("sphere", "plane", "box", "cylinder", "capsule", "ellipsoid", "con
 _BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def pose(r, A, f, c, R):
     """(o, G) of a shape's local frame in ground: o = r_f + A_f c, G = A_f R (row-major)."""
     o0 = r[f, 0] + A[f, 0, 0] * c[0] + A[f, 0, 1] * c[1] + A[f, 0, 2] * c[2]
@@ -39,34 +39,34 @@ def pose(r, A, f, c, R):
             A[f, 2, 0] * R[0, 2] + A[f, 2, 1] * R[1, 2] + A[f, 2, 2] * R[2, 2])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def to_ground(P, x0, x1, x2):
     """Ground point [m] of the local point x."""
     return (P[0] + P[3] * x0 + P[4] * x1 + P[5] * x2, P[1] + P[6] * x0 + P[7] * x1 + P[8] * x2,
             P[2] + P[9] * x0 + P[10] * x1 + P[11] * x2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def dir_ground(P, x0, x1, x2):
     """Ground components of the local direction x."""
     return (P[3] * x0 + P[4] * x1 + P[5] * x2, P[6] * x0 + P[7] * x1 + P[8] * x2,
             P[9] * x0 + P[10] * x1 + P[11] * x2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def dir_local(P, y0, y1, y2):
     """Local components of the ground direction y (G^T y)."""
     return (P[3] * y0 + P[6] * y1 + P[9] * y2, P[4] * y0 + P[7] * y1 + P[10] * y2,
             P[5] * y0 + P[8] * y1 + P[11] * y2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def to_local(P, y0, y1, y2):
     """Local coordinates of the ground point y."""
     return dir_local(P, y0 - P[0], y1 - P[1], y2 - P[2])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def n_candidates(kind, nvert):
     """How many candidate points a shape offers against a half-space (see `candidate`)."""
     if kind == SPHERE or kind == ELLIPSOID:
@@ -78,7 +78,7 @@ def n_candidates(kind, nvert):
     return nvert
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def candidate(kind, P, p, verts, v0, m0, m1, m2, k):
     """Ground position [m] of candidate point k of a shape against the half-space with outward unit normal
     m (ground; the shape lies on its +m side): the deepest point along -m of a sphere, an ellipsoid and
@@ -112,7 +112,7 @@ def candidate(kind, P, p, verts, v0, m0, m1, m2, k):
     return to_ground(P, verts[v0 + k, 0], verts[v0 + k, 1], verts[v0 + k, 2])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def support_depth(kind, P, p, verts, v0, nv, q0, q1, q2, m0, m1, m2):
     """Largest depth [m] of the shape below the plane through q with outward normal m (<= 0: clear)."""
     best = -np.inf
@@ -124,7 +124,7 @@ def support_depth(kind, P, p, verts, v0, nv, q0, q1, q2, m0, m1, m2):
     return best
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def face(P, planes, pl, g):
     """Face plane g of a polyhedron in ground: (a point q on it, outward unit normal m)."""
     n0, n1, n2 = dir_ground(P, planes[pl + g, 0], planes[pl + g, 1], planes[pl + g, 2])
@@ -132,7 +132,7 @@ def face(P, planes, pl, g):
     return P[0] + n0 * d, P[1] + n1 * d, P[2] + n2 * d, n0, n1, n2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def inside_except(P, planes, pl, npl, skip, x0, x1, x2, tol):
     """Whether the ground point x is inside every face plane of a polyhedron but `skip`, within tol [m]."""
     y0, y1, y2 = to_local(P, x0, x1, x2)
@@ -143,7 +143,7 @@ def inside_except(P, planes, pl, npl, skip, x0, x1, x2, tol):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def segment_closest(a0, a1, a2, b0, b1, b2, x0, x1, x2):
     """Closest point to x on the segment a-b."""
     d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
@@ -153,7 +153,7 @@ def segment_closest(a0, a1, a2, b0, b1, b2, x0, x1, x2):
     return a0 + t * d0, a1 + t * d1, a2 + t * d2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def segments_closest(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2):
     """Closest points (on a-b, on c-e) of two segments (clamped parameters, a few alternations)."""
     d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2

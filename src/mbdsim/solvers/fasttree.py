@@ -26,14 +26,15 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _rot_axis(a, th, R):
     """R = rotation by th [rad] about the unit axis a (Rodrigues)."""
     c, s = np.cos(th), np.sin(th)
@@ -49,7 +50,7 @@ def _rot_axis(a, th, R):
     R[2, 2] = c + k * a[2] * a[2]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def kinematics(tree, y, nj, r, A, rd, w, P, Rtmp):
     """Frames r, A, rd, w (ground axes, CM) of every body and joint points P from the joint state y."""
     parent, jtype, axis, spt, c0, R0, order, qadr = tree
@@ -122,7 +123,7 @@ def kinematics(tree, y, nj, r, A, rd, w, P, Rtmp):
                 rd[c, 2] += a2 * thd
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def aba(tree, y, nj, r, A, rd, w, P, F, mass, inertia, tw, ydot):
     """theta_ddot into ydot[nj:] (and theta_dot into ydot[:nj]) from frames at y and loads F (nf, 6):
     force [N] ground axes, moment about the CM [N m] body axes (fastdyn's layout). False if singular."""
@@ -260,7 +261,7 @@ def aba(tree, y, nj, r, A, rd, w, P, F, mass, inertia, tw, ydot):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def to_maximal(tree, p_idx, r_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w, yout, prev):
     """Absolute coordinates and velocities (system layout) of the frames into yout; Euler parameters with
     the sign nearest to prev's (continuous in time) when prev has the same size, else e0 >= 0."""
@@ -307,7 +308,7 @@ def to_maximal(tree, p_idx, r_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w, yout, 
             yout[nq + w_idx[k, c]] = A[f, 0, c] * w[f, 0] + A[f, 1, c] * w[f, 1] + A[f, 2, c] * w[f, 2]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def from_maximal(tree, nj, r, A, rd, w, y):
     """Joint state y from frames (the inverse of `kinematics`; angles in (-pi, pi], which the dynamics
     only see through their sines and cosines)."""

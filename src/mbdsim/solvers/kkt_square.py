@@ -29,13 +29,14 @@ from __future__ import annotations
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from .kkt_tree import lu_factor, lu_solve, lu_solve_transposed
 from .minnorm import _chol_solve, _cholesky
 
 SQUARE_PIVOT = 1e-6    # a pivot below this fraction of J's largest entry: near-singular, tree instead
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _add_row(Jc, bi, bj, vadr, rigid, row, X, i):
     """Add the compact row `row` of Jc (nc, 2, 6) into row i of X, dense over the velocity variables v
     (frame f's slot k at vadr[f] + k; a particle's translational slots only). Inlined where it is called,
@@ -48,7 +49,7 @@ def _add_row(Jc, bi, bj, vadr, rigid, row, X, i):
                 X[i, vadr[f] + k] += Jc[row, side, k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def square_factor(Jc, bi, bj, vadr, rigid, active, A, piv):
     """LU of the square Jacobian of the rows `active` (compact rows Jc (nc, 2, 6) of
     `system.kernels.rows_kernel`) into A (nv, nv) with the row swaps in piv[:nv]; piv[nv] = 1 when A
@@ -67,7 +68,7 @@ def square_factor(Jc, bi, bj, vadr, rigid, active, A, piv):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def square_solve(active, vadr, rigid, M6, A, piv, F, c_rows, x6, lam, x):
     """With the LU of `square_factor`: x6 = J^-1 c (c = c_rows at the active rows) per frame slot, and
     lam[active] = J^-T (F - M x6) (the other entries of lam untouched); F (nf, 6) loads per frame slot,
@@ -94,7 +95,7 @@ def square_solve(active, vadr, rigid, M6, A, piv, F, c_rows, x6, lam, x):
         lam[active[a]] = x[a]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def square_min_norm(Jc, bi, bj, vadr, rigid, active, A, piv, lam, C, S, y):
     """The multipliers lam (nc) solved on the rows `active` (zero elsewhere), with the LU of
     `square_factor` and the compact rows Jc at the same positions, replaced by the minimum-norm

@@ -25,9 +25,10 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def chol(A, n, L3, il):
     """Cholesky factor L3[il] (lower; its diagonal holds the reciprocals) of the leading n x n block of A;
     False if not positive definite."""
@@ -45,7 +46,7 @@ def chol(A, n, L3, il):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _fwd(L3, il, n, b2, ib):
     """b2[ib] <- L^-1 b2[ib] (forward substitution with L = L3[il] from `chol`)."""
     for i in range(n):
@@ -55,7 +56,7 @@ def _fwd(L3, il, n, b2, ib):
         b2[ib, i] = s * L3[il, i, i]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _bwd(L3, il, n, b2, ib):
     """b2[ib] <- L^-T b2[ib] (back substitution with L = L3[il] from `chol`)."""
     for i in range(n - 1, -1, -1):
@@ -65,19 +66,19 @@ def _bwd(L3, il, n, b2, ib):
         b2[ib, i] = s * L3[il, i, i]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def chol_solve(L3, il, n, b2, ib):
     """Solve (L L^T) x = b in place for the leading n entries of b2[ib] (L = L3[il] from `chol`)."""
     _fwd(L3, il, n, b2, ib)
     _bwd(L3, il, n, b2, ib)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _side(bi, bj, row, f):
     return 0 if bi[row] == f else 1
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
                 LD, Y, LS, JC, JP, D, Z):
     """Factor the tree part, leaves first: LD[c] = chol(D_c), LS[j] = chol(S_j), Y[j] = LS_j^-1 JP_j
@@ -136,7 +137,7 @@ def tree_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, Y, LS, JC, JP, F, c_rows, vd, lam, Qt, u, X):
     """Solve the tree system for loads F (nf, 6) and row right-hand sides c_rows (nc,) (global rows);
     writes vd (nf, 6) and lam (nc,) at the tree rows. Qt (nf, 6), u (nblk, 6), X (>= 2, 6) are work."""
@@ -195,7 +196,7 @@ def tree_solve(order, pblk, blk_parent, blk_ptr, blk_rows, LD, Y, LS, JC, JP, F,
             vd[c, k] = X[0, k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _row_dot(Jc, bi, bj, row, x):
     s = 0.0
     for side in range(2):
@@ -206,7 +207,7 @@ def _row_dot(Jc, bi, bj, row, x):
     return s
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_rows, ch_ptr, ch_blk,
                loop_rows, LD, G, LS, JC, JP, Qt, u, W, KW, LK, c0, LT, F, D, Z, perm):
     """Factor the whole system (tree, then the loop rows' Schur complement K W); False if singular.
@@ -247,7 +248,7 @@ def kkt_factor(Jc, bi, bj, M6, order, pblk, blk_child, blk_parent, blk_ptr, blk_
     return pivoted_chol(KW, nl, LK, perm) >= 0
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def pivoted_chol(A, n, L3, perm):
     """Cholesky with diagonal pivoting of the symmetric positive semi-definite A (overwritten): the
     factor of the permuted leading block goes to L3[0] (reciprocal diagonal, as `chol`), the order to
@@ -286,7 +287,7 @@ def pivoted_chol(A, n, L3, perm):
     return rank
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows, LD, G, LS, JC, JP, Qt, u,
               W, LK, lamL, LT, F, c_rows, vd, lam, X, perm):
     """Solve the factored system for loads F (nf, 6) and row right-hand sides c_rows (nc,);
@@ -316,7 +317,7 @@ def kkt_solve(Jc, bi, bj, order, pblk, blk_parent, blk_ptr, blk_rows, loop_rows,
             lam[row] -= LT[i, row] * la
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def dense_factor(Jc, bi, bj, M6, active, KD, piv):
     """Dense LU (partial pivoting) of the augmented matrix over six slots per body and the active rows,
     for models with a singular body mass matrix (massless links, point masses on rigid frames)."""
@@ -340,7 +341,7 @@ def dense_factor(Jc, bi, bj, M6, active, KD, piv):
     return lu_factor(KD, n, piv, 1e-13)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def lu_factor(A, n, piv, rel_tol):
     """LU with partial pivoting of the leading n x n block of A in place (L unit lower below the diagonal,
     U on and above it), the row swaps in piv[:n]; False when a pivot is not above rel_tol times the
@@ -370,7 +371,7 @@ def lu_factor(A, n, piv, rel_tol):
     return True
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def lu_solve(A, piv, n, x):
     """x <- A^-1 x (leading n entries) with the LU of `lu_factor`."""
     for k in range(n):
@@ -386,7 +387,7 @@ def lu_solve(A, piv, n, x):
         x[i] /= A[i, i]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def lu_solve_transposed(A, piv, n, x):
     """x <- A^-T x (leading n entries) with the LU of `lu_factor` (U^T w = x, L^T z = w, then the row
     swaps undone)."""
@@ -406,7 +407,7 @@ def lu_solve_transposed(A, piv, n, x):
             x[k], x[p] = x[p], x[k]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def dense_solve(active, KD, piv, F, c_rows, vd, lam, x):
     """Solve with the LU of `dense_factor` for loads F (nf, 6) and row right-hand sides c_rows; x scratch (n)."""
     nb = F.shape[0] - 1

@@ -22,13 +22,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
+
 __all__ = ["min_norm_multipliers"]
 
 # reassociation (vectorised dot products) but no finite-math assumption: the isfinite check must stay
 _FAST = {"reassoc", "contract", "nsz", "arcp"}
 
 
-@njit(cache=True, fastmath=_FAST)
+@kernel(fastmath=_FAST)
 def _cholesky(A, n):
     """Lower Cholesky factor of A[:n, :n] in place (upper part untouched); False if not positive definite
     to 1e-12 of the pivot's diagonal (for G = J_r J_r^T: rows dependent to about 1e-6 in the relative
@@ -50,7 +52,7 @@ def _cholesky(A, n):
     return True
 
 
-@njit(cache=True, fastmath=_FAST)
+@kernel(fastmath=_FAST)
 def _chol_solve(L, n, b):
     """Solve (L L^T) x = b in place (b: length n)."""
     for i in range(n):
@@ -65,7 +67,7 @@ def _chol_solve(L, n, b):
         b[i] = s / L[i, i]
 
 
-@njit(cache=True, fastmath=_FAST)
+@entry(fastmath=_FAST)
 def min_norm_multipliers(J, LAM, rows, dep, out, bad):
     """out (N, nc): minimum-norm multipliers from J (N, nc, nv) and LAM (N, nc) (the solved values on
     `rows`, zero elsewhere); bad (N,) set where the sample needs the SVD pseudo-inverse instead."""

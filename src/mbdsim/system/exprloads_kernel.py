@@ -18,11 +18,12 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from .exprvm import eval_program
 from .kernels import row_rate, row_terms
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _rot(A, f, s0, s1, s2):
     """A[f] s (body axes -> ground)."""
     return (A[f, 0, 0] * s0 + A[f, 0, 1] * s1 + A[f, 0, 2] * s2,
@@ -30,18 +31,18 @@ def _rot(A, f, s0, s1, s2):
             A[f, 2, 0] * s0 + A[f, 2, 1] * s1 + A[f, 2, 2] * s2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _axis(A, f, R, c):
     """Column c of A[f] R (a marker's axis c in ground)."""
     return _rot(A, f, R[0, c], R[1, c], R[2, c])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _cross(a0, a1, a2, b0, b1, b2):
     return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _point(r, A, rd, w, f, s):
     """Ground position and velocity of the point s (body axes, from the CM) of frame f."""
     s0, s1, s2 = _rot(A, f, s[0], s[1], s[2])
@@ -49,14 +50,14 @@ def _point(r, A, rd, w, f, s):
     return (r[f, 0] + s0, r[f, 1] + s1, r[f, 2] + s2), (rd[f, 0] + v0, rd[f, 1] + v1, rd[f, 2] + v2)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _in_axes(A, f, R, v0, v1, v2, c):
     """Component c of the ground vector v in the axes A[f] R."""
     a = _axis(A, f, R, c)
     return a[0] * v0 + a[1] * v1 + a[2] * v2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def measure(k, fi, fj, fk, si, sj, Ri, Rj, Rk, v, r, A, rd, w):
     """Value of a measure of kind k at one state (frames r, A, rd, w; ground = frame 0)."""
     if k <= 8:
@@ -96,7 +97,7 @@ def measure(k, fi, fj, fk, si, sj, Ri, Rj, Rk, v, r, A, rd, w):
     return row_rate(rd, w, fi, fj, Jri, Jpi, Jrj, Jpj)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
     """Ground-axes force at ground offset s from the CM of frame f, into F (nf, 6)."""
     if f == 0:
@@ -110,7 +111,7 @@ def _force(F, A, f, s0, s1, s2, F0, F1, F2, rigid):
             F[f, 3 + k] += A[f, 0, k] * m0 + A[f, 1, k] * m1 + A[f, 2, k] * m2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _row_load(F, A, f, s, Jr, Jp, rigid):
     """s times a constraint row's Jacobian rows on frame f (J_r [-], J_p ground axes) into F: the force
     s J_r [N] and the ground-axes torque s J_p turned into body axes."""
@@ -123,7 +124,7 @@ def _row_load(F, A, f, s, Jr, Jp, rigid):
             F[f, 3 + k] += s * (A[f, 0, k] * Jp[0] + A[f, 1, k] * Jp[1] + A[f, 2, k] * Jp[2])
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _torque(F, A, f, T0, T1, T2, rigid):
     """Ground-axes torque on frame f, into F (body axes)."""
     if f == 0 or not rigid[f]:
@@ -132,12 +133,12 @@ def _torque(F, A, f, T0, T1, T2, rigid):
         F[f, 3 + k] += A[f, 0, k] * T0 + A[f, 1, k] * T1 + A[f, 2, k] * T2
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _value(code, consts, tables, start, end, p, x, stack):
     return 0.0 if p < 0 else eval_program(code, consts, tables, start[p], end[p], x, stack)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def expr_measures(ex, ew, t, y, r, A, rd, w):
     """The variable vector x = ew[0] at one state: x[0] = t [s], x[1 + m] the value of measure m (frames
     r, A, rd, w; y: the joint-coordinate state [theta, theta_dot] on the tree path, read by joint
@@ -159,7 +160,7 @@ def expr_measures(ex, ew, t, y, r, A, rd, w):
                            ms_R[m, 1], ms_R[m, 2], ms_v[m], r, A, rd, w)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def sensor_values(ex, ew, t, y, r, A, rd, w, g):
     """g[s] = signal - threshold of each expression sensor at one state (frames r, A, rd, w; y as in
     `expr_measures`)."""
@@ -169,7 +170,7 @@ def sensor_values(ex, ew, t, y, r, A, rd, w, g):
         g[s] = _value(code, consts, tables, start, end, ex[18][s], ew[0], ew[1]) - ex[21][s]
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
     """Measures, expression programs and their loads at one state into F (see the module docstring).
     y: the joint-coordinate state [theta, theta_dot] on the tree path (read by joint measures that have

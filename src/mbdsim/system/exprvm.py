@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from .._exprtree import Bin, Call, Const, ExpressionError, Fn, Neg, Var
 
 # opcodes (operand in the second column)
@@ -159,7 +160,7 @@ def time_programs(tf):
 
 
 # ----------------------------------------------------------------------------- the interpreter
-@njit(cache=True, _nrt=False, error_model="numpy")
+@kernel(_nrt=False, error_model="numpy")
 def _poly_step(deg, x, x0, h0, x1, h1, order):
     """STEP (deg 3) / STEP5 (deg 5) and their derivatives, as mbdsim.functions."""
     if order == 0:
@@ -188,7 +189,7 @@ def _poly_step(deg, x, x0, h0, x1, h1, order):
     return out + h0 if order == 0 else out
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@kernel(_nrt=False, error_model="numpy")
 def _impact(x, xd, x1, k, e, cmax, d, order):
     """Adams IMPACT (mbdsim.functions.impact) and, order 1, its partial d/dx at fixed xd."""
     p = x1 - x
@@ -203,7 +204,7 @@ def _impact(x, xd, x1, k, e, cmax, d, order):
     return -k * e * p ** (e - 1.0) - _poly_step(3, x, x1 - d, cmax, x1, 0.0, 1) * xd
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@kernel(_nrt=False, error_model="numpy")
 def _table(tables, off, order, x):
     """Piecewise cubic (scipy PPoly layout) and its derivatives at x; nan outside when not extrapolating."""
     m = int(tables[off])
@@ -234,7 +235,7 @@ def _table(tables, off, order, x):
     return 0.0
 
 
-@njit(cache=True, _nrt=False, error_model="numpy")
+@kernel(_nrt=False, error_model="numpy")
 def eval_program(code, consts, tables, start, end, x, stack):
     """Value of the program code[start:end] for variable values x (stack: work array of the packed size)."""
     sp = 0

@@ -14,37 +14,38 @@ import numpy as np
 from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 
 KIND = {"dot1": 3, "dot2": 4, "angle": 5, "slide": 6, "screw": 7, "cvel": 8}
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _mv(A, b, x):
     return (A[b, 0, 0] * x[0] + A[b, 0, 1] * x[1] + A[b, 0, 2] * x[2],
             A[b, 1, 0] * x[0] + A[b, 1, 1] * x[1] + A[b, 1, 2] * x[2],
             A[b, 2, 0] * x[0] + A[b, 2, 1] * x[1] + A[b, 2, 2] * x[2])
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _cr(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _dt(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _sc(s, a):
     return (s * a[0], s * a[1], s * a[2])
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _put(Jc, row, side, b, Jr, Jp, A, rigid):
     """Row coefficients of frame b (side 0: body_i, 1: body_j): translation, then body-axes rotation Jp A."""
     for k in range(6):
@@ -58,7 +59,7 @@ def _put(Jc, row, side, b, Jr, Jp, A, rigid):
         for k in range(3):  # body axes: Jp A
             Jc[row, side, 3 + k] = Jp[0] * A[b, 0, k] + Jp[1] * A[b, 1, k] + Jp[2] * A[b, 2, k]
 
-@njit(cache=True)
+@kernel
 def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
     """Dense phi_q (nc, nv) from the compact rows Jc (nc, 2, 6); J zeroed by the caller."""
     for row in range(Jc.shape[0]):
@@ -71,7 +72,7 @@ def scatter_dense(Jc, bi_, bj_, vadr, rigid, J):
             for k in range(n):
                 J[row, c + k] += Jc[row, side, k]
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def _dot1(A, w, bi, bj, ai_B, aj_B):
     """a_i . a_j of unit vectors fixed on frames bi and bj (body axes ai_B, aj_B): (value, c = a_i x a_j
     (the ground-axes rotation row of bi; -c that of bj), quad, rate [1/s])."""
@@ -86,7 +87,7 @@ def _dot1(A, w, bi, bj, ai_B, aj_B):
     return _dt(ai, aj), c, quad, rate
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _sph_row(k, r, A, w, bi, bj, a, b):
     """Spherical row k (0, 1, 2): component k of P_j - P_i (a = s_i, b = s_j)."""
     wi = (w[bi, 0], w[bi, 1], w[bi, 2])
@@ -99,14 +100,14 @@ def _sph_row(k, r, A, w, bi, bj, a, b):
             _cr(wj, _cr(wj, sj))[k] - _cr(wi, _cr(wi, si))[k])
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _dot1_row(A, w, bi, bj, a, b):
     """dot1 row a_i . a_j (a = a_i, b = a_j)."""
     val, cc, quad, _ = _dot1(A, w, bi, bj, a, b)
     return val, (0.0, 0.0, 0.0), cc, (0.0, 0.0, 0.0), _sc(-1.0, cc), quad
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _dot2_row(r, A, rd, w, bi, bj, a, b, c):
     """dot2 row a_i . (P_j - P_i) (a = a_i, b = s_i, c = s_j)."""
     wi = (w[bi, 0], w[bi, 1], w[bi, 2])
@@ -123,7 +124,7 @@ def _dot2_row(r, A, rd, w, bi, bj, a, b, c):
     return _dt(ai, d), _sc(-1.0, ai), _cr(ai, _add(d, si)), ai, _cr(sj, ai), quad
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _angle_row(A, w, bi, bj, a, b, c):
     """Angle row atan2(g_i . f_j, f_i . f_j) (a = f_i, b = g_i, c = f_j)."""
     S, cS, qS, Sd = _dot1(A, w, bi, bj, b, c)
@@ -135,7 +136,7 @@ def _angle_row(A, w, bi, bj, a, b, c):
     return np.arctan2(S, C), (0.0, 0.0, 0.0), Jp, (0.0, 0.0, 0.0), _sc(-1.0, Jp), quad
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _screw_row(r, A, rd, w, bi, bj, V, c):
     """Screw row c wrap(s / c - theta): s = h_i . (P_j - P_i), theta the angle of j about h_i (V: f_i, g_i,
     f_j, h_i, s_i, s_j; c = lead / 2 pi [m/rad]); J = J_s - c J_theta, quad = quad_s - c quad_theta."""
@@ -146,7 +147,7 @@ def _screw_row(r, A, rd, w, bi, bj, V, c):
             _sub(srj, _sc(c, trj)), _sub(spj, _sc(c, tpj)), sq - c * tq)
 
 
-@njit(cache=True, _nrt=False, inline="always")
+@kernel(_nrt=False, inline="always")
 def _cvel_row(A, w, bi, bj, V):
     """Constant-velocity row f_i . g_j - g_i . f_j (V: f_i, g_i, f_j, g_j)."""
     a, _, api, _, apj, aq = _dot1_row(A, w, bi, bj, V[0], V[3])
@@ -155,7 +156,7 @@ def _cvel_row(A, w, bi, bj, V):
     return a - b, zero, _sub(api, bpi), zero, _sub(apj, bpj), aq - bq
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def row_terms(k, r, A, rd, w, bi, bj, V, p):
     """One constraint row of kind k between frames bi and bj, the single implementation of Haug's basic
     constraints (every evaluation goes through it or, in `rows_kernel`'s loop, through the same
@@ -184,14 +185,14 @@ def row_terms(k, r, A, rd, w, bi, bj, V, p):
     return _cvel_row(A, w, bi, bj, V)
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def row_rate(rd, w, bi, bj, Jri, Jpi, Jrj, Jpj):
     """phi's rate J v of a row [its unit / s] (no explicit time term) from its Jacobian rows."""
     return (_dt(Jri, (rd[bi, 0], rd[bi, 1], rd[bi, 2])) + _dt(Jpi, (w[bi, 0], w[bi, 1], w[bi, 2]))
             + _dt(Jrj, (rd[bj, 0], rd[bj, 1], rd[bj, 2])) + _dt(Jpj, (w[bj, 0], w[bj, 1], w[bj, 2])))
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def rows_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, rigid, phi, Jc, nu, gamma):
     """Fill phi, the compact Jacobian rows Jc (nc, 2, 6), nu and gamma for every row (`row_terms`, the
     drivers' targets f(t) [m or rad] and their rates taken off; V (nc, 6, 3) the rows' vectors, par
@@ -253,7 +254,7 @@ def rows_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, rigid, phi
             gamma[row] += fdd[n]
 
 
-@njit(cache=True, _nrt=False)
+@entry(_nrt=False)
 def ground_rows(kind, r, A, rd, w, bi_, bj_, V, par, phi, Jri, Jpi, Jrj, Jpj, quad, rate):
     """`row_terms` of every row with its Jacobian rows in ground axes (Jri, Jpi, Jrj, Jpj: (n, 3)) and
     its rate J v: the rows of `constraints.primitives` (frames may carry time samples flattened into
@@ -268,7 +269,7 @@ def ground_rows(kind, r, A, rd, w, bi_, bj_, V, par, phi, Jri, Jpi, Jrj, Jpj, qu
         rate[row] = row_rate(rd, w, bi, bj, a, b, c, d)
 
 
-@njit(cache=True)
+@entry
 def constraint_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, vadr, rigid,
                       phi, J, nu, gamma):
     """Fill phi, the dense J (nc, nv; zeroed by the caller), nu, gamma for every row."""
@@ -277,7 +278,7 @@ def constraint_kernel(r, A, rd, w, kind, bi_, bj_, V, par, drv, f, fd, fdd, vadr
     scatter_dense(Jc, bi_, bj_, vadr, rigid, J)
 
 
-@njit(cache=True)
+@entry
 def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_, V, par, drv, nd, vadr,
                    rigid, nv):
     """Constraint Jacobians phi_q (N, nc, nv) at the position samples Q (N, nq); phi_q does not depend on
@@ -295,7 +296,7 @@ def jacobian_batch(Q, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf, kind, bi_, bj_
     return out
 
 
-@njit(cache=True)
+@entry
 def jacobian_blocks(R, A, kind, bi_, bj_, V, par, drv, nd, rigid):
     """Compact Jacobian rows Jc (N, nr, 2, 6) of the rows given (kind ... drv sliced to them; column block
     0 on frame bi_, 1 on bj_, in the velocity variables' axes as `scatter_dense` places them) at the
@@ -311,7 +312,7 @@ def jacobian_blocks(R, A, kind, bi_, bj_, V, par, drv, nd, rigid):
     return out
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
     """Frames of one state into r, A, rd, w (nf, ...), ground axes; ground (0) at rest at the origin."""
     nf = r.shape[0]
@@ -344,7 +345,7 @@ def frames_into(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w):
             w[f, c] = (A[f, c, 0] * v[w_idx[k, 0]] + A[f, c, 1] * v[w_idx[k, 1]]
                        + A[f, c, 2] * v[w_idx[k, 2]])
 
-@njit(cache=True)
+@entry
 def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
     """Single-state frames: r, A, rd, w (ground axes) of all nf frames (ground = 0)."""
     r = np.zeros((nf, 3))
@@ -355,7 +356,7 @@ def frames_kernel(q, v, r_idx, p_idx, rd_idx, w_idx, rigid_fid, nf):
     return r, A, rd, w
 
 
-@njit(cache=True, _nrt=False)
+@kernel(_nrt=False)
 def quat_step(q, p_idx, k, x, y, z):
     """Euler parameters p_idx[k] of q <- p (x) exp((x, y, z) / 2), normalised, in place: the rotation by
     the body-axes rotation vector (x, y, z) [rad] applied on the right."""
@@ -372,7 +373,7 @@ def quat_step(q, p_idx, k, x, y, z):
     q[p_idx[k, 0]], q[p_idx[k, 1]], q[p_idx[k, 2]], q[p_idx[k, 3]] = p0 / n, p1 / n, p2 / n, p3 / n
 
 
-@njit(cache=True)
+@entry
 def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
     """q (+) dx: CM translations plus p <- p (x) exp(dx_w / 2) for body-axes rotation vectors."""
     out = q.copy()
@@ -384,7 +385,7 @@ def increment_kernel(q, dx, r_idx, rd_idx, p_idx, w_idx):
     return out
 
 
-@njit(cache=True)
+@entry
 def qdot_kernel(q, v, r_idx, rd_idx, p_idx, w_idx, nq):
     """dq/dt: rd for CM positions, pdot = 1/2 p (x) (0, w_B) for Euler parameters."""
     qd = np.zeros(nq)
@@ -401,7 +402,7 @@ def qdot_kernel(q, v, r_idx, rd_idx, p_idx, w_idx, nq):
     return qd
 
 
-@njit(cache=True)
+@entry
 def inertial_forces_kernel(A, w, mass, inertia_B, rd_idx, w_idx, rigid_fid, g, nv):
     """Q (nv,) of gravity m g on every CM and the gyroscopic term -w_B x (J w_B) (body axes)."""
     Q = np.zeros(nv)
