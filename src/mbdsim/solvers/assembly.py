@@ -139,6 +139,9 @@ def assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     return dataclasses.replace(report, system=sys, q=report.q.copy(), v=report.v.copy())
 
 
+DENSE_BYTES = 2 * 2**30   # bytes of one dense Jacobian (nc x nv) above which the general assembly refuses
+
+
 def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     """assemble_state without the cache."""
     from .assembly_large import consistent_tree
@@ -148,6 +151,13 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
         return AssemblyReport(sys, t, q0.copy(), v0.copy(), rows, sys.nv - len(rows), [], {}, {},
                               float(np.max(np.abs(phi), initial=0.0)), [], notes, {})
+    if 8.0 * sys.nv * max(sys.nc, 1) > DENSE_BYTES:
+        from .assembly_large import why_dense
+        raise AssemblyError(f"assembly of {sys.nbody} bodies ({sys.nv} velocity variables, {sys.nc} constraint "
+                            f"equations) needs dense matrices of {8.0 * sys.nv * sys.nc / 2**30:.1f} GB "
+                            f"here because {why_dense(sys, q0, v0, t, tol)}; a large model assembles without "
+                            "them when its joints form a tree, it is drawn assembled with consistent "
+                            "velocities and no joint initial values are given", time=float(t))
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:

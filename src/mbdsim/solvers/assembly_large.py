@@ -76,3 +76,16 @@ def consistent_tree(sys, q0, v0, t, tol):
         if np.linalg.svd(cols, compute_uv=False).min() <= 1e-9 * scale:
             return None
     return np.arange(sys.nc), phi
+
+
+def why_dense(sys, q0, v0, t, tol) -> str:
+    """Why `consistent_tree` did not take the state (words for the error of a too-large dense assembly)."""
+    if not sys.kernel_rows or len(sys.lock_rows):
+        return "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
+    if any(jt.initial_displacement is not None or jt.initial_velocity is not None
+           for jt in sys.model.joints.values()):
+        return "joint initial displacements or velocities are given"
+    _, tree, loop, blocks = _tree_plan(sys)
+    if len(loop) or len(tree) != sys.nc or blocks is None:
+        return "its joints close loops"
+    return "the bodies are not drawn in an assembled configuration with consistent velocities"
