@@ -26,7 +26,12 @@ class Bound:
 
 
 def _entry(kernel, args):
-    """The entry point of `kernel`'s overload for the types of `args` (the kernel itself when unknown)."""
+    """The entry point of `kernel`'s overload for the types of `args` (the kernel itself when unknown).
+    A wrapperless kernel (mbdsim._jit.kernel) is entered through its Python-callable twin: its own
+    overloads have no CPython wrapper, and calling their entry points from Python crashes."""
+    twin = getattr(kernel, "python_twin", None)
+    if twin is not None:
+        kernel = twin()
     try:
         sigs = kernel.signatures
         if len(sigs) == 1:
