@@ -4,17 +4,16 @@ The general assembly (solvers.assembly) works on the dense constraint Jacobian (
 10,000-body chain. A large system (more than DENSE_LIMIT velocity variables) whose joints form a tree,
 whose rows the compiled kernel evaluates, and whose initial state is already consistent (phi(q0) = 0
 and phi_q v0 = nu within the tolerance, no joint initial displacement or velocity to hold; or free bodies
-alone) needs no
-assembly step: `consistent_tree` checks exactly that with the sparse Jacobian (CSR, from the compact
-rows of `kernels.rows_kernel`, O(N)) and the tree blocks' independence on their child bodies, and
-returns the report of that state; anything else (None) goes to the general assembly.
+alone) needs no assembly step: `consistent_tree` checks exactly that with the sparse Jacobian (CSR,
+from the compact rows of `kernels.rows_kernel`, O(N)) and the tree blocks' independence on their
+child bodies, and returns the report of that state; anything else (None) goes to the general assembly.
 """
 from __future__ import annotations
 
 import numpy as np
 
 from .._blas import lazy_import
-from ..system.equations import _packed
+from ..system.equations import _packed, driver_values
 from ..system.frames import body_frames
 from ..system import kernels
 from ..system.rows import DENSE_LIMIT, _tree_plan
@@ -26,9 +25,7 @@ def sparse_terms(sys, q, v, t):
     matrix, O(nc)."""
     kind, bi, bj, V, par, drv, fns = _packed(sys)
     fr = body_frames(sys, q, v)
-    f = np.array([fn.value(t) for fn in fns], dtype=float)
-    fd = np.array([fn.d1(t) for fn in fns], dtype=float)
-    fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
+    f, fd, fdd = driver_values(fns, t)
     nc = sys.nc
     phi, nu, gamma, Jc = np.zeros(nc), np.zeros(nc), np.zeros(nc), np.zeros((nc, 2, 6))
     kernels.rows_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, V, par, drv, f, fd, fdd, sys.frame_rigid,
@@ -53,7 +50,7 @@ def compact_to_csr(sys, Jc, bi, bj):
 
 
 def consistent_tree(sys, q0, v0, t, tol):
-    """(rows, phi, J) when the state (q0, v0) at t needs no assembly (see the module docstring), else None."""
+    """(rows, phi) when the state (q0, v0) at t needs no assembly (see the module docstring), else None."""
     if sys.nv <= DENSE_LIMIT or not sys.kernel_rows or len(sys.lock_rows):
         return None
     if not sys.nc:   # free bodies: every given state is consistent

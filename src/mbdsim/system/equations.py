@@ -94,13 +94,17 @@ def _terms_compiled(sys, q, v, t, jacobian):
     return phi_, (J if jacobian else None), nu, gamma
 
 
+def driver_values(fns, t):
+    """(f, f', f'') at time t [s] of the packed driver functions, as the row kernels take them."""
+    return (np.array([fn.value(t) for fn in fns], dtype=float), np.array([fn.d1(t) for fn in fns], dtype=float),
+            np.array([fn.d2(t) for fn in fns], dtype=float))
+
+
 def _kernel_terms(sys, fr, t, V1=None):
     """phi, phi_q, nu, gamma of the packed rows from the compiled kernel at frames fr and time t [s]; V1:
     the packed vectors when the caller rewrote some (curve points), else the packed ones."""
     kind, bi, bj, V, par, drv, fns = _packed(sys)
-    f = np.array([fn.value(t) for fn in fns], dtype=float)
-    fd = np.array([fn.d1(t) for fn in fns], dtype=float)
-    fdd = np.array([fn.d2(t) for fn in fns], dtype=float)
+    f, fd, fdd = driver_values(fns, t)
     phi_, nu, gamma = np.zeros(sys.nc), np.zeros(sys.nc), np.zeros(sys.nc)
     J = np.zeros((sys.nc, sys.nv))
     kernels.constraint_kernel(fr.r, fr.A, fr.rd, fr.w, kind, bi, bj, V if V1 is None else V1, par, drv,
