@@ -97,6 +97,7 @@ def _constraint(res, diag, stride_limit=MAX_SAMPLES):
 
 def _energy_terms(res):
     """(T + V, D, P_applied) at the samples, or (None, reason)."""
+    from ..model.element_specs import Bushing
     from ..model.forces import Force, Torque
     from ..system.force_elements import evaluator
     from .energy import dissipation_power
@@ -112,8 +113,8 @@ def _energy_terms(res):
             return None, f"energy balance not checked: element '{e.name}' has no energy bookkeeping"
         if getattr(ev, "needs_lambda", False):
             return None, f"energy balance not checked: friction '{e.name}' needs the multipliers"
-        kt = getattr(e, "stiffness", None) if type(e).__name__ == "Bushing" else None
-        if kt is not None and np.ptp(np.asarray(kt, float)[3:]) > 1e-12 * np.max(np.asarray(kt, float)[3:]):
+        kt = np.asarray(e.stiffness, float)[3:] if isinstance(e, Bushing) else None
+        if kt is not None and np.ptp(kt) > 1e-12 * np.max(kt):
             return None, (f"energy balance not checked: bushing '{e.name}' has unequal rotational stiffnesses "
                           "(Adams' small-angle BUSHING torque -K a is not conservative for finite rotations)")
     T, V = res.kinetic_energy(), res.potential_energy()

@@ -63,18 +63,26 @@ def notify(progress, t, build=None) -> None:
         offer(build)
 
 
+def _arrow_columns(cols: dict) -> list:
+    """{column name: 1-D float array} as Arrow float64 arrays over the same buffers (no copy for
+    contiguous float arrays; pa.array on numpy would import pandas); ValueError for another shape."""
+    import pyarrow as pa
+    out = []
+    for name, v in cols.items():
+        x = np.ascontiguousarray(v, dtype=float)
+        if x.ndim != 1:
+            raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
+        out.append(pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)]))
+    return out
+
+
 def write_parquet(cols: dict, path) -> None:
     """Write {column name: 1-D float array} as a Parquet file with pyarrow alone: the arrays are wrapped as
     Arrow buffers (pa.array / pa.table on numpy arrays would import pandas, ~75 MB resident, which
     nothing on the writing path needs). pandas.read_parquet reads the file."""
     import pyarrow as pa
     import pyarrow.parquet as pq
-    arrays = []
-    for name, v in cols.items():
-        x = np.ascontiguousarray(v, dtype=float)
-        if x.ndim != 1:
-            raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
-        arrays.append(pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)]))
+    arrays = _arrow_columns(cols)
     # float columns: dictionary pages only cost memory (~4 MB) and space (nearly every value is distinct)
     table = pa.Table.from_arrays(arrays, names=list(cols)).replace_schema_metadata(MARKER)
     pq.write_table(table, path, use_dictionary=False)
@@ -89,11 +97,7 @@ def write_csv(cols: dict, fh, header: bool = True) -> None:
     import pyarrow.compute as pc
     import pyarrow.csv as pcsv
     arrays = []
-    for name, v in cols.items():
-        x = np.ascontiguousarray(v, dtype=float)
-        if x.ndim != 1:
-            raise ValueError(f"column {name!r}: expected a 1-D array, got shape {x.shape}")
-        a = pa.Array.from_buffers(pa.float64(), len(x), [None, pa.py_buffer(x)])
+    for a in _arrow_columns(cols):
         text = pc.cast(a, pa.string())
         integral = pc.and_(pc.equal(pc.floor(a), a), pc.less(pc.abs(a), 1e15))
         arrays.append(pc.if_else(integral, pc.binary_join_element_wise(text, ".0", ""), text))
@@ -137,20 +141,27 @@ def check_replaceable(path: Path, entity: str = "simulate") -> None:
                          "results tables); choose a new path or remove the file")
 
 
+def out_file(path, entity: str = "simulate") -> Path:
+    """`path` as the results file of an analysis: a .parquet or .csv path that is not a directory and
+    that mbdsim may replace (check_replaceable); ModelError naming entity.out otherwise."""
+    try:
+        out = Path(os.fspath(path))
+    except TypeError:
+        raise ModelError(entity, "out", f"expected a file path, got {path!r}") from None
+    if out.suffix.lower() not in SUFFIXES:
+        raise ModelError(entity, "out", f"{str(out)!r}: expected a .parquet or .csv file")
+    if out.is_dir():
+        raise ModelError(entity, "out", f"{str(out)!r} is a directory")
+    check_replaceable(out, entity)
+    return out
+
+
 class ResultFile:
     """The results table of one run, rewritten on disk as the run goes (see the module docstring)."""
 
     def __init__(self, path, entity="simulate", markers=False):
         self.markers = markers     # marker columns: results.export.marker_targets
-        try:
-            self.path = Path(os.fspath(path))
-        except TypeError:
-            raise ModelError(entity, "out", f"expected a file path, got {path!r}") from None
-        if self.path.suffix.lower() not in SUFFIXES:
-            raise ModelError(entity, "out", f"{str(self.path)!r}: expected a .parquet or .csv file")
-        if self.path.is_dir():
-            raise ModelError(entity, "out", f"{str(self.path)!r} is a directory")
-        check_replaceable(self.path, entity)
+        self.path = out_file(path, entity)
         self.last, self.cost, self.build, self.writes = time.monotonic(), 0.0, None, 0
 
     def offer(self, build) -> None:

@@ -155,7 +155,7 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         from .assembly_large import why_dense
         raise AssemblyError(f"assembly of {sys.nbody} bodies ({sys.nv} velocity variables, {sys.nc} constraint "
                             f"equations) needs dense matrices of {8.0 * sys.nv * sys.nc / 2**30:.1f} GB "
-                            f"here because {why_dense(sys, q0, v0, t, tol)}; a large model assembles without "
+                            f"here because {why_dense(sys)}; a large model assembles without "
                             "them when its joints form a tree, it is drawn assembled with consistent "
                             "velocities and no joint initial values are given", time=float(t))
     rows_all = sys.fixed_rows   # friction locks: run time

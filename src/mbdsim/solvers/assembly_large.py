@@ -51,16 +51,13 @@ def compact_to_csr(sys, Jc, bi, bj):
 
 def consistent_tree(sys, q0, v0, t, tol):
     """(rows, phi) when the state (q0, v0) at t needs no assembly (see the module docstring), else None."""
-    if sys.nv <= DENSE_LIMIT or not sys.kernel_rows or len(sys.lock_rows):
+    if sys.nv <= DENSE_LIMIT:
         return None
-    if not sys.nc:   # free bodies: every given state is consistent
+    if not sys.nc and sys.kernel_rows and not len(sys.lock_rows):   # free bodies: any given state is consistent
         return np.arange(0), np.zeros(0)
-    if any(jt.initial_displacement is not None or jt.initial_velocity is not None
-           for jt in sys.model.joints.values()):
+    if structural_reason(sys) is not None:
         return None
-    _, tree, loop, blocks = _tree_plan(sys)
-    if len(loop) or len(tree) != sys.nc or blocks is None:
-        return None
+    blocks = _tree_plan(sys)[3]
     phi, J, nu, _, Jc = sparse_terms(sys, q0, v0, t)
     scale = max(1.0, float(np.max(np.abs(J.data), initial=0.0)))
     if np.max(np.abs(phi), initial=0.0) > tol or \
@@ -75,8 +72,8 @@ def consistent_tree(sys, q0, v0, t, tol):
     return np.arange(sys.nc), phi
 
 
-def why_dense(sys, q0, v0, t, tol) -> str:
-    """Why `consistent_tree` did not take the state (words for the error of a too-large dense assembly)."""
+def structural_reason(sys) -> str | None:
+    """Why the model itself (whatever its state) cannot take `consistent_tree`, in words, or None."""
     if not sys.kernel_rows or len(sys.lock_rows):
         return "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
     if any(jt.initial_displacement is not None or jt.initial_velocity is not None
@@ -85,4 +82,10 @@ def why_dense(sys, q0, v0, t, tol) -> str:
     _, tree, loop, blocks = _tree_plan(sys)
     if len(loop) or len(tree) != sys.nc or blocks is None:
         return "its joints close loops"
-    return "the bodies are not drawn in an assembled configuration with consistent velocities"
+    return None
+
+
+def why_dense(sys) -> str:
+    """Why `consistent_tree` did not take a large system's state (words for the error of a too-large
+    dense assembly)."""
+    return structural_reason(sys) or "the bodies are not drawn in an assembled configuration with consistent velocities"

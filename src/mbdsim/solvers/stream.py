@@ -104,13 +104,7 @@ class CsvFile:
     An existing file is replaced only when mbdsim wrote it (results.stream.check_replaceable)."""
 
     def __init__(self, out):
-        try:
-            self.path = Path(out)
-        except TypeError:
-            raise ModelError("simulate", "out", f"expected a path, got {out!r}") from None
-        if self.path.is_dir():
-            raise ModelError("simulate", "out", f"{str(self.path)!r} is a directory")
-        results_stream.check_replaceable(self.path)
+        self.path = results_stream.out_file(out)
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
             self.path.write_bytes(b"")

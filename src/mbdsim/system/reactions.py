@@ -60,7 +60,7 @@ def joint_reaction(sys, q, lambda_, joint, on=None, A=None, J=None, fr=None):
     if J is None:
         fr = body_frames(sys, np.atleast_2d(q)) if fr is None else fr
         blocks = jacobian_blocks(sys, fr, rows)
-        A = fr.A if A is None else A
+        A = fr.A if A is None else A   # (fr made here when none was given)
         if blocks is None:
             J = jacobians(sys, q)
             keep_jacobians(sys, lambda_, J)
