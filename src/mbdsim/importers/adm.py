@@ -20,6 +20,7 @@ from ..errors import ModelFileError
 from . import adm_forces as forces
 from . import adm_joints as joints
 from . import adm_parts as parts
+from . import adm_spline
 from .adm_context import AdmImport
 from .adm_lexer import read_statements
 
@@ -31,13 +32,13 @@ __all__ = ["from_adm", "IGNORED", "REFUSED"]
 
 # read but without effect on the model (analysis settings, outputs): noted
 IGNORED = ("REQUEST", "OUTPUT", "RESULTS", "INTEGRATOR", "KINEMATICS", "EQUILIBRIUM", "IC", "DEBUG", "LSOLVER",
-           "PREFERENCES", "ENVIRONMENT", "STRING", "ARRAY", "SPLINE", "MATRIX", "SENSOR", "LIST", "NOLIST",
+           "PREFERENCES", "ENVIRONMENT", "STRING", "ARRAY", "MATRIX", "SENSOR", "LIST", "NOLIST",
            "SECTION", "MATERIAL", "UNITS_CONSISTENCY")
 # Adams statements mbdsim cannot represent: refused with the file and line
 REFUSED = ("BEAM", "NFORCE", "CVCV", "PTCV", "FLEX_BODY", "POINT_MASS", "GCON", "UCON", "CLEARANCE", "MFORCE",
            "CURVE", "SURFACE", "DIFF", "GSE", "LSE", "TFSISO", "PINPUT", "POUTPUT", "FE_PART", "FE_LOAD",
            "MODAL_FORCE", "FEMDATA", "MREQUEST", "USER", "CBKSUB")
-ORDER = ("UNITS", "VARIABLE", "PART", "MARKER", "ACCGRAV", "GRAPHICS", "JOINT", "JPRIM", "COUPLER", "GEAR", "MOTION",
+ORDER = ("UNITS", "SPLINE", "VARIABLE", "PART", "MARKER", "ACCGRAV", "GRAPHICS", "JOINT", "JPRIM", "COUPLER", "GEAR", "MOTION",
          "SFORCE", "SPRINGDAMPER", "BUSHING", "FIELD", "VFORCE", "VTORQUE", "GFORCE", "FRICTION", "CONTACT")
 
 
@@ -93,6 +94,8 @@ def _build(imp, by_name) -> None:
     get = lambda name: list(by_name.get(name, {}).values())   # noqa: E731
     for st in get("UNITS")[:1]:
         parts.units(imp, st)
+    for st in get("SPLINE"):
+        adm_spline.spline(imp, st)
     for st in get("VARIABLE"):
         parts.variable(imp, st)
     parts.parts_and_markers(imp, by_name.get("PART", {}), by_name.get("MARKER", {}))

@@ -70,6 +70,7 @@ class AdmImport:
     floating: set = field(default_factory=set)         # ids of floating markers
     joints: dict = field(default_factory=dict)         # joint id -> Joint (JOINT and JPRIM share ids? no: own)
     variables: dict = field(default_factory=dict)      # VARIABLE id -> (text, line)
+    splines: dict = field(default_factory=dict)        # SPLINE id -> (xs, ys, linear extrapolation)
     notes: list = field(default_factory=list)
     names: set = field(default_factory=set)
 
@@ -195,8 +196,10 @@ class AdmImport:
         text = a.values[0]
         if re.match(r"\s*USER\s*\(", text, re.IGNORECASE):
             self.fail(st, key, "USER(...) calls a compiled user subroutine, which mbdsim does not run", a.line)
+        from .adm_spline import table_name
+        spline = None if time_name == "t" else (lambda sid, kind: table_name(self, st, a.line, sid, kind))
         ctx = Context(st.label, self.source, a.line, self.marker_ref(st, a.line), self.variables,
-                      self.units.length, self.units.time, time_name)
+                      self.units.length, self.units.time, time_name, spline)
         out = translate(text, ctx)
         s = self.units.scale(quantity)
         return out if s == 1.0 else f"{s!r}*({out})"

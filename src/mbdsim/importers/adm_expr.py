@@ -10,7 +10,9 @@ ModelFileError naming the statement, the file and the line.
 Supported: + - * / ** and parentheses; numbers (1.5E3, 1.5D3, 90D = 90 degrees in rad); PI, DTOR,
 RTOD, TIME; ABS ACOS ASIN ATAN ATAN2 COS COSH EXP LOG LOG10 SIN SINH SQRT TAN TANH SIGN MIN MAX DIM;
 STEP STEP5 HAVSIN POLY SHF IMPACT BISTOP; DX DY DZ DM VX VY VZ VM VR WX WY WZ WM AX AY AZ ACCX ACCY
-ACCZ (markers by id, 0 = ground; reference frames other than ground are refused); VARVAL.
+ACCZ (markers by id, 0 = ground; reference frames other than ground are refused); VARVAL; IF and MOD
+(lowered to sign/abs/atan2/STEP: no new operation); AKISPL and CUBSPL of a SPLINE (mbdsim tables, in
+load functions; adm_spline).
 """
 from __future__ import annotations
 
@@ -22,7 +24,7 @@ from typing import Callable
 from ..errors import ModelFileError
 
 _TOKEN = re.compile(r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[EeDd][+-]?\d+)?[Dd]?)|(?P<id>[A-Za-z_][A-Za-z0-9_]*)"
-                    r"|(?P<op>\*\*|[-+*/(),]))")
+                    r"|(?P<op>\*\*|[-+*/(),:]))")
 MATH = {n: n.lower() for n in ("ABS", "ACOS", "ASIN", "ATAN", "ATAN2", "COS", "COSH", "EXP", "LOG", "SIN", "SINH",
                                "SQRT", "TAN", "TANH")}
 LIBRARY = ("STEP", "STEP5", "HAVSIN", "POLY", "SHF", "IMPACT", "BISTOP")
@@ -49,6 +51,7 @@ class Context:
     length: float = 1.0
     time: float = 1.0
     time_name: str = "TIME"
+    spline: Callable[[int, str], str] | None = None   # (SPLINE id, "AKISPL"/"CUBSPL") -> table name
     _active: set = field(default_factory=set)
 
     def fail(self, message: str, fld: str = "FUNCTION"):
@@ -102,7 +105,10 @@ def _expr(toks, k, ctx, stop=()):
             k += 1
         elif kind == "id":
             name = val.upper()
-            if k + 1 < len(toks) and toks[k + 1] == ("op", "("):
+            if name == "IF" and k + 1 < len(toks) and toks[k + 1] == ("op", "("):
+                text, k = _if(toks, k + 2, ctx)
+                parts.append(text)
+            elif k + 1 < len(toks) and toks[k + 1] == ("op", "("):
                 args, k = _args(toks, k + 2, ctx)
                 parts.append(_call(name, args, ctx))
             else:
@@ -114,7 +120,7 @@ def _expr(toks, k, ctx, stop=()):
                 ctx.fail("unbalanced parentheses: a '(' is not closed")
             parts.append(f"({inner})")
             k += 1
-        elif val in (")", ","):
+        elif val in (")", ",", ":"):
             ctx.fail(f"unexpected {val!r} in the function expression")
         else:
             parts.append(val)
@@ -164,13 +170,69 @@ def _call(name, args, ctx):
                 "DIM": f"(0.5*(({x}) - ({y}) + abs(({x}) - ({y}))))"}[name]
     if name in LIBRARY:
         return f"{name}({', '.join(a)})"
+    if name == "MOD":
+        _arity(name, a, 2, ctx)
+        return _mod(*a)
+    if name in ("AKISPL", "CUBSPL"):
+        return _spline(name, args, ctx)
     if name in MEASURES:
         return _measure(name, args, ctx)
     if name == "VARVAL":
         return _varval(args, ctx)
-    known = sorted([*MATH, "LOG10", "MIN", "MAX", "SIGN", "DIM", *LIBRARY, *MEASURES, "VARVAL"])
+    known = sorted([*MATH, "LOG10", "MIN", "MAX", "SIGN", "DIM", *LIBRARY, *MEASURES, "VARVAL", "IF", "MOD",
+                    "AKISPL", "CUBSPL"])
     ctx.fail(f"unknown or unsupported function {name!r} in the function expression (mbdsim reads: "
              f"{', '.join(known)})")
+
+
+def _if(toks, k, ctx):
+    """IF(e1: e2, e3, e4) (tokens from k, after its '('): e2 where e1 < 0, e3 where e1 = 0, e4 where
+    e1 > 0, written with the indicators 0.5(|s| - s), 1 - |s|, 0.5(|s| + s) of s = sign(e1), which are
+    exactly 0 or 1: the chosen branch's value is returned to the last bit (the others must be finite)."""
+    cond, k = _expr(toks, k, ctx, (":", ")", ","))
+    if k >= len(toks) or toks[k][1] != ":":
+        ctx.fail("IF is written IF(expression1: expression2, expression3, expression4)")
+    args, k = _args(toks, k + 1, ctx)
+    if len(args) != 3:
+        ctx.fail(f"IF takes three expressions after the ':', got {len(args)}")
+    e2, e3, e4 = (t for t, _ in args)
+    s = f"sign({cond})"
+    return (f"(0.5*(abs({s}) - {s})*({e2}) + (1 - abs({s}))*({e3}) + 0.5*(abs({s}) + {s})*({e4}))", k)
+
+
+MOD_BLEND = 1e-10   # MOD's jump at a multiple of b is blended over this fraction of |b| (see _mod)
+
+
+def _mod(a, b):
+    """Fortran MOD(a, b) = a - b*int(a/b) (the sign of a, magnitude below |b|) without a floor operation:
+    c = |b|/(2 pi) atan2(sin psi, cos psi), psi = 2 pi |a|/|b|, is |a| modulo |b| centred in
+    (-|b|/2, |b|/2]; adding |b| where c < 0 (a STEP of width MOD_BLEND*|b|, so that a rounding residue of
+    an exact multiple still reads 0) gives |a| mod |b| in [0, |b|); times sign(a).  Exact to about
+    1e-16 |a| away from the multiples of b; within MOD_BLEND*|b| below one, blended."""
+    P = f"abs({b})"
+    c = f"({P}/(2*pi)*atan2(sin(2*pi*abs({a})/{P}), cos(2*pi*abs({a})/{P})))"
+    return f"(sign({a})*({c} + {P}*STEP(-{c}, 0, 0, {MOD_BLEND!r}*{P}, 1)))"
+
+
+def _spline(name, args, ctx):
+    """AKISPL / CUBSPL(x, z, id[, iord]) -> a call of the SPLINE's table (z: one curve, ignored as Adams does)."""
+    if ctx.spline is None:
+        ctx.fail(f"{name} is not supported in a MOTION function (a spline of time): mbdsim reads splines in "
+                 "force and VARIABLE functions")
+    if len(args) not in (3, 4):
+        ctx.fail(f"{name} takes (x, z, id[, iord]), got {len(args)} argument(s)")
+    raw = args[2][1]
+    if len(raw) != 1 or not raw[0][1].isdigit():
+        ctx.fail(f"{name}: the third argument is a SPLINE id (an integer), got {' '.join(v for _, v in raw)!r}")
+    sid = int(raw[0][1])
+    order = 0
+    if len(args) == 4:
+        raw = args[3][1]
+        if len(raw) != 1 or raw[0][1] not in ("0", "1", "2"):
+            ctx.fail(f"{name}: iord must be 0, 1 or 2, got {' '.join(v for _, v in raw)!r}")
+        order = int(raw[0][1])
+    table = ctx.spline(sid, name)
+    return f"{table}({args[0][0]}, order={order})" if order else f"{table}({args[0][0]})"
 
 
 def _arity(name, a, n, ctx):
@@ -213,5 +275,5 @@ def _varval(args, ctx):
         ctx.fail(f"VARVAL({vid}): the VARIABLEs refer to each other in a loop")
     text, line = ctx.variables[vid]
     sub = Context(f"VARIABLE/{vid}", ctx.source, line, ctx.marker, ctx.variables, ctx.length, ctx.time,
-                  ctx.time_name, ctx._active | {vid})
+                  ctx.time_name, ctx.spline, ctx._active | {vid})
     return f"({translate(text, sub)})"

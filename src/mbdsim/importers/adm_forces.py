@@ -4,8 +4,8 @@ SFORCE TRANSLATIONAL: a line force (positive repels, as in Adams); ACTIONONLY: a
 SFORCE ROTATIONAL / SPRINGDAMPER ROTATIONAL: a torque on I about J's z and its reaction on J.
 SPRINGDAMPER TRANSLATIONAL: a spring-damper (FORCE is the preload, repelling positive).  BUSHING:
 mbdsim's bushing (Adams semantics; rotations as a rotation vector, equal to Adams' small angles to
-first order).  FIELD: diagonal matrices without free-length offsets in rotation -> a bushing;
-otherwise refused.  VFORCE/VTORQUE/GFORCE: expression components in the RM marker's axes on I, the
+first order).  FIELD (matrices by columns): diagonal -> a bushing; coupled -> expression loads of the
+same linear law (field_loads).  VFORCE/VTORQUE/GFORCE: expression components in the RM marker's axes on I, the
 reaction on the JFLOAT marker's part at I's current position (as a force at the floating marker's
 initial point plus the moment of the offset).  FRICTION: mbdsim's event-driven joint friction (the
 stiction transition parameters are approximated by exact stick/slip).  CONTACT: sphere-sphere and
@@ -110,29 +110,56 @@ def bushing(imp, st) -> None:
 
 
 def field(imp, st) -> None:
-    """FIELD/id, I=, J=, KMATRIX (36), CMATRIX (36) or CRATIO, LENGTH (6), FORCE (6): diagonal -> bushing."""
+    """FIELD/id, I=, J=, KMATRIX (36), CMATRIX (36) or CRATIO, LENGTH (6), FORCE (6); the matrices are given
+    by columns, as Adams reads them.  Diagonal: a bushing; coupled (off-diagonal terms): the same linear
+    law written as expression loads on I in J's axes (field_loads)."""
+    if "FUNCTION" in [x.key for x in st.args]:
+        imp.fail(st, "FUNCTION", "a FIELD written by a user subroutine (FIESUB) is not supported")
     a, _ = imp.args(st, ("I", "J", "KMATRIX", "CMATRIX", "CRATIO", "LENGTH", "FORCE"), ignored=("ROUTINE",))
     mi, mj = imp.marker(st, a, "I"), imp.marker(st, a, "J")
-    K = np.array(imp.nums(st, a, "KMATRIX", 36, [0.0] * 36)).reshape(6, 6)
-    C = np.array(imp.nums(st, a, "CMATRIX", 36, [0.0] * 36)).reshape(6, 6)
+    K = np.array(imp.nums(st, a, "KMATRIX", 36, [0.0] * 36)).reshape(6, 6).T     # by columns
+    C = np.array(imp.nums(st, a, "CMATRIX", 36, [0.0] * 36)).reshape(6, 6).T
     if "CRATIO" in a:
         C = imp.num(st, a, "CRATIO") * K
-    off = lambda M: M - np.diag(np.diag(M))   # noqa: E731
-    if np.any(off(K)) or np.any(off(C)):
-        imp.fail(st, "KMATRIX" if np.any(off(K)) else "CMATRIX", "a FIELD with coupling (off-diagonal) terms is "
-                 "not supported; mbdsim reads diagonal FIELDs as bushings")
-    L = imp.nums(st, a, "LENGTH", 6, [0.0] * 6)
-    # SI: translational rows in length units, rotational in rad
+    L = np.array(imp.nums(st, a, "LENGTH", 6, [0.0] * 6))
+    # SI: translational rows in force, rotational in torque; columns in length or rad (and per time for C)
     su = np.array([imp.units.scale("force")] * 3 + [imp.units.scale("torque")] * 3)
     du = np.array([imp.units.length] * 3 + [1.0] * 3)
-    k, c = np.diag(K) * su / du, np.diag(C) * su / du * imp.units.time
+    K, C = K * su[:, None] / du[None, :], C * su[:, None] / du[None, :] * imp.units.time
+    L = L * du
     f0 = np.array(imp.nums(st, a, "FORCE", 6, [0.0] * 6)) * su
-    preload = f0 + k * np.array(L) * du    # -K (x - L) + F0 = -K x + (F0 + K L)
+    name = imp.name(st, f"FIELD_{st.id}")
+    off = lambda M: M - np.diag(np.diag(M))   # noqa: E731
     try:
-        imp.model.add_bushing(imp.name(st, f"FIELD_{st.id}"), mj, mi, k, c, preload)
+        if np.any(off(K)) or np.any(off(C)):
+            field_loads(imp, st, name, mi, mj, K, C, L, f0)
+            imp.note(st, "coupled FIELD read as expression loads: rotations as AX/AY/AZ(I, J) (Adams' small "
+                     "angles), translational velocity as seen in J's frame")
+            return
+        k, c = np.diag(K), np.diag(C)
+        imp.model.add_bushing(name, mj, mi, k, c, f0 + k * L)    # -K (x - L) + F0 = -K x + (F0 + K L)
     except ModelError as exc:
         imp.model_error(st, exc)
     imp.note(st, "diagonal FIELD read as a bushing (rotations as a rotation vector)")
+
+
+def field_loads(imp, st, name, mi, mj, K, C, L, f0) -> None:
+    """F = -K (x - L) - C xdot + F0 on I (SI, J's axes): x = (DX DY DZ)(I, J, J), AX AY AZ(I, J); xdot =
+    the velocity of I relative to J as seen in J's frame (VX(I, J, J) - (w_J x r)) and WX WY WZ(I, J, J).
+    The reaction on J's part, with the moment of the offset, by _pair_loads (exact action-reaction)."""
+    i, j = f"{mi.body.name}.{mi.name}", f"{mj.body.name}.{mj.name}"
+    r = [f"D{c}({i}, {j}, {j})" for c in "XYZ"]
+    wj = [f"W{c}({j}, ground, {j})" for c in "XYZ"]
+    x = r + [f"A{c}({i}, {j})" for c in "XYZ"]
+    v = [f"(V{c}({i}, {j}, {j}) - ({wj[(n + 1) % 3]}*{r[(n + 2) % 3]} - {wj[(n + 2) % 3]}*{r[(n + 1) % 3]}))"
+         for n, c in enumerate("XYZ")] + [f"W{c}({i}, {j}, {j})" for c in "XYZ"]
+    rows = []
+    for n in range(6):
+        terms = [f"{f0[n] + K[n] @ L!r}"]
+        terms += [f"({-K[n, m]!r})*{x[m]}" for m in range(6) if K[n, m] != 0.0]
+        terms += [f"({-C[n, m]!r})*{v[m]}" for m in range(6) if C[n, m] != 0.0]
+        rows.append(" + ".join(terms))
+    _pair_loads(imp, st, name, mi, mj, mj, rows[:3], rows[3:])
 
 
 def vector_force(imp, st) -> None:

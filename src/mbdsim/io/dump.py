@@ -286,6 +286,9 @@ def model_to_dict(model) -> dict:
     d["sensors"] = [_sensor(s) for s in getattr(model, "sensors", {}).values()]
     d["inputs"] = [{"name": i.name, "value": i.value} for i in getattr(model, "inputs", {}).values()]
     d["outputs"] = [{"name": o.name, "expression": o.text} for o in getattr(model, "outputs", {}).values()]
+    for name in getattr(model, "tables", {}):      # spline tables (Adams SPLINE): no model-file section yet
+        raise ModelError(f"table '{name}'", "tables", "spline tables (read from an Adams SPLINE) cannot be stored "
+                         "in a model file yet: simulate the imported model directly")
     for f in getattr(model, "fmus", {}).values():   # an FMU is code: model files never carry (and run) one
         raise ModelError(f"fmu '{f.name}'", "path", "an FMU runs its own code, so model files do not carry FMUs; "
                          "store the model without it and add it after loading (Model.add_fmu)")

@@ -188,7 +188,7 @@ def parse_load(model, text, entity, field, allow_acc=False) -> LoadExpr:
     hook = _Hook(model, allow_acc)
     inputs = [v for v in getattr(model, "inputs", {}) if v not in reserved and v not in joints]
     try:
-        e = parse(text, (*TIME_NAMES, *joints, *inputs), measures=hook)
+        e = parse(text, (*TIME_NAMES, *joints, *inputs), measures=hook, tables=getattr(model, "tables", None))
     except (ExpressionError, ValueError) as exc:
         raise ModelError(entity, field, f"{exc} (measures: {', '.join(MEASURE_KIND)} of bodies and "
                          f"body.marker; variables: t, TIME, the joints {', '.join(joints) or '(none)'}"
