@@ -148,3 +148,178 @@ JOINT/2, TRANSLATIONAL, I=30, J=11, ICTRAN=10, -50
     t = res.time
     assert np.abs(res.joint_coordinate("JOINT_1") - (0.3 + 2 * t)).max() < 1e-9
     assert np.abs(res.joint_coordinate("JOINT_2") - (0.01 - 0.05 * t)).max() < 1e-9
+
+
+# ---------------------------------------------------------------- FIELD
+K6 = np.array([[2000.0, 300.0, -100.0, 0, 0, 0], [-500.0, 1500.0, 200.0, 0, 0, 0],
+               [100.0, 0.0, 3000.0, 0, 0, 0], [0, 0, 0, 10.0, 1.0, 0], [0, 0, 0, 0, 10.0, 0], [0, 0, 0, 0, 0, 10.0]])
+C6 = np.array([[2.0, 0.5, 0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0], [-0.3, 0, 3.0, 0, 0, 0], [0] * 6, [0] * 6, [0] * 6])
+
+
+def _by_columns(M):
+    return ", ".join(repr(float(v)) for v in np.asarray(M).T.ravel())
+
+
+def test_coupled_field_translation_against_its_linear_equations(tmp_path):
+    """A FIELD with off-diagonal (and unsymmetric) K and C between a part and a turned ground marker, the
+    part's orientation held (JPRIM ORIENTATION), LENGTH and FORCE preloads: m x'' = R (-K (R^T x - L) -
+    C R^T x' + F0) in the J marker's axes R, integrated by scipy; the matrices given by columns."""
+    L, F0 = [0.01, 0.0, -0.02, 0, 0, 0], [5.0, -3.0, 0.0, 0, 0, 0]
+    m = adm(tmp_path, f"""
+PART/1, GROUND
+MARKER/10, PART=1, REULER=30D, 20D, 0
+PART/2, MASS=1.5, CM=20, IP=0.01, 0.01, 0.01
+MARKER/20, PART=2, REULER=30D, 20D, 0
+JPRIM/1, ORIENTATION, I=20, J=10
+FIELD/1, I=20, J=10, KMATRIX={_by_columns(K6)}
+, CMATRIX={_by_columns(C6)}, LENGTH={', '.join(map(str, L))}, FORCE={', '.join(map(str, F0))}
+""")
+    assert any("coupled FIELD" in n for n in m.import_notes)
+    R = _rz(np.radians(30)) @ np.array([[1, 0, 0], [0, np.cos(np.radians(20)), -np.sin(np.radians(20))],
+                                          [0, np.sin(np.radians(20)), np.cos(np.radians(20))]])
+    K, C = K6[:3, :3], C6[:3, :3]
+
+    def rhs(t, y):
+        x, v = y[:3], y[3:]
+        f = R @ (-K @ (R.T @ x - L[:3]) - C @ (R.T @ v) + F0[:3])
+        return np.concatenate([v, f / 1.5])
+    res = mb.simulate(m, 0.3, output_step=0.01, rtol=1e-11, atol=1e-13)
+    ref = solve_ivp(rhs, (0, 0.3), np.zeros(6), method="DOP853", rtol=1e-12, atol=1e-14, t_eval=res.time).y[:3].T
+    err = np.abs(res.position("PART_2") - ref).max()
+    assert err < 1e-9, err
+    assert np.ptp(ref, axis=0).max() > 5e-3
+
+
+@pytest.mark.filterwarnings("ignore::mbdsim.MonitorWarning")   # an unsymmetric K does work: no energy balance
+def test_coupled_field_between_free_parts_conserves_momentum(tmp_path):
+    """Two free parts joined by a coupled FIELD (rotational coupling too), no gravity: the loads are an exact
+    action-reaction pair (force and moment about a common point), so linear and angular momentum stay."""
+    m = adm(tmp_path, f"""
+PART/1, GROUND
+PART/2, MASS=1.0, CM=20, IP=0.02, 0.03, 0.04, VX=0.2, WZ=1.0
+MARKER/20, PART=2
+PART/3, MASS=2.0, CM=30, IP=0.05, 0.04, 0.03, QG=0.3, 0.1, 0
+MARKER/30, PART=3
+MARKER/31, PART=3, QP=-0.2, 0, 0, REULER=10D, 0, 0
+FIELD/1, I=20, J=31, KMATRIX={_by_columns(K6)}
+, CMATRIX={_by_columns(C6)}
+""")
+    res = mb.simulate(m, 0.3, output_step=0.05, rtol=1e-11, atol=1e-13)
+    P = sum(mb_.mass * res.velocity(n) for n, mb_ in ((n, m.bodies[n]) for n in ("PART_2", "PART_3")))
+    H = 0
+    for n in ("PART_2", "PART_3"):
+        b = m.bodies[n]
+        Rb = res.orientation(n)
+        J = np.asarray(b.inertia)
+        Hs = np.einsum("kij,jl,kml,km->ki", Rb, J, Rb, res.angular_velocity(n))
+        H = H + Hs + b.mass * np.cross(res.position(n), res.velocity(n))
+    assert np.abs(P - P[0]).max() < 1e-9 and np.abs(H - H[0]).max() < 1e-9
+    assert np.ptp(res.angular_velocity("PART_2")[:, 2]) > 1e-3
+
+
+# ---------------------------------------------------------------- SPLINE, IF, MOD
+def test_akispl_of_linear_data_is_a_linear_spring(tmp_path):
+    """SFORCE = -AKISPL(DZ(I, J, J), 0, 5) [N of mm] on linear data y = 20 x (20 N/mm, beyond the data by
+    Adams' end parabola, here a line): a harmonic oscillator, z = z0 cos(w t) with w = sqrt(20000/2)."""
+    m = adm(tmp_path, """
+UNITS/FORCE=NEWTON, MASS=KILOGRAM, LENGTH=MILLIMETER, TIME=SECOND
+PART/1, GROUND
+MARKER/11, PART=1
+PART/2, MASS=2, CM=20, IP=1000, 1000, 1000
+MARKER/20, PART=2
+MARKER/21, PART=2
+JOINT/1, TRANSLATIONAL, I=21, J=11, ICTRAN=5, 0
+SPLINE/5, X=-10, -4, 0, 1, 3, 10, Y=-200, -80, 0, 20, 60, 200
+SFORCE/1, TRANSLATIONAL, ACTIONONLY, I=21, J=11, FUNCTION=-AKISPL(DZ(21,11,11), 0, 5)
+""")
+    assert "AKISPL_5" in m.tables
+    res = mb.simulate(m, 0.1, output_step=0.005, rtol=1e-11, atol=1e-13)
+    w = np.sqrt(20000.0 / 2.0)
+    err = np.abs(res.joint_coordinate("JOINT_1") - 0.005 * np.cos(w * res.time)).max()
+    assert err < 1e-9, err
+
+
+def test_spline_tables_interpolate_and_extrapolate_as_adams():
+    """CUBSPL (not-a-knot) reproduces cubic data exactly; beyond the data the parabola through the last
+    three points (LINEAR_EXTRAPOLATE: the line through the last two); derivatives by iord."""
+    from mbdsim.importers.adm_spline import AdamsSpline
+    xs = np.array([0.0, 1.0, 2.5, 3.0, 4.0])
+    f = lambda x: x ** 3 - 2 * x  # noqa: E731
+    sp = AdamsSpline(xs, f(xs), "CUBSPL")
+    x = np.linspace(0.1, 3.9, 17)
+    assert np.abs(sp(x) - f(x)).max() < 1e-12 and np.abs(sp(x, 1) - (3 * x ** 2 - 2)).max() < 1e-11
+    p = np.polyfit(xs[-3:], f(xs[-3:]), 2)
+    for xe in (4.5, 7.0, 20.0):
+        assert abs(sp(xe) - np.polyval(p, xe)) < 1e-9 * max(1, abs(np.polyval(p, xe)))
+    p = np.polyfit(xs[:3], f(xs[:3]), 2)
+    assert abs(sp(-3.0) - np.polyval(p, -3.0)) < 1e-10
+    lin = AdamsSpline(xs, f(xs), "AKISPL", linear=True)
+    slope = (f(4.0) - f(3.0)) / 1.0
+    assert abs(lin(6.0) - (f(4.0) + 2 * slope)) < 1e-10 and abs(lin(2.5) - f(2.5)) < 1e-12
+
+
+def _ctx():
+    return Context("SFORCE/1", "m.adm", 3, lambda i: "ground", {})
+
+
+@pytest.mark.parametrize("a, b", [(7.3, 2.0), (-7.3, 2.0), (7.3, -2.0), (-0.4, 0.3), (123.456, 0.7), (4.0, 2.0),
+                                  (6.0, 3.0), (-9.0, 3.0), (0.0, 1.5)])
+def test_mod_is_fortran_mod(a, b):
+    """MOD(a, b) = a - b*int(a/b) (np.fmod), exact multiples included."""
+    text = translate(f"MOD(TIME, {b})", _ctx())
+    got = mb.parse(text, ("TIME",))(a)
+    assert abs(got - np.fmod(a, b)) < 1e-12 * max(1.0, abs(a)), (got, np.fmod(a, b))
+
+
+def test_if_picks_its_branch_exactly():
+    text = translate("IF(TIME - 1: 1E20, -3, TIME**2)", _ctx())
+    e = mb.parse(text, ("TIME",))
+    for t in (0.0, 0.5, 1.0, 1.5, 3.0):
+        assert e(t) == (1e20 if t < 1 else -3.0 if t == 1 else t * t)
+
+
+def test_if_and_mod_drive_a_mass(tmp_path):
+    """F = IF(TIME - 0.1: 0, 0, 2) + MOD(TIME, 0.05)*40 [N] on 2 kg (no gravity): x'' integrated in closed
+    form piecewise (a sawtooth and a step)."""
+    m = adm(tmp_path, """
+PART/1, GROUND
+MARKER/11, PART=1
+PART/2, MASS=2, CM=20, IP=1, 1, 1
+MARKER/20, PART=2
+JOINT/1, TRANSLATIONAL, I=20, J=11
+SFORCE/1, TRANSLATIONAL, ACTIONONLY, I=20, J=11, FUNCTION=IF(TIME - 0.1: 0, 0, 2) + MOD(TIME, 0.05)*40
+""")
+    res = mb.simulate(m, 0.23, output_step=0.01, rtol=1e-11, atol=1e-13)
+    t = res.time
+
+    def x_exact(t):
+        P, n = 0.05, np.floor(t / 0.05)
+        # sawtooth s = t - nP: its double integral from 0 (each full period adds P^2/2 to the velocity)
+        tau = t - n * P
+        v_saw = n * P ** 2 / 2 + tau ** 2 / 2
+        x_saw = sum(((t - (k + 1) * P) * P ** 2 / 2 + P ** 3 / 6) for k in range(int(n))) + tau ** 3 / 6
+        step = np.where(t > 0.1, (t - 0.1) ** 2 / 2, 0.0) * 2
+        return 40 * x_saw / 2 + step / 2, v_saw
+    ref = np.array([x_exact(tt)[0] for tt in t])
+    err = np.abs(res.joint_coordinate("JOINT_1") - ref).max()
+    assert err < 1e-8, err
+
+
+def test_spline_in_a_motion_and_unknown_spline_are_refused(tmp_path):
+    base = """
+PART/1, GROUND
+MARKER/11, PART=1
+PART/2, MASS=2, CM=20, IP=1, 1, 1
+MARKER/20, PART=2
+JOINT/1, TRANSLATIONAL, I=20, J=11
+SPLINE/5, X=0, 1, 2, 3, Y=0, 1, 4, 9
+"""
+    with pytest.raises(ModelFileError, match=r"m.adm, line 8.*MOTION/1.*AKISPL.*not supported in a MOTION"):
+        adm(tmp_path, base + "MOTION/1, JOINT=1, FUNCTION=AKISPL(TIME, 0, 5)")
+    with pytest.raises(ModelFileError, match=r"line 8.*no SPLINE/6"):
+        adm(tmp_path, base + "SFORCE/1, TRANSLATIONAL, ACTIONONLY, I=20, J=11, FUNCTION=CUBSPL(TIME, 0, 6)")
+    with pytest.raises(ModelFileError, match=r"line 8.*IF is written"):
+        adm(tmp_path, base + "SFORCE/1, TRANSLATIONAL, ACTIONONLY, I=20, J=11, FUNCTION=IF(TIME, 1, 2, 3)")
+    m = adm(tmp_path, base + "SFORCE/1, TRANSLATIONAL, ACTIONONLY, I=20, J=11, FUNCTION=CUBSPL(TIME, 0, 5, 1)")
+    with pytest.raises(mb.ModelError, match="spline tables"):
+        mb.save_model(m, tmp_path / "out.yaml")

@@ -200,18 +200,19 @@ def _if(toks, k, ctx):
     return (f"(0.5*(abs({s}) - {s})*({e2}) + (1 - abs({s}))*({e3}) + 0.5*(abs({s}) + {s})*({e4}))", k)
 
 
-MOD_BLEND = 1e-10   # MOD's jump at a multiple of b is blended over this fraction of |b| (see _mod)
+MOD_BLEND = 1e-9    # MOD's jump at a multiple of b is blended over this fraction of |b| (see _mod)
 
 
 def _mod(a, b):
     """Fortran MOD(a, b) = a - b*int(a/b) (the sign of a, magnitude below |b|) without a floor operation:
     c = |b|/(2 pi) atan2(sin psi, cos psi), psi = 2 pi |a|/|b|, is |a| modulo |b| centred in
-    (-|b|/2, |b|/2]; adding |b| where c < 0 (a STEP of width MOD_BLEND*|b|, so that a rounding residue of
-    an exact multiple still reads 0) gives |a| mod |b| in [0, |b|); times sign(a).  Exact to about
-    1e-16 |a| away from the multiples of b; within MOD_BLEND*|b| below one, blended."""
+    (-|b|/2, |b|/2]; adding |b| where c < 0 (a STEP5 of width MOD_BLEND*|b|, whose cubic onset keeps the
+    rounding residue ~1e-16 |a| of an exact multiple at 0) gives |a| mod |b| in [0, |b|); times sign(a).
+    Exact to about 1e-16 |a| (while |a/b| < 1e4) except within MOD_BLEND*|b| below a multiple of b,
+    where the jump is blended."""
     P = f"abs({b})"
     c = f"({P}/(2*pi)*atan2(sin(2*pi*abs({a})/{P}), cos(2*pi*abs({a})/{P})))"
-    return f"(sign({a})*({c} + {P}*STEP(-{c}, 0, 0, {MOD_BLEND!r}*{P}, 1)))"
+    return f"(sign({a})*({c} + {P}*STEP5(-{c}, 0, 0, {MOD_BLEND!r}*{P}, 1)))"
 
 
 def _spline(name, args, ctx):

@@ -155,9 +155,9 @@ def field_loads(imp, st, name, mi, mj, K, C, L, f0) -> None:
          for n, c in enumerate("XYZ")] + [f"W{c}({i}, {j}, {j})" for c in "XYZ"]
     rows = []
     for n in range(6):
-        terms = [f"{f0[n] + K[n] @ L!r}"]
-        terms += [f"({-K[n, m]!r})*{x[m]}" for m in range(6) if K[n, m] != 0.0]
-        terms += [f"({-C[n, m]!r})*{v[m]}" for m in range(6) if C[n, m] != 0.0]
+        terms = [repr(float(f0[n] + K[n] @ L))]
+        terms += [f"({float(-K[n, m])!r})*{x[m]}" for m in range(6) if K[n, m] != 0.0]
+        terms += [f"({float(-C[n, m])!r})*{v[m]}" for m in range(6) if C[n, m] != 0.0]
         rows.append(" + ".join(terms))
     _pair_loads(imp, st, name, mi, mj, mj, rows[:3], rows[3:])
 
