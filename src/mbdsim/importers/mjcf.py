@@ -10,7 +10,7 @@ frames are exactly MuJoCo's.  Mapping (docs/import.md has the table):
   free                           -> no joint (a free body)
   ref                            -> the model is drawn at qpos0, so a joint coordinate is q - ref
   stiffness, springref, damping  -> torsion spring / joint force (hinge, slide), bushing (ball)
-  armature                       -> a rotor body (inertia = armature) coupled 1:1 to the joint
+  armature                       -> a massless ground rotor (inertia = armature) coupled 1:1 to the joint
   range (limited)                -> compliant stop;  frictionloss -> Coulomb joint friction
   equality joint / connect / weld-> coupler or user constraint / spherical joint / fixed joint (exact)
   motor actuator                 -> joint force gear * gain * ctrl (ctrl of the keyframe, else 0)
@@ -270,24 +270,16 @@ class _Builder:
             self.armature(jt, typ, float(mj.dof_armature[va]))
 
     def armature(self, jt, typ, a) -> None:
-        """A rotor on body_i turning (sliding) with the joint: kinetic energy a qdot^2 / 2 (exact when
-        body_i does not rotate; otherwise the rotor also adds a to body_i's rotational inertia)."""
+        """MuJoCo's armature adds `a` to the joint's diagonal of the mass matrix (kinetic energy a qdot^2 / 2,
+        whatever the parent body does): a massless rotor of inertia a [kg m^2] on a ground revolute, coupled
+        1:1 to the joint (1 rad per rad, or per m for a slide, whose armature is in kg): no gravity and no
+        coupling with the parent's rotation, so it matches mj_forward's qacc exactly."""
         model = self.model
         name = self.names.take(f"{jt.name}_rotor", "body")
-        if typ == HINGE:
-            rotor = model.add_body(name, mass=0.0, inertia=(a, a, a), position=jt.point)
-            rj = model.add_revolute(f"{name}_joint", jt.body_i, rotor, jt.point, jt.axis,
-                                    initial_displacement=jt.initial_displacement,
-                                    initial_velocity=jt.initial_velocity)
-        else:
-            rotor = model.add_body(name, mass=a, inertia=(0, 0, 0), position=jt.point)
-            rj = model.add_translational(f"{name}_joint", jt.body_i, rotor, jt.point, jt.axis,
-                                         initial_displacement=jt.initial_displacement,
-                                         initial_velocity=jt.initial_velocity)
+        rotor = model.add_body(name, mass=0.0, inertia=(a, a, a), position=jt.point)
+        rj = model.add_revolute(f"{name}_joint", model.ground, rotor, jt.point, jt.axis,
+                                initial_displacement=jt.initial_displacement, initial_velocity=jt.initial_velocity)
         model.add_coupler(f"{name}_coupler", jt, rj, 1.0)
-        if not jt.body_i.is_ground:
-            self.notes.append(f"joint {jt.name!r}: armature is a rotor on moving body {jt.body_i.name!r} "
-                              "(MuJoCo's armature is a joint-space inertia; equal when that body does not rotate)")
 
     def add_equalities(self) -> None:
         from .mjcf_equality import add_equality

@@ -3,8 +3,10 @@
   joint   y - y0 = a0 + a1 (x - x0) + ... + a4 (x - x0)^4  (y0, x0 = qpos0; mbdsim coordinates are
           q - qpos0): a coupler when only a1 is non-zero, else a user constraint; without joint2
           the coordinate is held at a0 (a motion)
-  connect the anchor points of body1 and body2 coincide: a spherical joint at the anchor
-  weld    body2 keeps its pose relative to body1 (as at qpos0): a fixed joint
+  connect the anchor points of body1 and body2 coincide: a spherical joint at the anchor; by sites:
+          a spherical joint between markers at site1 and site2 (their origins coincide)
+  weld    body2 keeps its pose relative to body1 (as at qpos0): a fixed joint; by sites: a fixed joint
+          between markers at the two sites (their frames coincide)
 """
 from __future__ import annotations
 
@@ -68,11 +70,10 @@ def _connect_weld(b, e, name, typ) -> None:
     mj, d, model = b.mj, b.data, b.model
     o1, o2 = int(mj.eq_obj1id[e]), int(mj.eq_obj2id[e])
     if int(mj.eq_objtype[e]) == SITE:
-        b1, b2 = int(mj.site_bodyid[o1]), int(mj.site_bodyid[o2])
-        point = d.site_xpos[o1].copy()
-    else:
-        b1, b2 = o1, o2
-        point = d.xpos[b1] + d.xmat[b1].reshape(3, 3) @ mj.eq_data[e, :3]
+        _site_pair(b, name, typ, o1, o2)
+        return
+    b1, b2 = o1, o2
+    point = d.xpos[b1] + d.xmat[b1].reshape(3, 3) @ mj.eq_data[e, :3]
     body1, body2 = b.body_of[b1], b.body_of[b2]
     if body1 is body2:
         b.notes.append(f"equality {name!r} joins parts of one rigid body: nothing to constrain")
@@ -80,9 +81,35 @@ def _connect_weld(b, e, name, typ) -> None:
     if typ == CONNECT:
         model.add_spherical(name, body1, body2, point)
         return
-    if int(mj.eq_objtype[e]) != SITE:
-        _check_relpose(b, e, b1, b2, name)
+    _check_relpose(b, e, b1, b2, name)
     model.add_fixed(name, body1, body2, point)
+
+
+def _site_pair(b, name, typ, s1, s2) -> None:
+    """connect / weld given by sites: MuJoCo makes site1's origin (connect) or frame (weld) coincide with
+    site2's; a spherical (fixed) joint between markers at the two sites does so exactly, and assembly
+    closes the loop when the file draws the sites apart."""
+    body1, body2 = b.body_of[int(b.mj.site_bodyid[s1])], b.body_of[int(b.mj.site_bodyid[s2])]
+    if body1 is body2:
+        b.notes.append(f"equality {name!r} joins parts of one rigid body: nothing to constrain")
+        return
+    m1, m2 = _site_marker(b, s1, body1), _site_marker(b, s2, body2)
+    (b.model.add_spherical if typ == CONNECT else b.model.add_fixed)(name, m1, m2)
+
+
+def _site_marker(b, s, body):
+    """The marker of site s on `body` (the site's name when it can be one; add_sites then keeps it)."""
+    d = b.data
+    name = b.name("mjOBJ_SITE", s)
+    for cand in (name, f"site_{s}"):
+        if cand and cand in body.markers:
+            return body.markers[cand]
+        if cand and is_identifier(cand):
+            try:
+                return body.add_marker(cand, d.site_xpos[s].copy(), d.site_xmat[s].reshape(3, 3).copy())
+            except ModelError:
+                continue
+    raise ModelError(f"site '{name}'", "name", "cannot be a marker name")
 
 
 def _check_relpose(b, e, b1, b2, name) -> None:
