@@ -135,7 +135,8 @@ class Builder:
         s = self.spec
         self.path = ("ground",)
         self.add_markers(self.model.ground, s.ground.markers)
-        for section, items, fn in (("inputs", s.inputs, lambda i: self.model.add_input(i.name, i.value)),
+        for section, items, fn in (("tables", s.tables, self.add_table),
+                                   ("inputs", s.inputs, lambda i: self.model.add_input(i.name, i.value)),
                                    ("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
                                    ("joints", s.joints, self.add_joint), ("motions", s.motions, self.add_motion),
                                    ("forces", s.forces, self.add_element),
@@ -205,6 +206,19 @@ class Builder:
         if c.type == "gear":
             return self.model.add_gear(c.name, c.joint_1, c.joint_2, c.ratio)
         return self.model.add_coupler(c.name, c.joint_1, c.joint_2, c.ratio, c.dof_1, c.dof_2)
+
+    def add_table(self, t):
+        """An interpolated table (model.tables) that load expressions call by name (an Adams SPLINE)."""
+        from ..importers.adm_spline import AdamsSpline
+        entity = f"table '{t.name}'"
+        if len(t.x) != len(t.y) or len(t.x) < 3:
+            self.fail(entity, "y", f"needs as many y as x values, at least 3 (got {len(t.x)} x, {len(t.y)} y)")
+        if any(b <= a for a, b in zip(t.x, t.x[1:])):
+            self.fail(entity, "x", "values must be strictly increasing")
+        tables = self.model.__dict__.setdefault("tables", {})
+        if t.name in tables:
+            self.fail(entity, "name", "a second table of this name")
+        tables[t.name] = AdamsSpline(t.x, t.y, t.kind, t.linear_extrapolate)
 
     def add_sensor(self, s):
         self.model.add_sensor(s.name, s.signal, s.value, s.direction, s.action)

@@ -286,15 +286,22 @@ def model_to_dict(model) -> dict:
     d["sensors"] = [_sensor(s) for s in getattr(model, "sensors", {}).values()]
     d["inputs"] = [{"name": i.name, "value": i.value} for i in getattr(model, "inputs", {}).values()]
     d["outputs"] = [{"name": o.name, "expression": o.text} for o in getattr(model, "outputs", {}).values()]
-    for name in getattr(model, "tables", {}):      # spline tables (Adams SPLINE): no model-file section yet
-        raise ModelError(f"table '{name}'", "tables", "spline tables (read from an Adams SPLINE) cannot be stored "
-                         "in a model file yet: simulate the imported model directly")
+    d["tables"] = [_table(n, t) for n, t in getattr(model, "tables", {}).items()]
     for f in getattr(model, "fmus", {}).values():   # an FMU is code: model files never carry (and run) one
         raise ModelError(f"fmu '{f.name}'", "path", "an FMU runs its own code, so model files do not carry FMUs; "
                          "store the model without it and add it after loading (Model.add_fmu)")
     if getattr(model, "planar", None) is not None:
         d["planar"] = True if np.allclose(model.planar, [0, 0, 1]) else _unit(model.planar)
     return {k: v for k, v in d.items() if v != [] or k == "bodies"}
+
+
+def _table(name, t) -> dict:
+    from ..importers.adm_spline import AdamsSpline
+    if not isinstance(t, AdamsSpline):
+        raise ModelError(f"table '{name}'", "tables", f"a {type(t).__name__} cannot be stored in a model file; "
+                         "only the tables of Adams SPLINEs (AKISPL, CUBSPL) can")
+    out = {"name": name, "kind": t.kind, "x": [float(v) for v in t.xs], "y": [float(v) for v in t.ys]}
+    return out | ({"linear_extrapolate": True} if t.linear else {})
 
 
 def _constraint(c) -> dict:

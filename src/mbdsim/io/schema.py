@@ -241,7 +241,7 @@ class PointOnCurveSpec(Spec):
 
 
 from .schema_extra import (EXTRA_JOINTS, ConstraintSpec, InputSpec, JointForceSpec, LineForceSpec,  # noqa: E402
-                           OutputSpec, SensorSpec)
+                           OutputSpec, SensorSpec, TableSpec)
 
 JointSpec = Annotated[Union[(AxisJointSpec, InlineSpec, SphericalSpec, AtPointSpec, UniversalSpec, PlanarSpec,
                              FixedSpec, PointOnCurveSpec,
@@ -399,6 +399,7 @@ class ModelSpec(Spec):
     gravity: V("m/s**2") = [0.0, 0.0, 0.0]
     planar: Union[bool, V("")] = False     # True: a 2D mechanism in the xy plane (or its plane normal)
     ground: GroundSpec = GroundSpec()
+    tables: list[TableSpec] = []       # interpolated tables that load expressions call (Adams SPLINE)
     inputs: list[InputSpec] = []       # scalars that expressions read by name (a Simulator sets them)
     bodies: list[BodySpec] = []
     particles: list[ParticleSpec] = []
@@ -410,7 +411,7 @@ class ModelSpec(Spec):
     outputs: list[OutputSpec] = []     # measured signals (expressions of the state)
 
 
-SECTIONS = {"bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
+SECTIONS = {"tables": "table", "bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
             "constraints": "constraint", "sensors": "sensor", "inputs": "input", "outputs": "output"}
 
 

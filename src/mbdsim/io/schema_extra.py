@@ -118,3 +118,16 @@ class OutputSpec(Spec):
     name: Name
     expression: str
 
+
+class TableSpec(Spec):
+    """An interpolated table that load expressions call as `name(x)` (or `name(x, order=1)`): an Adams
+    SPLINE read through AKISPL (Akima) or CUBSPL (cubic, not-a-knot), extrapolated beyond the data by the
+    parabola through the end three points, or the line through the end two with linear_extrapolate.  The
+    numbers are in the units of the expression that reads it (not converted)."""
+
+    name: Name
+    kind: Literal["AKISPL", "CUBSPL"] = "AKISPL"
+    x: list[float]
+    y: list[float]
+    linear_extrapolate: bool = False
+
