@@ -112,21 +112,25 @@ JOINT/1, HOOKE, I=20, J=10
     assert np.abs(res.angular_velocity("PART_2")[:, 2] - 50.0 * res.time).max() < 1e-8
 
 
-def test_part_velocities_in_the_wm_axes_and_at_the_vm_marker(tmp_path):
-    """PART WX..WZ are about the axes of the WM marker (default CM); VX..VZ (ground axes) are the velocity of
-    the VM marker: v_cm = v_vm + w x (r_cm - r_vm).  A free, spherical (isotropic) part keeps them."""
+def test_part_velocities_in_the_wm_and_vm_axes(tmp_path):
+    """Adams' PART: WX..WZ are about the axes of the WM marker (default the CM marker's), VX..VZ the CM's
+    velocity along the axes of the VM marker (default ground's).  A free, isotropic part keeps them."""
     m = adm(tmp_path, """
 PART/1, GROUND
-PART/2, MASS=2, CM=20, IP=0.1, 0.1, 0.1, WM=21, VM=22, WX=0, WY=0, WZ=3, VX=1, VY=0, VZ=0, QG=0, 0, 0
+PART/2, MASS=2, CM=20, IP=0.1, 0.1, 0.1, WM=21, VM=22, WZ=3, VX=1, VZ=2
 MARKER/20, PART=2, REULER=30D, 0, 0
 MARKER/21, PART=2, REULER=0, 90D, 0
-MARKER/22, PART=2, QP=0, 0.5, 0
+MARKER/22, PART=2, QP=0, 0.5, 0, REULER=90D, 0, 0
+PART/3, MASS=2, CM=30, IP=0.1, 0.1, 0.1, WX=1, VY=4, QG=1, 0, 0
+MARKER/30, PART=3, REULER=90D, 0, 0
 """)
-    w_expect = 3.0 * np.array([0.0, -1.0, 0.0])           # z of MARKER/21 (x rotated 90 deg): -y
-    v_expect = np.array([1.0, 0, 0]) + np.cross(w_expect, [0.0, -0.5, 0.0])
     res = mb.simulate(m, 0.1, output_step=0.05, rtol=1e-10, atol=1e-12)
-    assert np.allclose(res.angular_velocity("PART_2"), w_expect, atol=1e-9)
-    assert np.allclose(res.velocity("PART_2"), v_expect, atol=1e-9)
+    # PART_2: z of MARKER/21 (x turned 90 deg) is -Y; MARKER/22's x is Y and z is Z
+    assert np.allclose(res.angular_velocity("PART_2"), [0.0, -3.0, 0.0], atol=1e-9)
+    assert np.allclose(res.velocity("PART_2"), [0.0, 1.0, 2.0], atol=1e-9)
+    # PART_3 defaults: WX about the CM marker's x (= Y), VY along ground Y
+    assert np.allclose(res.angular_velocity("PART_3"), [0.0, 1.0, 0.0], atol=1e-9)
+    assert np.allclose(res.velocity("PART_3"), [0.0, 4.0, 0.0], atol=1e-9)
 
 
 def test_icrot_ictran_start_the_joints(tmp_path):

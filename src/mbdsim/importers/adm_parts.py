@@ -4,8 +4,8 @@ bodies and markers (SI, ground frame at t=0).
 PART/id: QG (origin of the part frame in ground), REULER (body-fixed 3-1-3 angles, rad; `D` for
 degrees) or ZG/XG (points on its z axis and in its xz plane); MASS, CM (the centre-of-mass marker),
 IP = Ixx, Iyy, Izz[, Ixy, Ixz, Iyz] about the IM marker (default CM) in its axes, products as positive
-integrals (Adams' convention: the tensor holds -Ixy ...); VX VY VZ (velocity of the VM marker, default
-CM, in ground) and WX WY WZ (angular velocity in the axes of the WM marker, default CM).  The mbdsim
+integrals (Adams' convention: the tensor holds -Ixy ...); VX VY VZ (the CM's velocity along the axes of
+the VM marker, default ground) and WX WY WZ (angular velocity about the axes of the WM marker, default CM).  The mbdsim
 body sits at the CM marker with that marker's axes (the inertia is rotated and shifted into them).
 MARKER/id: PART, QP and REULER or ZP/XP (USEXP) in the part frame; FLOATING markers are kept on their
 part at their given pose (mbdsim uses them as reaction points only).
@@ -181,21 +181,24 @@ def _body(imp, pid, st, a, p, R, poses):
 
 
 def _velocities(imp, st, a, cm, poses, pid):
-    """(CM velocity, angular velocity) in ground from VX.. (VM marker) and WX.. (WM marker axes), or None."""
+    """(CM velocity, angular velocity) in ground, or None.  Adams' PART: VX VY VZ are the CM marker's velocity
+    along the axes of the VM marker (default: ground axes); WX WY WZ the angular velocity about the axes of
+    the WM marker (default: the CM marker)."""
     vs = [imp.num(st, a, k, None, "velocity") for k in ("VX", "VY", "VZ")]
     ws = [imp.num(st, a, k, None, "angular_velocity") for k in ("WX", "WY", "WZ")]
     if "EXACT" in a:
         imp.note(st, "EXACT ignored: the given velocities are held at assembly where consistent")
-    w = None
+
+    def axes(key, default):
+        if key not in a:
+            return default
+        mid = imp.ident(st, a, key)
+        if mid not in poses:
+            imp.fail(st, key, f"no MARKER/{mid} in the dataset", a[key].line)
+        return poses[mid][2]
+    w = v = None
     if any(x is not None for x in ws):
-        wm = cm if "WM" not in a else (poses[imp.ident(st, a, "WM")][1:3] if imp.ident(st, a, "WM") in poses else
-                                       imp.fail(st, "WM", "no such marker"))
-        w = wm[1] @ np.array([0.0 if x is None else x for x in ws])
-    v = None
+        w = axes("WM", cm[1]) @ np.array([0.0 if x is None else x for x in ws])
     if any(x is not None for x in vs):
-        vm = cm if "VM" not in a else (poses[imp.ident(st, a, "VM")][1:3] if imp.ident(st, a, "VM") in poses else
-                                       imp.fail(st, "VM", "no such marker"))
-        v = np.array([0.0 if x is None else x for x in vs])
-        if w is not None:
-            v = v + np.cross(w, cm[0] - vm[0])
+        v = axes("VM", np.eye(3)) @ np.array([0.0 if x is None else x for x in vs])
     return v, w
