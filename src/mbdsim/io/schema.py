@@ -411,7 +411,8 @@ class ModelSpec(Spec):
     outputs: list[OutputSpec] = []     # measured signals (expressions of the state)
 
 
-SECTIONS = {"tables": "table", "bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
+SECTIONS = {"tables": "table",
+            "bodies": "body", "particles": "particle", "joints": "joint", "motions": "motion", "forces": "element",
             "constraints": "constraint", "sensors": "sensor", "inputs": "input", "outputs": "output"}
 
 
