@@ -16,7 +16,8 @@ Arguments name a body (its centre-of-mass frame: CM origin, body axes) or a mark
 j and k default to ground. Differences are taken in ground (Adams' reference frame l = ground).
 Variables: t and TIME [s]; the coordinate of every revolute, screw (angle [rad], continuous) and
 translational joint (slide [m]) by its name, and its rate as <joint>_dot [rad/s, m/s]; the model's
-inputs (Model.add_input) by name.
+inputs (Model.add_input) by name.  Tables: the model's `tables` {name: table} (the Adams SPLINEs that
+mb.from_adm reads, a model file's `tables:` section) are called as name(x) or name(x, order=n).
 """
 from __future__ import annotations
 
