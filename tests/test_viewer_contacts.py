@@ -41,9 +41,9 @@ def test_scene_has_an_arrow_per_touching_point(res):
     ref = res.contact_points("floor")
     ref = ref[ref.time == res.time[-1]]
     assert np.allclose(np.sort(last[:, 2]), np.sort(ref.z), atol=1e-9)
-    # the largest force is drawn 0.15 scene sizes long
-    fmax = max(np.abs(np.asarray(f).reshape(-1, 6)[:, 3:]).max() for f in cf["frames"] if f)
-    assert cf["scale"] * fmax == pytest.approx(0.15 * scene.scale, rel=1e-5)
+    # a force of the 90th percentile of the run's point forces is drawn 0.1 scene sizes long
+    mags = np.concatenate([np.linalg.norm(np.reshape(f, (-1, 6))[:, 3:], axis=1) for f in cf["frames"] if f])
+    assert cf["scale"] * np.percentile(mags, 90) == pytest.approx(0.1 * scene.scale, rel=1e-5)
 
 
 def test_animate_page_carries_the_arrows(res, tmp_path):

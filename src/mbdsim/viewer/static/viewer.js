@@ -129,7 +129,8 @@ function updateSprings() {
   }
 }
 
-// contact forces (on request): an arrow per touching point, from the point along the force on shape_j
+// contact forces (on request): an arrow per touching point along the force on shape_j, its tip at the point
+// (it pushes on shape_j), drawn over the bodies
 const CF = data.contact_forces, arrows = [];
 const arrowGroup = new THREE.Group();
 arrowGroup.name = 'contact-forces';
@@ -141,6 +142,8 @@ function updateArrows(k, f) {
   while (arrows.length < n) {
     const a = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, 0xd62728);
     a.frustumCulled = false;
+    a.renderOrder = 999;
+    for (const part of [a.line, a.cone]) { part.material.depthTest = false; part.material.transparent = true; part.renderOrder = 999; }
     arrowGroup.add(a);
     arrows.push(a);
   }
@@ -148,11 +151,12 @@ function updateArrows(k, f) {
   arrows.forEach((a, i) => {
     if (i >= n) { a.visible = false; return; }
     _d.set(pts[6 * i + 3], pts[6 * i + 4], pts[6 * i + 5]);
-    const len = _d.length() * CF.scale;
+    const len = Math.min(_d.length() * CF.scale, 0.3 * S);
     a.visible = len > 1e-6 * S;
     if (!a.visible) return;
-    a.position.set(pts[6 * i], pts[6 * i + 1], pts[6 * i + 2]);
-    a.setDirection(_d.normalize());
+    _d.normalize();
+    a.position.set(pts[6 * i] - _d.x * len, pts[6 * i + 1] - _d.y * len, pts[6 * i + 2] - _d.z * len);
+    a.setDirection(_d);
     a.setLength(len, Math.min(0.3 * len, 0.03 * S), Math.min(0.15 * len, 0.015 * S));
     shown += 1;
   });
