@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import mbdsim as mb
-from mbdsim.importers.collision import DEFAULT_CONTACT, mujoco_impact
+from mbdsim.importers.collision import DEFAULT_CONTACT, mujoco_impact, resting_penetration
 
 G, A, M = 9.81, 0.1, 1.0
 
@@ -89,22 +89,49 @@ def test_mjcf_box_on_plane_rests_at_the_mapped_impact_penetration(tmp_path):
     contacts = [e for e in model.forces.values() if type(e).__name__ == "ShapeContact"]
     assert len(contacts) == 1                      # the ghost geom (contype=conaffinity=0) collides with nothing
     c = contacts[0]
-    # MuJoCo's defaults solref (0.02, 1), solimp (0.9, 0.95, 0.001): k = m d^2 / ((1-d) dwidth^2 tc^2 dr^2)
-    k = M * 0.9 ** 2 / (0.1 * 0.95 ** 2 * 0.02 ** 2)
-    assert c.stiffness == pytest.approx(k, rel=1e-12) and c.exponent == 1.0
-    assert c.damping == pytest.approx(2 * np.sqrt(k * M), rel=1e-12) and c.penetration == pytest.approx(1e-4)
-    assert c.mu == 1.0                              # MuJoCo's default sliding friction
-    # the resting penetration of one contact carrying m g is MuJoCo's own (1 - d) g dwidth^2 tc^2 dr^2 / d^2
-    assert M * G / c.stiffness == pytest.approx(0.1 * G * 0.95 ** 2 * 0.02 ** 2 / 0.81, rel=1e-12)
+    r = resting_penetration(G, (0.02, 1.0), (0.9, 0.95, 0.001, 0.5, 2.0))   # MuJoCo's defaults
+    assert c.stiffness == pytest.approx(M * G / r, rel=1e-12) and c.exponent == 1.0
+    assert c.damping == pytest.approx(2 * np.sqrt(c.stiffness * M), rel=1e-12)   # dampratio 1
+    assert c.penetration == pytest.approx(0.1 * r) and c.mu == 1.0               # MuJoCo's default friction
     z = rest_height(model)
-    delta = M * G / 4 / c.stiffness
+    delta = M * G / 4 / c.stiffness                # four corners share the weight
     assert abs(z - (A / 2 - delta)) < 1e-3 * delta, (z, A / 2 - delta)
 
 
-def test_mujoco_direct_solref_and_frictionless_condim():
-    p = mujoco_impact(2.0, (-1000.0, -20.0), (0.5, 0.95, 0.001, 0.5, 2), (0.7, 0.005, 1e-4), 1)
-    assert p["stiffness"] == pytest.approx(2.0 * 1000.0) and p["damping"] == pytest.approx(2.0 * 20.0)
+SPHERE = f"""<mujoco><option gravity="0 0 -{G}" timestep="0.001"/><worldbody>
+  <geom name="floor" type="plane" size="2 2 0.1" solref="{{solref}}" solimp="{{solimp}}"/>
+  <body name="ball" pos="0 0 0.05"><freejoint/><geom name="ball" type="sphere" size="0.05" mass="{{mass}}"
+    solref="{{solref}}" solimp="{{solimp}}"/></body>
+</worldbody></mujoco>"""
+
+
+@pytest.mark.parametrize("solref, solimp, mass", [("0.02 1", "0.9 0.95 0.001 0.5 2", 1.0),
+                                                   ("0.01 0.7", "0.8 0.99 0.004 0.3 3", 3.0),
+                                                   ("-20000 -300", "0.9 0.95 0.001 0.5 2", 2.0)])
+def test_a_sphere_rests_at_mujocos_own_penetration(tmp_path, solref, solimp, mass):
+    """One contact: the mapped IMPACT spring holds the sphere at the penetration MuJoCo's soft contact
+    gives it, measured by running MuJoCo itself (an independent engine) on the same file."""
+    mujoco = pytest.importorskip("mujoco")
+    text = SPHERE.format(solref=solref, solimp=solimp, mass=mass)
+    mj = mujoco.MjModel.from_xml_string(text)
+    d = mujoco.MjData(mj)
+    for _ in range(4000):
+        mujoco.mj_step(mj, d)
+    assert abs(d.qvel[2]) < 1e-9 and d.ncon == 1
+    r_mujoco = 0.05 - d.qpos[2]
+    path = tmp_path / "ball.xml"
+    path.write_text(text)
+    with pytest.warns(mb.ImportApproximationWarning):
+        model = mb.from_mjcf(path, collision=True)
+    z = rest_height(model, "ball", t_end=1.0)
+    assert abs((0.05 - z) / r_mujoco - 1) < 1e-7, (0.05 - z, r_mujoco)   # measured: 1e-9
+
+
+def test_frictionless_condim_and_direct_solref_damping():
+    p = mujoco_impact(2.0, G, (-1000.0, -20.0), (0.5, 0.95, 0.001, 0.5, 2), (0.7, 0.005, 1e-4), 1)
     assert p["mu"] == 0.0
+    # damping ratio B / (2 sqrt K) with K = 1000 / dwidth^2, B = 20 / dwidth: 20 / (2 sqrt(1000))
+    assert p["damping"] == pytest.approx(2 * 20 / (2 * np.sqrt(1000)) * np.sqrt(p["stiffness"] * 2.0), rel=1e-12)
 
 
 def test_mjcf_contact_pairs_and_exclusions(tmp_path):

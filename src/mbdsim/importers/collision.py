@@ -93,29 +93,64 @@ def urdf_contacts(model, robot, body_of, visuals, names, notes, contact) -> None
                  + ", ".join(f"{k}={v!r}" for k, v in params.items()))
 
 
-def mujoco_impact(mass, solref, solimp, friction, condim) -> dict:
-    """IMPACT parameters standing for MuJoCo's soft contact on a body of `mass` [kg] (see docs/import.md).
-
-    MuJoCo's contact obeys a1 + d (b v + k r) = (1 - d) a0 with impedance d (taken as solimp[0]), and
-    for solref = (timeconst, dampratio) > 0: b = 2 / (dwidth timeconst), k = d / (dwidth^2 timeconst^2
-    dampratio^2) (dwidth = solimp[1]); for solref <= 0: k = -solref[0], b = -solref[1].  The linear
-    IMPACT spring keeps MuJoCo's resting penetration under the weight, r = (1 - d) g / (d k): stiffness
-    m d k / (1 - d); its damping keeps the damping ratio (solref's dampratio; for direct solref the
-    damping m d b / (1 - d)), reached at a tenth of the solimp width.  mu: the sliding friction
-    (torsional and rolling friction are dropped; condim 1: frictionless)."""
-    d0, dwidth, width = float(solimp[0]), float(solimp[1]), float(solimp[2])
-    d0 = min(max(d0, 1e-4), 0.9999)
-    dwidth = min(max(dwidth, 1e-4), 0.9999)
-    if solref[0] > 0:
-        tc, dr = float(solref[0]), float(solref[1])
-        k = d0 / (dwidth ** 2 * tc ** 2 * dr ** 2)
-        stiffness = mass * d0 * k / (1.0 - d0)
-        damping = 2.0 * dr * math.sqrt(stiffness * mass)
+def impedance(r, solimp) -> float:
+    """MuJoCo's constraint impedance d(r) at penetration r [m] (solimp = d0, dwidth, width, midpoint, power)."""
+    d0, dw, width, mid, power = (float(x) for x in solimp[:5])
+    if width <= 1e-15 or d0 == dw:
+        d = 0.5 * (d0 + dw)
     else:
-        k, b = -float(solref[0]), -float(solref[1])
-        stiffness, damping = mass * d0 * k / (1.0 - d0), mass * d0 * b / (1.0 - d0)
-    return {"stiffness": stiffness, "exponent": 1.0, "damping": damping, "penetration": max(0.1 * width, 1e-9),
-            "mu": 0.0 if condim == 1 else float(friction[0]), "friction_velocity": 1e-3}
+        x = min(max(r / width, 0.0), 1.0)
+        if x in (0.0, 1.0) or power == 1:
+            y = x
+        elif x <= mid:
+            y = x ** power / mid ** (power - 1)
+        else:
+            y = 1 - (1 - x) ** power / (1 - mid) ** (power - 1)
+        d = d0 + y * (dw - d0)
+    return min(max(d, 1e-4), 0.9999)
+
+
+def resting_penetration(g, solref, solimp) -> float:
+    """MuJoCo's penetration [m] of one contact holding a body against acceleration g [m/s^2]: at rest its
+    constraint a1 + d (b v + k r) = (1 - d) a0 gives d(r) K d(r) r = (1 - d(r)) g."""
+    from scipy.optimize import brentq
+    K = _stiffness_ref(solref, solimp)
+    f = lambda r: impedance(r, solimp) ** 2 * K * r - (1 - impedance(r, solimp)) * g  # noqa: E731
+    d0 = impedance(0.0, solimp)
+    hi = (1 - d0) * g / (d0 * d0 * K)       # d(r) >= d0 puts the root below the d0 answer
+    return brentq(f, 0.0, hi, xtol=1e-18, rtol=1e-14) if hi > 0 else 0.0
+
+
+def _stiffness_ref(solref, solimp) -> float:
+    dmax = min(max(float(solimp[1]), 1e-4), 0.9999)
+    if solref[0] > 0:
+        return 1.0 / (dmax ** 2 * float(solref[0]) ** 2 * float(solref[1]) ** 2)
+    return -float(solref[0]) / dmax ** 2
+
+
+def _damping_ref(solref, solimp) -> float:
+    dmax = min(max(float(solimp[1]), 1e-4), 0.9999)
+    return 2.0 / (dmax * float(solref[0])) if solref[0] > 0 else -float(solref[1]) / dmax
+
+
+def mujoco_impact(mass, g, solref, solimp, friction, condim) -> dict:
+    """IMPACT parameters standing for MuJoCo's soft contact on a body of `mass` [kg] under gravity `g`
+    [m/s^2] (see docs/import.md).
+
+    MuJoCo's contact obeys a1 + d (B v + K d r) = (1 - d) a0 with impedance d(r) (solimp) and, for
+    solref = (timeconst, dampratio) > 0, K = 1 / (dwidth^2 timeconst^2 dampratio^2), B = 2 / (dwidth
+    timeconst) (dwidth = solimp[1]); for solref <= 0, K = -solref[0] / dwidth^2, B = -solref[1] / dwidth.
+    The linear IMPACT spring keeps MuJoCo's resting penetration r* of one contact under the weight
+    (`resting_penetration`): stiffness m g / r*; its damping keeps MuJoCo's damping ratio B / (2 sqrt K)
+    (solref's dampratio) and is reached at a tenth of r*.  mu: the sliding friction (torsional and
+    rolling friction dropped; condim 1: frictionless)."""
+    r = resting_penetration(g, solref, solimp)
+    if not (mass > 0 and r > 0):
+        raise ValueError("no resting penetration")   # a massless body or no gravity: caller notes it
+    stiffness = mass * g / r
+    zeta = _damping_ref(solref, solimp) / (2.0 * math.sqrt(_stiffness_ref(solref, solimp)))
+    return {"stiffness": stiffness, "exponent": 1.0, "damping": 2.0 * zeta * math.sqrt(stiffness * mass),
+            "penetration": 0.1 * r, "mu": 0.0 if condim == 1 else float(friction[0]), "friction_velocity": 1e-3}
 
 
 def _mix(mj, g1, g2):
@@ -153,13 +188,21 @@ def mjcf_contacts(builder, shape_of, contact) -> None:
     parent = [weld[int(mj.body_parentid[w])] for w in weld]
     pairs, seen = [], set()
 
+    g = float(np.linalg.norm(builder.model.gravity)) or 9.81   # without gravity: rated for 1 g (noted)
+    if not np.linalg.norm(builder.model.gravity):
+        notes.append("no gravity: MuJoCo's contact stiffness is matched at 9.81 m/s^2")
+
     def add(g1, g2, solref, solimp, friction, condim):
+        seen.add(frozenset((g1, g2)))
         a, b = shape_of[g1], shape_of[g2]
-        params = mujoco_impact(_mass(a, b), solref, solimp, friction, condim)
+        m = _mass(a, b)
+        if not m > 0:
+            notes.append(f"no contact between {label[g1]!r} and {label[g2]!r}: neither body has mass")
+            return
+        params = mujoco_impact(m, g, solref, solimp, friction, condim)
         if contact:
             params.update(contact)
         pairs.append((label[g1], a, label[g2], b, params))
-        seen.add(frozenset((g1, g2)))
 
     for p in range(mj.npair):
         g1, g2 = int(mj.pair_geom1[p]), int(mj.pair_geom2[p])
