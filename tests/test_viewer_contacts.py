@@ -65,3 +65,20 @@ def test_cli_contact_forces(tmp_path):
     r = CliRunner().invoke(app, ["animate", str(model), "--end", "0.05", "--contact-forces", "-o", str(out)])
     assert r.exit_code == 0, r.output
     assert '"contact_forces":{"scale"' in out.read_text()
+
+
+def test_sphere_plane_contact_arrow_is_the_contact_force():
+    """The exact sphere-plane Contact: one arrow at the touching point, equal to its normal force."""
+    m = mb.Model("ball", gravity=(0, 0, -G))
+    ball = m.add_particle("ball", 1.0, position=(0, 0, 0.2))
+    m.add_contact("floor", mb.Sphere(ball, 0.05), mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), 1e5, 1.5, 50.0, 1e-3)
+    res = mb.simulate(m, 0.6, 0.002)
+    cf = build_scene(res, contact_forces=True).contact_forces
+    Fn = res.spring_force("floor")
+    touching = [k for k, f in enumerate(cf["frames"]) if f]
+    assert touching == list(np.nonzero(Fn > 0)[0]) and touching
+    for k in touching:
+        x, y, z, fx, fy, fz = cf["frames"][k]
+        assert abs(fz - (-Fn[k])) <= 1e-5 * abs(Fn[k]) + 1e-9    # force on shape_j (the plane): downward
+        below = res.position("ball")[k, 2] - 0.05                   # the sphere's lowest point (< 0: overlap)
+        assert abs(z - below / 2) <= 1e-5 * abs(below) + 1e-12      # the middle of the overlap

@@ -72,8 +72,9 @@ def animate(res_or_model: Result | Model | pd.DataFrame, path: PathLike = "anim.
     first joint coordinate, None shows none.  end_time: also cuts a Result at that time [s].
     geometry: {body or name: mb.Sphere} drawn instead of the body's equivalent-inertia box.
     Bodies move with positions and orientation quaternions sampled at <= `max_frames` frames.
-    contact_forces: draw the force [N] at each touching point of the shape contacts (Model.add_contact
-    between shapes) as an arrow on shape_j's side, the largest 0.15 scene sizes long.
+    contact_forces: draw the force [N] on shape_j at each touching point of the contacts
+    (Model.add_contact) as an arrow whose tip is at the point; a force of the run's 90th percentile is
+    0.1 scene sizes long (docs/visualisation.md).
     """
     out = Path(path)
     if out.suffix.lower() not in (".html", ".htm"):

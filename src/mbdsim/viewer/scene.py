@@ -123,14 +123,22 @@ def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int 
 
 
 def _contact_forces(res, model, scale: float) -> dict:
-    """Scene.contact_forces: every shape contact's touching points and forces (on shape_j) per frame; a
+    """Scene.contact_forces: every contact's touching points and forces (on shape_j) per frame; a
     force of the 90th percentile of all point forces of the run is drawn 0.1 scene sizes long (so that
     impact peaks do not shrink resting forces out of sight; the page caps arrows at 0.3 scene sizes)."""
     from ..model.contacts import ShapeContact
+    from ..model.element_specs import Contact
     from ..results.contacts import _records
     frames = [[] for _ in res.time]
     for el in model.forces.values():
-        if isinstance(el, ShapeContact):
+        if isinstance(el, Contact):   # the exact sphere-plane / sphere-sphere contact: its own evaluator
+            from ..system.force_elements.contact import _forces, contact_state
+            g, n, cp, v_rel = contact_state(res.system, res.frames, el)
+            Fn, _, _, Ft = _forces(el, g, n, v_rel)
+            F = Fn[:, None] * n + Ft
+            for k in np.nonzero(Fn > 0)[0]:
+                frames[k].extend(np.concatenate([cp[k], F[k]]))
+        elif isinstance(el, ShapeContact):
             for k, rc in enumerate(_records(res, el)):
                 if len(rc):
                     F = rc[:, 8:9] * rc[:, 4:7] + rc[:, 9:12]
