@@ -115,3 +115,28 @@ def test_page_plays_in_chromium(driver, tmp_path):
         from PIL import Image
         for k, img in enumerate(shots):
             Image.fromarray(img.astype(np.uint8)).save(os.path.join(os.environ["MBDSIM_SHOTS"], f"viewer_{k}.png"))
+
+
+def test_contact_force_arrows_render_in_chromium(driver, tmp_path):
+    """Issue 30: with contact_forces=True the page draws an arrow per touching point (a box resting on a
+    plane: four) without console errors; without it, none."""
+    model = mb.Model("box", gravity=(0, 0, -9.81))
+    box = model.add_body("box", 1.0, (1 / 600,) * 3, position=(0, 0, 0.05 - 9.81 / 4e5))
+    model.add_contact("floor", mb.Plane(model.ground, (0, 0, 0), (0, 0, 1)), box.add_shape("g", mb.Box((0.1,) * 3)),
+                      1e5, 1.0, 200.0, 1e-4, mu=0.3)
+    res = mb.simulate(model, end_time=0.1, output_step=0.01)
+    v = "window.mbdsimViewer"
+    for flag, arrows in ((True, 4), (False, 0)):
+        page = mb.animate(res, tmp_path / f"box_{flag}.html", signal=None, contact_forces=flag)
+        driver.get(page.resolve().as_uri())
+        t_end = time.monotonic() + 30
+        while not driver.execute_script("return !!(window.mbdsimViewer && window.mbdsimViewer.ready)"):
+            assert time.monotonic() < t_end, "viewer did not start: " + str(driver.get_log("browser"))
+            time.sleep(0.05)
+        driver.execute_script(f"{v}.setTime(0.1)")
+        assert driver.execute_script(f"return {v}.contactArrows") == arrows
+        drawn = driver.execute_script(f"return {v}.scene.getObjectByName('contact-forces').children"
+                                      ".filter((a) => a.visible).length")
+        assert drawn == arrows
+        logs = [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
+        assert logs == [], logs

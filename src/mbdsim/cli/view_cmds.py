@@ -4,7 +4,7 @@ Commands::
 
     mbdsim plot RESULTS SIGNAL... [--x SIGNAL] -o fig.png|svg|pdf
     mbdsim plot RESULTS --list
-    mbdsim animate MODEL|RESULTS -o anim.html [--end T] [--signal SIGNAL]
+    mbdsim animate MODEL|RESULTS -o anim.html [--end T] [--signal SIGNAL] [--contact-forces]
 
 RESULTS is a .csv or .parquet file written from ``res.to_dataframe()``; SIGNAL a column name, matched
 leniently (exactly, then case-insensitively ignoring the unit suffix, then by a unique prefix).  A
@@ -104,6 +104,8 @@ def animate_cmd(
                                         "default 2 s; results: cut there)."),
     signal: Optional[str] = typer.Option(None, "--signal", metavar="SIGNAL",
                                          help="Column shown beside the 3D view (default: first joint coordinate)."),
+    contact_forces: bool = typer.Option(False, "--contact-forces",
+                                        help="Draw shape-contact forces as arrows at the touching points."),
 ) -> None:
     """Write a self-contained HTML page (three.js inlined, no network) playing a model's motion.
 
@@ -124,7 +126,7 @@ def animate_cmd(
         what = load_model_file(source)
         title = None
     try:
-        page = animate(what, out, signal=signal or "auto", end_time=end, title=title)
+        page = animate(what, out, signal=signal or "auto", end_time=end, title=title, contact_forces=contact_forces)
     except MbdsimError as exc:
         _fail(str(exc), 2 if isinstance(exc, ValueError) else 1)
     except OSError as exc:

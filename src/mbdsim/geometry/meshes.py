@@ -78,6 +78,7 @@ class Mesh:
         s = scalar(entity, "scale", scale, minimum=0.0, strict=True)
         if isinstance(path_or_vertices, (str, os.PathLike)):
             self.path = os.fspath(path_or_vertices)
+            self.abspath = os.path.abspath(self.path)   # model files store it relative to their folder
             entity = f"mesh {self.path!r}"
             if faces is not None:
                 raise ModelError(entity, "faces", "a mesh file carries its own faces")
@@ -91,7 +92,7 @@ class Mesh:
                 raise ModelError(entity, "path", "the file holds no triangle mesh")
             mesh.apply_scale(s)
         else:
-            self.path = None
+            self.path = self.abspath = None
             v = _points(entity, "vertices", path_or_vertices) * s
             if faces is None:
                 raise ModelError(entity, "faces", "give the triangles (m, 3) vertex indices with the vertices")
@@ -102,7 +103,7 @@ class Mesh:
             if f.ndim != 2 or f.shape[1] != 3 or len(f) == 0 or f.min() < 0 or f.max() >= len(v):
                 raise ModelError(entity, "faces", f"expected (m, 3) indices into the {len(v)} vertices")
             mesh = trimesh.Trimesh(v, f, process=True)
-        self.mesh = mesh
+        self.mesh, self.scale = mesh, s
         self.vertices = np.asarray(mesh.vertices, float)
         self.faces = np.asarray(mesh.faces, np.int64)
 

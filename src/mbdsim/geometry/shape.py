@@ -33,6 +33,12 @@ class Shape:
     geometry: Any
     s_B: np.ndarray
     R_BG: np.ndarray
+    # as given to add_shape (for model files): centre [m] and axes in ground at t = 0 (None: the defaults),
+    # density [kg/m^3] (None: no mass) and the mass [kg] / inertia [kg m^2] it added to the body
+    given_center: np.ndarray | None = None
+    given_orientation: np.ndarray | None = None
+    density: float | None = None
+    added_mass: tuple | None = None
 
     @property
     def center(self) -> np.ndarray:
@@ -66,11 +72,14 @@ def add_shape(body, name: str, geometry, center=None, orientation=None, density=
     except ValueError as exc:
         raise ModelError(entity, "orientation", str(exc)) from None
     A = body.orientation
-    shape = Shape(name, body, geometry, A.T @ (c - body.position), A.T @ R)
+    shape = Shape(name, body, geometry, A.T @ (c - body.position), A.T @ R,
+                  None if center is None else c.copy(), None if orientation is None else R.copy())
     if density is not None:
         if body.is_ground:
             raise ModelError(entity, "density", "ground has no mass properties")
         m, I_B = _body_mass_properties(entity, shape, density)
+        shape.density = float(density)
+        shape.added_mass = (float(body.mass), np.array(body.inertia, float), m, I_B)
         body.mass = float(body.mass + m)
         body.inertia = np.asarray(body.inertia, float) + (0.0 if body.is_particle else I_B)
     body.shapes[name] = shape

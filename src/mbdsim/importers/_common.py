@@ -142,10 +142,12 @@ def is_identifier(name: str) -> bool:
     return name.isidentifier()
 
 
-def finish(model, notes: list, visuals: list, source: str) -> None:
-    """Attach the notes and visual shapes to the model (`attach_shapes`: drawn by the viewer) and warn
-    once about the approximations."""
+def finish(model, notes: list, visuals: list, source: str, then=None) -> None:
+    """Attach the notes and visual shapes to the model (`attach_shapes`: drawn by the viewer), run `then()`
+    (the collision step, importers.collision) and warn once about the approximations."""
     attach_shapes(model, visuals, notes)
+    if then is not None:
+        then()
     model.import_notes = list(notes)
     model.visuals = list(visuals)
     model.source_file = source

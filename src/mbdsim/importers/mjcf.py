@@ -15,6 +15,8 @@ frames are exactly MuJoCo's.  Mapping (docs/import.md has the table):
   equality joint / connect / weld-> coupler or user constraint / spherical joint / fixed joint (exact)
   motor actuator                 -> joint force gear * gain * ctrl (ctrl of the keyframe, else 0)
   gravity, keyframe              -> Model gravity; the initial state
+  geoms, contact pairs           -> with collision=True: contact shapes and IMPACT contacts (solref/solimp
+                                    mapped as in importers.collision.mujoco_impact)
 """
 from __future__ import annotations
 
@@ -30,13 +32,18 @@ GEOM_KIND = {2: "sphere", 3: "capsule", 4: "ellipsoid", 5: "cylinder", 6: "box",
 
 
 def from_mjcf(path, initial_displacement: dict | None = None, initial_velocity: dict | None = None,
-              keyframe: int | str | None = None):
+              keyframe: int | str | None = None, collision: bool = False, contact: dict | None = None):
     """Build a Model from a MuJoCo MJCF file (SI units; ground = MuJoCo's world frame).
 
     The initial state is the keyframe `keyframe` (index or name; default: the file's first keyframe if it
     has one, else qpos0; False: qpos0), then `initial_displacement` / `initial_velocity` {joint name:
     value} override hinge [rad, rad/s] and slide [m, m/s] joints, in MuJoCo's qpos / qvel convention.
-    Joint coordinates (Result.joint_coordinate) are q - ref (the model is drawn at qpos0).  Returns a Model
+    Joint coordinates (Result.joint_coordinate) are q - ref (the model is drawn at qpos0).  collision:
+    geoms that can collide (contype/conaffinity) become contact shapes (a plane geom an mb.Plane, a mesh
+    the convex hull of its vertices) and every pair MuJoCo would collide (bitmasks, parent-child and
+    <exclude> filters, <pair> elements) an IMPACT contact mapped from solref/solimp
+    (importers.collision.mujoco_impact; `contact`, a dict of Model.add_contact arguments, overrides the
+    mapped values).  Returns a Model
     whose `import_notes` lists what was approximated and `visuals` the geoms; errors are ModelFileError
     naming the file, line and element."""
     try:
@@ -51,6 +58,7 @@ def from_mjcf(path, initial_displacement: dict | None = None, initial_velocity: 
         raise compile_error(exc, doc.source, index) from None
     b = _Builder(mujoco, mj, doc.source, index, notes)
     b.model_name = doc.root.get("model") or "mjcf"
+    b.collision, b.contact = collision, contact
     return b.build(initial_displacement, initial_velocity, keyframe)
 
 
@@ -95,8 +103,41 @@ class _Builder:
         self.add_equalities()
         self.add_actuators(ctrl)
         self.add_sites()
-        finish(self.model, self.notes, self.visuals(), self.source)
+        visuals = self.visuals()
+        finish(self.model, self.notes, visuals, self.source, (lambda: self.collide(visuals))
+               if getattr(self, "collision", False) else None)
         return self.model
+
+    def collide(self, visuals) -> None:
+        """Contact shapes of the collidable geoms and their contacts (importers.collision)."""
+        import mbdsim as mb
+        from .collision import mjcf_contacts, place
+        mj, d = self.mj, self.data
+        drawn = {v.name: (k, v) for k, v in enumerate(visuals)}
+        shape_of = {}
+        paired = {int(g) for g in mj.pair_geom1[:mj.npair]} | {int(g) for g in mj.pair_geom2[:mj.npair]}
+        for g in range(mj.ngeom):
+            if not (mj.geom_contype[g] or mj.geom_conaffinity[g] or g in paired):
+                continue
+            body = self.body_of[int(mj.geom_bodyid[g])]
+            label = self.name("mjOBJ_GEOM", g) or f"geom_{g}"
+            R = d.geom_xmat[g].reshape(3, 3)
+            if mj.geom_type[g] == 0:   # an (infinite, for collision) plane: its z axis is the normal
+                shape_of[g] = mb.Plane(body, d.geom_xpos[g].copy(), R[:, 2].copy())
+                continue
+            k, v = drawn.get(label, (None, None))
+            if v is None:
+                self.notes.append(f"geom {label!r}: {int(mj.geom_type[g])} geoms do not collide in mbdsim")
+                continue
+            hull = None
+            if v.kind == "mesh":   # MuJoCo collides a mesh as its convex hull
+                m = int(mj.geom_dataid[g])
+                a, n = int(mj.mesh_vertadr[m]), int(mj.mesh_vertnum[m])
+                hull = mb.ConvexMesh(np.asarray(mj.mesh_vert[a:a + n], float))
+            shape = place(self.model, v, f"hull_{k}" if hull is not None else f"visual_{k}", self.notes, hull)
+            if shape is not None:
+                shape_of[g] = shape
+        mjcf_contacts(self, shape_of, self.contact)
 
     def initial_state(self, keyframe, init_q, init_v):
         mj = self.mj

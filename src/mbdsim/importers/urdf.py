@@ -12,7 +12,8 @@ Mapping (docs/import.md has the full table):
   mimic           -> coupler (x_mimic = multiplier x_ref, + offset: a user constraint)
   dynamics        -> damping: torsion damper / joint force; friction: Coulomb joint friction
   visual/collision-> model.visuals (VisualShape, meshes resolved through package:// and relative paths;
-                     a missing mesh is a warning)
+                     a missing mesh is a warning); with collision=True, collision geometry -> contact
+                     shapes and IMPACT contacts between bodies not joined by a joint (importers.collision)
 The root link is ground with floating_base=False (its mass, like that of links fixed to it, does not
 move: a note says so), else a free body.  Joint coordinates are the file's joint positions: the model
 is drawn at q = 0 and `initial_displacement` / `initial_velocity` {joint name: value} [rad or m, rad/s
@@ -35,14 +36,18 @@ _KIND = {"revolute": "revolute", "continuous": "revolute", "prismatic": "transla
 
 
 def from_urdf(path, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), initial_displacement: dict | None = None,
-              initial_velocity: dict | None = None, package_dirs=()):
+              initial_velocity: dict | None = None, package_dirs=(), collision: bool = False,
+              contact: dict | None = None):
     """Build a Model from a URDF file (SI units; ground axes = the root link's frame at q = 0).
 
     floating_base: the root link moves freely (6 DOF) instead of being ground.  gravity [m/s^2] in ground
     axes.  initial_displacement / initial_velocity: {joint name: value} for revolute/continuous [rad,
     rad/s], prismatic [m, m/s] and planar ((u, v, angle) [m, m, rad]) joints, from the file's zero
     position; joints not named start at 0, at rest.  package_dirs: folders searched for package://
-    meshes (also $ROS_PACKAGE_PATH and the folders above the file).  Returns a Model whose
+    meshes (also $ROS_PACKAGE_PATH and the folders above the file).  collision: each <collision>
+    geometry also becomes a contact shape on its body, and each pair of them on two bodies that no joint
+    joins gets a contact (Model.add_contact) with the IMPACT parameters `contact` (a dict of add_contact
+    arguments; defaults importers.collision.DEFAULT_CONTACT, listed in import_notes).  Returns a Model whose
     `import_notes` lists what was approximated and `visuals` the shapes; errors are ModelFileError
     naming the file, line and element."""
     from ..model.model import Model
@@ -62,7 +67,11 @@ def from_urdf(path, floating_base: bool = False, gravity=(0.0, 0.0, -9.81), init
     joint_of = _add_joints(model, robot, poses, body_of, names, init_q, init_v, notes)
     _add_mimics(model, robot, joint_of, init_q, notes)
     visuals = _visuals(robot, poses, body_of, Path(doc.source).resolve().parent, package_dirs)
-    finish(model, notes, visuals, doc.source)
+    then = None
+    if collision:
+        from .collision import urdf_contacts
+        then = lambda: urdf_contacts(model, robot, body_of, visuals, names, notes, contact)  # noqa: E731
+    finish(model, notes, visuals, doc.source, then)
     return model
 
 

@@ -27,10 +27,11 @@ if TYPE_CHECKING:
 __all__ = ["load_model", "save_model", "model_from_dict", "model_to_dict", "json_schema", "ModelFileError"]
 
 
-def model_from_dict(data: dict, source: str = "<dict>", marks: dict | None = None):
+def model_from_dict(data: dict, source: str = "<dict>", marks: dict | None = None, base_dir: PathLike | None = None):
     """Build a Model from model-file data (the schema of `json_schema()`); SI unless units are given.
 
-    `source` names the origin in error messages, `marks` maps key paths to line numbers (from a file).
+    `source` names the origin in error messages, `marks` maps key paths to line numbers (from a file),
+    `base_dir` is the folder relative mesh paths start from (default: the working directory).
     Raises ModelFileError naming source, line, entity and field."""
     from pydantic import ValidationError
 
@@ -45,24 +46,25 @@ def model_from_dict(data: dict, source: str = "<dict>", marks: dict | None = Non
     except ValidationError as exc:
         raise diagnose.from_validation(exc, data, source, marks) from None
     try:
-        return Builder(spec).build()
+        return Builder(spec, None if base_dir is None else str(base_dir)).build()
     except ItemError as exc:
         raise diagnose.from_item_error(exc, source, marks) from None
 
 
-def model_to_dict(model) -> dict:
-    """Plain data for `model` in the model-file schema (SI numbers, expression strings).
+def model_to_dict(model, base_dir: PathLike | None = None) -> dict:
+    """Plain data for `model` in the model-file schema (SI numbers, expression strings); mesh files by
+    their path relative to `base_dir` (default: absolute paths).
 
     Raises ModelError naming the element when something cannot be stored (a Python callable)."""
     from .dump import model_to_dict as dump
-    return dump(model)
+    return dump(model, base_dir)
 
 
 def load_model(path: PathLike) -> Model:
     """Read a model file (.yaml/.yml or .json) and build the Model; errors are ModelFileError."""
     from .files import read
     data, marks, source = read(path)
-    return model_from_dict(data, source, marks)
+    return model_from_dict(data, source, marks, Path(path).parent)
 
 
 def save_model(model: Model, path: PathLike) -> Path:
@@ -75,7 +77,7 @@ def save_model(model: Model, path: PathLike) -> Path:
     if not isinstance(model, _Model):
         raise ModelError("save_model", "model", f"expected an mbdsim.Model, got {type(model).__name__}")
     file_kind(Path(path), f"model '{model.name}'")
-    return write(model_to_dict(model), path)
+    return write(model_to_dict(model, Path(path).parent), path)
 
 
 def json_schema() -> dict:

@@ -13,6 +13,7 @@ import numpy as np
 
 from ..errors import ModelError
 from ..model.joint_kinds import JOINT_KINDS
+from .build_shapes import add_shapes, contact_side
 from .schema import AxisAngleSpec, EulerSpec, ModelSpec
 from .units import UnitError, to_si
 
@@ -80,15 +81,18 @@ def rotation_matrix(entity: str, field: str, spec) -> np.ndarray | None:
 class Builder:
     """Turns a ModelSpec into a Model; `path` is the item being built (for error locations)."""
 
-    def __init__(self, spec: ModelSpec):
+    def __init__(self, spec: ModelSpec, base_dir: str | None = None):
         import mbdsim as mb
-        self.spec, self.mb = spec, mb
+        self.spec, self.mb, self.base_dir = spec, mb, base_dir   # base_dir: where relative mesh paths start
         self.model = mb.Model(spec.name, gravity=spec.gravity, planar=spec.planar)
         self.path: tuple = ()
 
     # ------------------------------------------------------------------ references
     def fail(self, entity, field, message):
         raise ItemError(entity, field, message, self.path + (field,))
+
+    def fail_at(self, entity, field, message, path):
+        raise ItemError(entity, field, message, path)
 
     def body(self, entity, field, name):
         bodies = self.model.bodies
@@ -135,6 +139,7 @@ class Builder:
         s = self.spec
         self.path = ("ground",)
         self.add_markers(self.model.ground, s.ground.markers)
+        add_shapes(self, self.model.ground, s.ground.shapes, ("ground",))
         for section, items, fn in (("tables", s.tables, self.add_table),
                                    ("inputs", s.inputs, lambda i: self.model.add_input(i.name, i.value)),
                                    ("bodies", s.bodies, self.add_body), ("particles", s.particles, self.add_particle),
@@ -175,9 +180,12 @@ class Builder:
                                    rotation_matrix(entity, "orientation", b.orientation), b.velocity,
                                    b.angular_velocity, shape=shape, density=b.density)
         self.add_markers(body, b.markers)
+        add_shapes(self, body, b.shapes, self.path[:2])
 
     def add_particle(self, p):
-        self.add_markers(self.model.add_particle(p.name, p.mass, p.position, p.velocity), p.markers)
+        body = self.model.add_particle(p.name, p.mass, p.position, p.velocity)
+        self.add_markers(body, p.markers)
+        add_shapes(self, body, p.shapes, self.path[:2])
 
     def add_joint(self, j):
         entity = f"joint '{j.name}'"
@@ -324,9 +332,11 @@ class Builder:
 
     def add_contact(self, entity, e):
         k = self.si(entity, "stiffness", e.stiffness, f"N/m**{e.exponent!r}")
-        self.model.add_contact(e.name, self.contact_shape(entity, "shape_i", e.shape_i),
-                               self.contact_shape(entity, "shape_j", e.shape_j), k, e.exponent, e.damping,
-                               e.penetration, e.mu, e.friction_velocity)
+        self.model.add_contact(e.name, contact_side(self, entity, "shape_i", e.shape_i),
+                               contact_side(self, entity, "shape_j", e.shape_j), k, e.exponent, e.damping,
+                               e.penetration, e.mu, e.friction_velocity, restitution=e.restitution,
+                               mu_static=e.mu_static, mu_dynamic=e.mu_dynamic,
+                               stiction_velocity=e.stiction_velocity, transition_velocity=e.transition_velocity)
 
     def add_stop(self, entity, e):
         jt = self.joint(entity, "joint", e.joint)

@@ -89,16 +89,19 @@ def _given(b, field):
     return _vec(getattr(b, field)) if getattr(b, field + "_given", True) else None
 
 
-def _body(b) -> dict:
+def _body(b, base_dir=None) -> dict:
+    from .dump_shapes import base_mass, shapes
+    mass, inertia, with_density = base_mass(b)   # the shapes with a density add theirs on loading
     if b.is_particle:
-        d = {"name": b.name, "mass": float(b.mass), "position": _vec(b.position)}
+        d = {"name": b.name, "mass": float(mass), "position": _vec(b.position)}
         _put(d, "velocity", _given(b, "velocity"))
     else:
-        d = {"name": b.name, "mass": float(b.mass), "inertia": _inertia(b.inertia), "position": _vec(b.position)}
+        d = {"name": b.name, "mass": float(mass), "inertia": _inertia(inertia), "position": _vec(b.position)}
         _put(d, "orientation", _matrix(b.orientation))
         _put(d, "velocity", _given(b, "velocity"))
         _put(d, "angular_velocity", _given(b, "angular_velocity"))
-    return _put(d, "markers", _markers(b), [])
+    _put(d, "markers", _markers(b), [])
+    return _put(d, "shapes", shapes(b, base_dir, with_density, _vec, _unit, _matrix), [])
 
 
 def _joint_values(j, field):
@@ -251,6 +254,10 @@ def _element(e) -> dict:
     if isinstance(e, Bushing):
         return {**head, "type": "bushing", "marker_i": _marker_ref(e.marker_i), "marker_j": _marker_ref(e.marker_j),
                 "stiffness": _vec(e.stiffness), "damping": _vec(e.damping), "preload": _vec(e.preload)}
+    from ..model.contacts import ShapeContact
+    if isinstance(e, ShapeContact):
+        from .dump_shapes import shape_contact
+        return shape_contact(e, _shape)
     if isinstance(e, Contact):
         return {**head, "type": "contact", "shape_i": _shape(e.shape_i), "shape_j": _shape(e.shape_j),
                 "stiffness": e.stiffness, "exponent": e.exponent, "damping": e.damping,
@@ -270,14 +277,18 @@ def _element(e) -> dict:
     raise ModelError(f"element '{e.name}'", "type", f"{type(e).__name__} cannot be stored in a model file")
 
 
-def model_to_dict(model) -> dict:
-    """Plain data (SI numbers, expression strings) describing `model` in the model-file schema."""
+def model_to_dict(model, base_dir=None) -> dict:
+    """Plain data (SI numbers, expression strings) describing `model` in the model-file schema; mesh files
+    are written relative to `base_dir` (the model file's folder; None: absolute paths)."""
+    from .dump_shapes import shapes
     bodies = [b for b in model.bodies.values() if not b.is_ground]
     d = {"name": model.name, "gravity": _vec(model.gravity)}
-    if model.ground.markers:
-        d["ground"] = {"markers": _markers(model.ground)}
-    d |= {"bodies": [_body(b) for b in bodies if not b.is_particle],
-         "particles": [_body(b) for b in bodies if b.is_particle],
+    ground = {k: v for k, v in (("markers", _markers(model.ground)),
+                                ("shapes", shapes(model.ground, base_dir, False, _vec, _unit, _matrix))) if v}
+    if ground:
+        d["ground"] = ground
+    d |= {"bodies": [_body(b, base_dir) for b in bodies if not b.is_particle],
+         "particles": [_body(b, base_dir) for b in bodies if b.is_particle],
          "joints": [_joint(j) for j in model.joints.values()]
          + [_path(p) for p in getattr(model, "path_constraints", {}).values()],
          "motions": [_motion(m) for m in model.motions.values()],

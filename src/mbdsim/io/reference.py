@@ -167,7 +167,13 @@ def _example(cls, kind=None) -> dict:
 
 # hand-written examples where the generated one (required fields, placeholder values) is not valid
 _EXAMPLES: dict[str, dict] = {
-    "BodySpec": {"name": "arm", "mass": "2 kg", "inertia": [0.01, 0.02, 0.02], "position": ["100 mm", 0, 0]},
+    "BodySpec": {"name": "arm", "mass": "2 kg", "inertia": [0.01, 0.02, 0.02], "position": ["100 mm", 0, 0],
+                 "shapes": [{"name": "geo", "geometry": {"type": "box", "size": ["200 mm", "20 mm", "20 mm"]}},
+                            {"name": "tip", "geometry": {"type": "mesh", "path": "meshes/tip.stl", "scale": 0.001},
+                             "center": ["200 mm", 0, 0], "density": "2700 kg/m**3"}]},
+    "ContactSpec": {"type": "contact", "name": "floor", "shape_i": "ground.floor", "shape_j": ["arm.geo", "arm.tip"],
+                    "stiffness": "100 kN/m", "exponent": 1.0, "damping": "20 N*s/m", "penetration": "0.1 mm",
+                    "mu_static": 0.3, "mu_dynamic": 0.2, "stiction_velocity": "1 mm/s"},
     "PointOnCurveSpec": {"type": "point_on_curve", "name": "follower", "marker": "arm.tip", "body": "ground",
                          "curve": {"type": "spline", "points": [[0, 0, 0], ["100 mm", "50 mm", 0], ["200 mm", 0, 0]]}},
 }

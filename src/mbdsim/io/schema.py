@@ -82,11 +82,14 @@ class BoxSpec(Spec):
     size: V("m")
 
 
+Axis = Union[Literal["x", "y", "z"], V("")]   # a geometry's axis: "x", "y", "z" or a vector in its own axes
+
+
 class CylinderSpec(Spec):
     type: Literal["cylinder"]
     radius: Length
     length: Length
-    axis: Literal["x", "y", "z"] = "z"
+    axis: Axis = "z"
 
 
 class SphereShapeSpec(Spec):
@@ -95,6 +98,58 @@ class SphereShapeSpec(Spec):
 
 
 MassShape = Annotated[Union[BoxSpec, CylinderSpec, SphereShapeSpec], Field(discriminator="type")]
+
+
+class CapsuleSpec(Spec):
+    """Points within `radius` of a segment of `length` (between the cap centres) along `axis`."""
+
+    type: Literal["capsule"]
+    radius: Length
+    length: Length
+    axis: Axis = "z"
+
+
+class EllipsoidSpec(Spec):
+    type: Literal["ellipsoid"]
+    radii: V("m")
+
+
+Points = Annotated[list[V("m")], Field(min_length=4)]
+
+
+class ConvexMeshSpec(Spec):
+    """The convex hull of `vertices` [m] (the geometry's axes)."""
+
+    type: Literal["convex_mesh"]
+    vertices: Points
+
+
+class MeshSpec(Spec):
+    """A triangle mesh: a file (STL, OBJ, PLY; a path relative to the model file's folder, or absolute)
+    whose coordinates times `scale` are metres, or `vertices` [m] with `faces` (vertex index triples)."""
+
+    type: Literal["mesh"]
+    path: Optional[Name] = None
+    scale: Number = 1.0
+    vertices: Optional[Points] = None
+    faces: Optional[Annotated[list[Annotated[list[int], Field(min_length=3, max_length=3)]],
+                              Field(min_length=1)]] = None
+
+
+Geometry = Annotated[Union[BoxSpec, CylinderSpec, CapsuleSpec, EllipsoidSpec, SphereShapeSpec, ConvexMeshSpec,
+                           MeshSpec], Field(discriminator="type")]
+
+
+class ShapeSpec(Spec):
+    """A geometry placed on the body (Body.add_shape): for contact, the viewer and, with `density`, mass
+    properties (added to the body's `mass` and `inertia`).  `center` [m] and `orientation` (geometry ->
+    ground) in ground at t = 0; defaults the body's centre of mass and axes."""
+
+    name: Name
+    geometry: Geometry
+    center: Optional[V("m")] = None
+    orientation: Optional[Orientation] = None
+    density: Optional[Q("kg/m**3")] = None
 
 
 class LocationSpec(Spec):
@@ -128,12 +183,15 @@ class BodySpec(Spec):
     velocity: Optional[V("m/s")] = None            # None: free, solved at assembly (as in the API)
     angular_velocity: Optional[V("rad/s")] = None
     markers: list[MarkerSpec] = []
+    shapes: list[ShapeSpec] = []
 
 
 class GroundSpec(Spec):
-    """The ground body, fixed: only its markers (`model.ground.add_marker` in the API), named "ground.<name>"."""
+    """The ground body, fixed: its markers (`model.ground.add_marker` in the API), named "ground.<name>", and
+    its shapes (without density), named "ground.<name>" in contacts."""
 
     markers: list[MarkerSpec] = []
+    shapes: list[ShapeSpec] = []
 
 
 class ParticleSpec(Spec):
@@ -142,6 +200,7 @@ class ParticleSpec(Spec):
     position: V("m") = [0.0, 0.0, 0.0]
     velocity: Optional[V("m/s")] = None
     markers: list[MarkerSpec] = []
+    shapes: list[ShapeSpec] = []     # spheres only (a particle has no orientation)
 
 
 # ----------------------------------------------------------------------------- joints
@@ -340,21 +399,32 @@ class ContactPlaneSpec(Spec):
 
 
 ContactShape = Annotated[Union[ContactSphereSpec, ContactPlaneSpec], Field(discriminator="type")]
+# a body's shape by "body.shape" (BodySpec.shapes), or an inline sphere / plane
+ShapeRef = Union[Name, ContactShape]
+ShapeSide = Union[ShapeRef, Annotated[list[ShapeRef], Field(min_length=1)]]
 
 
 class ContactSpec(Spec):
-    """Adams IMPACT contact: stiffness [N/m^exponent] (a number in SI), damping [N s/m] at `penetration` [m]."""
+    """Contact between shapes (one or a list on each side: every pair between the lists): the Adams IMPACT
+    law, stiffness [N/m^exponent] (a number in SI, or with units), damping [N s/m] reached at `penetration`
+    [m], or POISSON with `restitution` (0..1).  Friction: `mu` regularised below `friction_velocity`, or
+    Adams' `mu_static`, `mu_dynamic`, `stiction_velocity` and `transition_velocity`."""
 
     type: Literal["contact"]
     name: Name
-    shape_i: ContactShape
-    shape_j: ContactShape
+    shape_i: ShapeSide
+    shape_j: ShapeSide
     stiffness: Raw
     exponent: Number
     damping: Q("N*s/m")
     penetration: Length
     mu: Number = 0.0
     friction_velocity: Q("m/s") = 1e-3
+    restitution: Optional[Number] = None
+    mu_static: Optional[Number] = None
+    mu_dynamic: Optional[Number] = None
+    stiction_velocity: Optional[Q("m/s")] = None
+    transition_velocity: Optional[Q("m/s")] = None
 
 
 class StopSpec(Spec):

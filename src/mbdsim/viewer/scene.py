@@ -31,12 +31,16 @@ class Scene:
     shapes: list = field(default_factory=list)
     signal: dict | None = None
     trails: bool = False      # draw each body's centre-of-mass path
+    # shape-contact forces drawn as arrows: {"scale": arrow length per force [m/N], "frames": per frame a flat
+    # list x, y, z [m], Fx, Fy, Fz [N] of each touching point (force on shape_j, ground axes)}; None: not drawn
+    contact_forces: dict | None = None
 
     def to_json(self) -> dict:
         """The scene as a JSON-ready dict."""
         return {"title": self.title, "up": self.up, "scale": self.scale, "time": self.time,
                 "bodies": self.bodies, "joints": self.joints, "springs": self.springs,
-                "shapes": self.shapes, "signal": self.signal, "trails": self.trails}
+                "shapes": self.shapes, "signal": self.signal, "trails": self.trails,
+                "contact_forces": self.contact_forces}
 
 
 def frame_indices(n: int, max_frames: int = MAX_FRAMES) -> np.ndarray:
@@ -82,10 +86,11 @@ def _local(body, point_ground) -> list:
 
 
 def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int = MAX_FRAMES,
-                title: str | None = None) -> Scene:
+                title: str | None = None, contact_forces: bool = False) -> Scene:
     """Extract the scene of a Result: at most `max_frames` frames; `signal` as in `mbdsim.plot` (or None);
     `geometry` maps a body (or its name) to an mb.Sphere drawn instead of its equivalent box (its centre
-    in ground at t=0, default the body's CM)."""
+    in ground at t=0, default the body's CM); `contact_forces`: the force at each touching point of the
+    shape contacts, per frame (Scene.contact_forces, drawn as arrows)."""
     system, model = res.system, res.system.model
     if len(res.time) == 0:
         raise ModelError("animation", "result", "the result holds no samples")
@@ -112,7 +117,36 @@ def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int 
             scene.shapes.append({**d, "body": _on(b, index)})
     if signal is not None:
         scene.signal = _signal(sub, signal)
+    if contact_forces:
+        scene.contact_forces = _contact_forces(sub, model, scale)
     return scene
+
+
+def _contact_forces(res, model, scale: float) -> dict:
+    """Scene.contact_forces: every contact's touching points and forces (on shape_j) per frame; a
+    force of the 90th percentile of all point forces of the run is drawn 0.1 scene sizes long (so that
+    impact peaks do not shrink resting forces out of sight; the page caps arrows at 0.3 scene sizes)."""
+    from ..model.contacts import ShapeContact
+    from ..model.element_specs import Contact
+    from ..results.contacts import _records
+    frames = [[] for _ in res.time]
+    for el in model.forces.values():
+        if isinstance(el, Contact):   # the exact sphere-plane / sphere-sphere contact: its own evaluator
+            from ..system.force_elements.contact import _forces, contact_state
+            g, n, cp, v_rel = contact_state(res.system, res.frames, el)
+            Fn, _, _, Ft = _forces(el, g, n, v_rel)
+            F = Fn[:, None] * n + Ft
+            for k in np.nonzero(Fn > 0)[0]:
+                frames[k].extend(np.concatenate([cp[k], F[k]]))
+        elif isinstance(el, ShapeContact):
+            for k, rc in enumerate(_records(res, el)):
+                if len(rc):
+                    F = rc[:, 8:9] * rc[:, 4:7] + rc[:, 9:12]
+                    frames[k].extend(np.column_stack([rc[:, 1:4], F]).ravel())
+    mags = np.concatenate([np.linalg.norm(np.reshape(f, (-1, 6))[:, 3:], axis=1) for f in frames if f] or
+                          [np.zeros(0)])
+    ref = float(np.percentile(mags, 90)) if len(mags) else 0.0
+    return {"scale": float(f"{0.1 * scale / ref:.6g}") if ref > 0 else 0.0, "frames": [_r(f) for f in frames]}
 
 
 def _scale(model, pos: dict) -> float:

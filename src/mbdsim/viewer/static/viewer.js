@@ -129,6 +129,41 @@ function updateSprings() {
   }
 }
 
+// contact forces (on request): an arrow per touching point along the force on shape_j, its tip at the point
+// (it pushes on shape_j), drawn over the bodies
+const CF = data.contact_forces, arrows = [];
+const arrowGroup = new THREE.Group();
+arrowGroup.name = 'contact-forces';
+scene.add(arrowGroup);
+function updateArrows(k, f) {
+  if (!CF) return 0;
+  const pts = CF.frames[N === 1 || f < 0.5 ? k : k + 1] || [];
+  const n = pts.length / 6;
+  while (arrows.length < n) {
+    const a = new THREE.ArrowHelper(new THREE.Vector3(0, 0, 1), new THREE.Vector3(), 1, 0xd62728);
+    a.frustumCulled = false;
+    a.renderOrder = 999;
+    for (const part of [a.line, a.cone]) { part.material.depthTest = false; part.material.transparent = true; part.renderOrder = 999; }
+    arrowGroup.add(a);
+    arrows.push(a);
+  }
+  let shown = 0;
+  arrows.forEach((a, i) => {
+    if (i >= n) { a.visible = false; return; }
+    _d.set(pts[6 * i + 3], pts[6 * i + 4], pts[6 * i + 5]);
+    const len = Math.min(_d.length() * CF.scale, 0.3 * S);
+    a.visible = len > 1e-6 * S;
+    if (!a.visible) return;
+    _d.normalize();
+    a.position.set(pts[6 * i] - _d.x * len, pts[6 * i + 1] - _d.y * len, pts[6 * i + 2] - _d.z * len);
+    a.setDirection(_d);
+    a.setLength(len, Math.min(0.3 * len, 0.03 * S), Math.min(0.15 * len, 0.015 * S));
+    shown += 1;
+  });
+  return shown;
+}
+let arrowsShown = 0;
+
 // ------------------------------------------------------------------ floor grid and camera (placed by fitView)
 const side = Math.abs(up.z) > 0.9 ? new THREE.Vector3(0, -1, 0) : new THREE.Vector3(0, 0, 1);
 const right = new THREE.Vector3().crossVectors(up, side).normalize();
@@ -158,6 +193,7 @@ function pose(t) {
     _q0.fromArray(b.quat, 4 * k); _q1.fromArray(b.quat, 4 * k1);
     g.quaternion.slerpQuaternions(_q0, _q1, N === 1 ? 0 : f);
   });
+  arrowsShown = updateArrows(k, f);
   scene.updateMatrixWorld(true);
   updateSprings();
   return [k, f];
@@ -287,4 +323,5 @@ function project(name) {
 window.mbdsimViewer = {
   setTime, play, pause: () => setTime(time), get time() { return time; }, get playing() { return playing; },
   duration: t1 - t0, start: t0, end: t1, frames: N, ready: true, project, scene, camera, render,
+  get contactArrows() { return arrowsShown; },   // arrows drawn at the current time
 };
