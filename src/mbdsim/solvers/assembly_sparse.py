@@ -276,6 +276,7 @@ def _newton(sys, q, t, tol, Dinv, coords, scale, maxit, backtrack, held=False):
         if coords is not None:
             coords.eval(q)
         rows, hk = _select(sys, J, Jc, coords)
+        last = np.inf
         for _ in range(maxit):
             res = float(np.max(np.abs(phi), initial=0.0))
             if not held and res <= tol:
@@ -295,8 +296,9 @@ def _newton(sys, q, t, tol, Dinv, coords, scale, maxit, backtrack, held=False):
             phi, J, _, _, Jc = sparse_terms(sys, q, zero, t)
             if coords is not None:
                 coords.eval(q)
-            if held and small < 1e-14 * max(1.0, L) and res <= tol:
-                break
+            if held and small < 1e-14 * max(1.0, L) and (res <= tol or res >= last):
+                break   # converged (or at round-off: phi of a km-long chain does not reach 1e-12)
+            last = res
             if not held and small < 1e-15 * max(1.0, float(np.max(np.abs(q)))):
                 break
         res = float(np.max(np.abs(phi), initial=0.0))

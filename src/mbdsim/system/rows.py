@@ -188,20 +188,29 @@ def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=No
     d = np.abs(lu.U.diagonal())
     if d.min() <= 1e-13 * d.max():
         return None
-    kept = [tree]
-    Q = np.zeros((sys.nv, 0))
+    kept, PL = [tree], np.zeros((0, sys.nv))
     if len(loop):
         P = _project(AT, lu, J[loop])
-        dd, piv = pivoted_qr(P.T)
-        sel = np.sort(piv[:int(np.sum(dd > tol * scale))])
+        sel = _pivoted_rows(P, tol * scale)
         kept.append(loop[sel])
-        Q = np.linalg.qr(P[sel].T)[0] if len(sel) else Q
+        PL = P[sel]
     if len(extra):
         P = _project(AT, lu, H[extra])
-        P -= (P @ Q) @ Q.T
-        dd, piv = pivoted_qr(P.T)
-        keep_h[extra[piv[:int(np.sum(dd > tol * hscale))]]] = True
+        if len(PL):   # minus its projection on the kept loop rows: P PL^T (PL PL^T)^-1 PL, PL^T = Q R
+            st = lazy_import("scipy.linalg").solve_triangular
+            R = np.linalg.qr(PL.T, mode="r")
+            P -= st(R, st(R, (P @ PL.T).T, trans="T")).T @ PL
+        keep_h[extra[_pivoted_rows(P, tol * hscale)]] = True
     return np.sort(np.concatenate(kept)), np.flatnonzero(keep_h)
+
+
+def _pivoted_rows(P, thr):
+    """Sorted rows of P kept by the column-pivoted QR of P^T (|R_kk| > thr), its R taken from the R of an
+    unpivoted QR of P^T first when P^T is tall (the same pivots and |R_kk|, by blocked BLAS-3: a few
+    hundred loop rows of a 10,000-body model in seconds, not minutes)."""
+    A = np.linalg.qr(P.T, mode="r") if P.shape[1] > 2 * P.shape[0] else P.T
+    dd, piv = pivoted_qr(np.asarray(A))
+    return np.sort(piv[:int(np.sum(dd > thr))])
 
 
 def _project(AT, lu, K):
