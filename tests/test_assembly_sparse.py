@@ -53,7 +53,8 @@ MODELS = textwrap.dedent('''
         for k in range(every - 1, n, every):
             r = m.add_body(f"r{k}", 1.0, inertia=(0.01, 0.1, 0.1), position=(0.5, -0.5 - k, 0.0))
             add(f"ra{k}", f"a{k}", r, (0.0, -0.5 - k, 0.0))
-            mi, mj = r.add_marker("e", (1.0 - gap, -0.5 - k, 0.0)), m.bodies[f"b{k}"].add_marker("r", (1.0, -0.5 - k, 0.0))
+            mi = r.add_marker("e", (1.0 - gap, -0.5 - k, 0.0))
+            mj = m.bodies[f"b{k}"].add_marker("r", (1.0, -0.5 - k, 0.0))
             if kind == "spherical":
                 m.add_spherical(f"rb{k}", mi, mj)
             else:
@@ -168,14 +169,16 @@ def _both_routes(make, monkeypatch):
     return reps, caught
 
 
-@pytest.mark.parametrize("case", ["chain", "chain drawn", "ladder3d", "ladder planar", "given body velocities"])
+@pytest.mark.parametrize("case", ["chain", "chain drawn", "ladder3d", "ladder planar", "given body velocities",
+                                  "ladder given velocities"])
 def test_small_models_same_state_on_both_routes(case, monkeypatch):
     rng = np.random.default_rng(3)
     th, om = rng.uniform(-0.6, 0.6, 7), rng.uniform(-1.0, 1.0, 7)
     make = {"chain": lambda: gapped_chain(7, th, om), "chain drawn": lambda: gapped_chain(7),
             "ladder3d": lambda: ladder(6, 3, gap=0.05),
             "ladder planar": lambda: ladder(6, 3, gap=0.05, kind="revolute"),
-            "given body velocities": lambda: _with_velocities(gapped_chain(4, th[:4], None))}[case]
+            "given body velocities": lambda: _with_velocities(gapped_chain(4, th[:4], None)),
+            "ladder given velocities": lambda: _with_velocities(ladder(4, 2, gap=0.05))}[case]
     (dense, sparse), (wd, ws) = _both_routes(make, monkeypatch)
     assert dense.residual < 1e-12 and sparse.residual < 1e-12
     assert np.abs(dense.q - sparse.q).max() < 1e-10 and np.abs(dense.v - sparse.v).max() < 1e-10
@@ -204,3 +207,17 @@ def test_inconsistent_held_values_warned_on_the_sparse_route(monkeypatch):
     with pytest.warns(mb.InitialConditionWarning, match="body 'b0' angular_velocity given"):
         rep = mb.assemble(m)
     assert rep.v[rep.system.w_idx][0, 2] == pytest.approx(0.5, abs=1e-12)
+
+
+def test_over_driven_four_bar_named_on_the_sparse_route(monkeypatch):
+    """The sparse route drops rows it finds dependent and fails to close the loop: the dense route (the
+    model being small enough) then names the over-driving motions, as without the sparse route."""
+    sys.path.insert(0, __file__.rsplit("/", 1)[0])
+    from test_marker_joints import four_bar
+    monkeypatch.setattr(assembly_sparse, "SPARSE_NV", 0)
+    model, _, _ = four_bar(offset=(0, 0, 0), turn=0.0, rocker_motion=True)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(mb.AssemblyError, match="over-driven") as err:
+            mb.assemble(model)
+    assert "drive" in err.value.joints and "rocker_drive" in err.value.joints

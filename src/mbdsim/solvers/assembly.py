@@ -152,7 +152,14 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         return AssemblyReport(sys, t, q0.copy(), v0.copy(), rows, sys.nv - len(rows), [], {}, {},
                               float(np.max(np.abs(phi), initial=0.0)), [], notes, {})
     from . import assembly_sparse
-    solved = assembly_sparse.assemble_sparse(sys, q0, v0, t, tol) if sys.nv > assembly_sparse.SPARSE_NV else None
+    solved = None
+    if sys.nv > assembly_sparse.SPARSE_NV:
+        try:
+            solved = assembly_sparse.assemble_sparse(sys, q0, v0, t, tol)
+        except AssemblyError:
+            if not sys.model.motions or 8.0 * sys.nv * max(sys.nc, 1) > DENSE_BYTES:
+                raise
+            solved = "its motions may be over-driven"   # the dense route names them (_check_overdriven)
     if isinstance(solved, tuple):
         q, v, rows, changed, vchanged, phi, dropped = solved
         return _report(sys, q0, v0, t, q, v, rows, changed, vchanged, phi, _sparse_redundancy(sys, dropped))

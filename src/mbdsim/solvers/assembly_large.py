@@ -68,10 +68,13 @@ def consistent_tree(sys, q0, v0, t, tol):
     return np.arange(sys.nc), phi
 
 
+NOT_KERNEL_ROWS = "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
+
+
 def structural_reason(sys) -> str | None:
     """Why the model itself (whatever its state) cannot take `consistent_tree`, in words, or None."""
     if not sys.kernel_rows or len(sys.lock_rows):
-        return "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
+        return NOT_KERNEL_ROWS
     if any(jt.initial_displacement is not None or jt.initial_velocity is not None
            for jt in sys.model.joints.values()):
         return "joint initial displacements or velocities are given"

@@ -35,7 +35,7 @@ from ..system.equations import _packed
 from ..system.frames import body_frames
 from ..system.metrics import kinetic_parts, length_scale, position_metric
 from ..system.rows import DENSE_LIMIT, _tree_plan, independent_rows_sparse
-from .assembly_large import compact_to_csr, sparse_terms
+from .assembly_large import NOT_KERNEL_ROWS, compact_to_csr, sparse_terms
 from .common import increment
 from .held import Held, changed_items, coordinate_rows
 
@@ -49,7 +49,7 @@ class _Refused(Exception):
 def sparse_reason(sys) -> str | None:
     """Why the sparse assembly cannot take this System (whatever its state), in words, or None."""
     if not sys.kernel_rows or len(sys.lock_rows):
-        return "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
+        return NOT_KERNEL_ROWS
     for jt in sys.model.joints.values():
         given = jt.initial_displacement is not None or jt.initial_velocity is not None
         if given and jt.name in sys.geoms and coordinate_rows(sys, jt) is None:
@@ -289,7 +289,8 @@ def _newton(sys, q, t, tol, Dinv, coords, scale, maxit, backtrack, held=False):
             step = 1.0
             if backtrack and res > 1e-6:
                 n0 = float(np.linalg.norm(phi[rows]))
-                while step > 1e-3 and np.linalg.norm(sparse_terms(sys, increment(sys, q, step * dx), zero, t)[0][rows]) >= n0:
+                trial = lambda h: sparse_terms(sys, increment(sys, q, h * dx), zero, t)[0][rows]  # noqa: E731
+                while step > 1e-3 and np.linalg.norm(trial(step)) >= n0:
                     step *= 0.5   # far from the solution: backtrack along the Gauss-Newton direction
             q = increment(sys, q, step * dx)
             small = float(np.max(np.abs(dx), initial=0.0))
