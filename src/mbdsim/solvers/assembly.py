@@ -151,13 +151,26 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
         return AssemblyReport(sys, t, q0.copy(), v0.copy(), rows, sys.nv - len(rows), [], {}, {},
                               float(np.max(np.abs(phi), initial=0.0)), [], notes, {})
+    from . import assembly_sparse
+    solved = None
+    if sys.nv > assembly_sparse.SPARSE_NV:
+        try:
+            solved = assembly_sparse.assemble_sparse(sys, q0, v0, t, tol)
+        except AssemblyError:
+            if not sys.model.motions or 8.0 * sys.nv * max(sys.nc, 1) > DENSE_BYTES:
+                raise
+            solved = "its motions may be over-driven"   # the dense route names them (_check_overdriven)
+    if isinstance(solved, tuple):
+        q, v, rows, changed, vchanged, phi, dropped = solved
+        return _report(sys, q0, v0, t, q, v, rows, changed, vchanged, phi, _sparse_redundancy(sys, dropped))
     if 8.0 * sys.nv * max(sys.nc, 1) > DENSE_BYTES:
         from .assembly_large import why_dense
         raise AssemblyError(f"assembly of {sys.nbody} bodies ({sys.nv} velocity variables, {sys.nc} constraint "
                             f"equations) needs dense matrices of {8.0 * sys.nv * sys.nc / 2**30:.1f} GB "
-                            f"here because {why_dense(sys)}; a large model assembles without "
-                            "them when its joints form a tree, it is drawn assembled with consistent "
-                            "velocities and no joint initial values are given", time=float(t))
+                            f"here because {solved or why_dense(sys)}; a large model assembles without "
+                            "them when the compiled kernels evaluate all its constraints (no couplers, paths "
+                            "or joint friction), its tree joints are independent and its loops close "
+                            "few rows", time=float(t))
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:
@@ -175,17 +188,49 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     if redundant and getattr(sys.model, "planar", None) is not None:   # dependent by design (issue 11)
         from .planar import planar_redundancy
         redundant, planar_note = planar_redundancy(sys, q, J, rows)
+    vchanged = None
+    if v0 is sys.v0:
+        v, vchanged = velocities(sys, q, t, rows, terms)
+    else:
+        v = project_velocities(sys, q, v0, t, rows)
+    return _report(sys, q0, v0, t, q, v, rows, changed, vchanged, terms[0][rows_all], (redundant, planar_note))
+
+
+def _sparse_redundancy(sys, dropped):
+    """(redundant owners, planar note) of the rows the sparse selection dropped: the owners of those rows
+    (the dense route also names the kept rows they depend on); a planar model's dropped rows are taken
+    as its out-of-plane equations, dependent by design (the dense route checks them row by row)."""
+    if not len(dropped):
+        return [], None
+    _check_motions(sys, dropped)
+    owners = list(dict.fromkeys(sys.row_owner[r] for r in dropped))
+    if getattr(sys.model, "planar", None) is not None:
+        return [], (f"planar model: {len(dropped)} out-of-plane equations are dependent by design and dropped "
+                    f"(rows of {', '.join(sorted(owners))}); in-plane reactions are determinate")
+    return owners, None
+
+
+def _check_motions(sys, dropped):
+    """AssemblyError naming the motions whose rows the sparse selection dropped (over-driven)."""
+    bad = [m for m in dict.fromkeys(sys.row_owner[r] for r in dropped) if m in sys.model.motions]
+    if bad:
+        raise AssemblyError("over-driven mechanism: motion(s) " + ", ".join(f"'{m}'" for m in bad) +
+                            " are dependent on the constraints and the other motions (remove one)", joints=bad)
+
+
+def _report(sys, q0, v0, t, q, v, rows, changed, vchanged, phi, redundancy) -> AssemblyReport:
+    """The AssemblyReport of an assembled state, with the warnings of redundant rows and changed values
+    (vchanged: the changed given velocities, None when v0 was not the System's own)."""
+    redundant, planar_note = redundancy
     if redundant:
         warn(f"redundant constraints: {sys.nc - len(rows)} of {sys.nc} equations are dependent; "
              f"joints involved: {', '.join(redundant)}. The dynamics use an independent subset; "
              "indeterminate reaction components are returned as the minimum-norm solution.",
              RedundantConstraintWarning)
-    if v0 is sys.v0:
-        v, vchanged = velocities(sys, q, t, rows, terms)
-        changed += vchanged
+    if vchanged is not None:
+        changed = changed + vchanged
         vmoved = {e.split("'")[1]: float(np.linalg.norm(u - g)) for e, f, g, u in vchanged if e.startswith("body")}
     else:
-        v = project_velocities(sys, q, v0, t, rows)
         vmoved = _vchanged(sys, v0, v)
     moves = [_change(sys, q, e, f, g, u) for e, f, g, u in changed]
     if changed:
@@ -197,7 +242,6 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
     for (e, f, _, _), (d, _) in zip(changed, moves):
         if e.startswith("joint"):
             jmoved.setdefault(e.split("'")[1], {})[f] = d
-    phi = terms[0][rows_all]
     notes = [f"joint '{j.name}': {n}" for j in sys.model.joints.values() for n in getattr(j, "notes", [])]
     notes += [planar_note] if planar_note else []
     return AssemblyReport(sys, t, q, v, rows, sys.nv - len(rows), redundant, _moved(sys, q0, q),
@@ -210,9 +254,11 @@ def _change(sys, q, entity, fld, given, used):
     d = np.atleast_1d(np.asarray(used, dtype=float) - np.asarray(given, dtype=float))
     if entity.startswith("body"):
         return d, " m/s" if fld == "velocity" else " rad/s"
-    from .held import ROTVEC_JOINTS, joint_values
+    from .held import ROTVEC_JOINTS, coordinate_rows, joint_values
     jt = sys.model.joints[entity.split("'")[1]]
-    angle = np.ones(len(d), dtype=bool) if jt.kind in ROTVEC_JOINTS else joint_values(sys, jt, q)[4][:len(d)]
+    rows = None if jt.kind in ROTVEC_JOINTS else coordinate_rows(sys, jt)
+    angle = np.ones(len(d), dtype=bool) if jt.kind in ROTVEC_JOINTS else \
+        np.array([a for _, _, a in rows])[:len(d)] if rows is not None else joint_values(sys, jt, q)[4][:len(d)]
     if fld == "initial_displacement":
         d = np.where(angle, (d + np.pi) % (2 * np.pi) - np.pi, d)
     units = [("rad" if a else "m") + ("/s" if fld == "initial_velocity" else "") for a in angle]
@@ -299,9 +345,10 @@ def _residual(sys, q, t, rows):
                         initial=0.0))
 
 
-def _check_residual(sys, q, t, rows, res):
+def _check_residual(sys, q, t, rows, res, phi=None):
+    """AssemblyError naming the joints of the largest residuals when res > 1e-9 (phi: of all rows at q)."""
     if res > 1e-9:
-        phi = constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0][rows]
+        phi = (constraint_terms(sys, q, np.zeros(sys.nv), t, jacobian=False)[0] if phi is None else phi)[rows]
         worst = [sys.row_owner[rows[k]] for k in np.argsort(-np.abs(phi))[:4] if abs(phi[k]) > 1e-9]
         raise AssemblyError(f"assembly failed: constraint residual {res:.3g} cannot be removed",
                             time=t, joints=dict.fromkeys(worst), state=q)

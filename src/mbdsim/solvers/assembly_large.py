@@ -16,7 +16,7 @@ from .._blas import lazy_import
 from ..system.equations import _packed, driver_values
 from ..system.frames import body_frames
 from ..system import kernels
-from ..system.rows import DENSE_LIMIT, _tree_plan
+from ..system.rows import DENSE_LIMIT, _tree_plan, compact_blocks_independent
 
 
 def sparse_terms(sys, q, v, t):
@@ -63,19 +63,18 @@ def consistent_tree(sys, q0, v0, t, tol):
     if np.max(np.abs(phi), initial=0.0) > tol or \
             np.max(np.abs(J @ v0 - nu), initial=0.0) > 1e-9 * max(1.0, float(np.max(np.abs(nu), initial=0.0))):
         return None
-    bj = _packed(sys)[2]
-    for rows, adr, width in blocks:   # each tree block independent on its child body's velocities
-        side = (sys.frame_v_adr[bj[rows]] == adr[:, None]).astype(np.int64)    # (nb, k): the child's side
-        cols = Jc[rows, side, :width]                                            # (nb, k, width)
-        if np.linalg.svd(cols, compute_uv=False).min() <= 1e-9 * scale:
-            return None
+    if not compact_blocks_independent(sys, Jc, _packed(sys)[2], blocks, 1e-9 * scale):
+        return None   # each tree block independent on its child body's velocities
     return np.arange(sys.nc), phi
+
+
+NOT_KERNEL_ROWS = "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
 
 
 def structural_reason(sys) -> str | None:
     """Why the model itself (whatever its state) cannot take `consistent_tree`, in words, or None."""
     if not sys.kernel_rows or len(sys.lock_rows):
-        return "it has constraints the compiled kernels do not evaluate (couplers, paths, joint friction)"
+        return NOT_KERNEL_ROWS
     if any(jt.initial_displacement is not None or jt.initial_velocity is not None
            for jt in sys.model.joints.values()):
         return "joint initial displacements or velocities are given"

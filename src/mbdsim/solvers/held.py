@@ -77,6 +77,24 @@ def joint_values(sys, jt, q, v=None):
     return x, rate, rows, pos, angle
 
 
+def coordinate_rows(sys, jt):
+    """The joint's coordinates as constraint rows the compiled kernels evaluate, [(kind, vectors, angle)]:
+    an angle row (kind 5: the angle of f_j about h_i, as `measures.joint_coordinate`) and a slide row
+    (kind 6: h_i . (P_j - P_i)), the rows of a motion driver on that coordinate without its target; a
+    planar joint's u and v are slides along f_i and g_i, then its angle.  None for the joints whose
+    coordinates are a rotation vector (spherical, universal, constant velocity) or a planar joint on a
+    particle (`joint_values` evaluates those)."""
+    from ..model.joint_kinds import has_slide, is_angle
+    g = sys.geoms[jt.name]
+    if jt.kind in ROTVEC_JOINTS or (jt.kind == "planar" and g.particle_j):
+        return None
+    angle = (5, (g.f_i, g.g_i, g.f_j), True)
+    if jt.kind == "planar":
+        return [(6, (g.f_i, g.s_i, g.s_j), False), (6, (g.g_i, g.s_i, g.s_j), False), angle]
+    out = [angle] if is_angle(jt.kind) and not g.particle_j else []
+    return out + ([(6, (g.h_i, g.s_i, g.s_j), False)] if has_slide(jt.kind) else [])
+
+
 def joint_position_items(sys, q, scale=1.0):
     """Held joint displacements (scaled by `scale`, for continuation) at q."""
     out = []

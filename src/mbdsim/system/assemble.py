@@ -202,12 +202,21 @@ def _assemble_system(model) -> System:
 def mass_matrix(sys) -> np.ndarray:
     """Dense constant mass matrix (nv, nv) of a System (see System.M)."""
     M = np.zeros((sys.nv, sys.nv))
-    for f in range(1, sys.nbody + 1):
-        a = int(sys.frame_v_adr[f])
-        M[range(a, a + 3), range(a, a + 3)] = sys.mass[f]
-        if sys.frame_rigid[f]:
-            M[a + 3:a + 6, a + 3:a + 6] = sys.inertia_B[f]
+    for a, block in zip(*mass_blocks(sys)):
+        M[a:a + 3, a:a + 3] = block
     return M
+
+
+def mass_blocks(sys):
+    """(first velocity column (nb,), 3x3 blocks (nb, 3, 3)) of the block-diagonal mass matrix: each body's
+    mass times the identity on its CM velocity [kg], each rigid body's inertia about its CM in body axes
+    on its angular velocity [kg m^2]; the massless auxiliary coordinates have no block."""
+    f = np.arange(1, sys.nbody + 1)
+    adr = sys.frame_v_adr[f]
+    trans = sys.mass[f, None, None] * np.eye(3)
+    rig = f[sys.frame_rigid[f]]
+    return (np.concatenate([adr, sys.frame_v_adr[rig] + 3]).astype(np.int64),
+            np.concatenate([trans, sys.inertia_B[rig]]))
 
 
 def joint_geometry(joint, fid) -> JointGeom:

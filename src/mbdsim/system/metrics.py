@@ -56,13 +56,29 @@ def position_metric(sys) -> np.ndarray:
 @_cached("kinetic_metric")
 def kinetic_metric(sys) -> np.ndarray:
     """The mass matrix, with the position weights standing in where it has no mass (massless bodies,
-    zero moments of slender rods, curve parameters), so that it is positive definite."""
-    D = position_metric(sys)
-    M = sys.M.copy()
-    diag = np.diag(M)
-    empty = diag <= 1e-12 * max(float(diag.max(initial=0.0)), 1e-300)
-    M[empty, empty] += D[empty]
+    zero moments of slender rods, curve parameters), so that it is positive definite (dense (nv, nv);
+    `kinetic_parts` gives it without dense matrices)."""
+    adr, blocks, extra = kinetic_parts(sys)
+    M = np.diag(extra)
+    for a, b in zip(adr.tolist(), blocks):
+        M[a:a + 3, a:a + 3] += b
     return M
+
+
+def kinetic_parts(sys):
+    """The kinetic metric as (first columns (nb,), 3x3 blocks (nb, 3, 3), diagonal added (nv,)): the mass
+    matrix's blocks (system.assemble.mass_blocks) plus the position weights on the diagonal entries where
+    it has no mass (see kinetic_metric); O(N), kept in sys.derived."""
+    out = sys.derived.get("kinetic_parts")
+    if out is None:
+        from .assemble import mass_blocks
+        adr, blocks = mass_blocks(sys)
+        diag = np.zeros(sys.nv)
+        diag[(adr[:, None] + np.arange(3)).ravel()] = np.einsum("bii->bi", blocks).ravel()
+        empty = diag <= 1e-12 * max(float(diag.max(initial=0.0)), 1e-300)
+        extra = np.where(empty, position_metric(sys), 0.0)
+        out = sys.derived["kinetic_parts"] = (adr, blocks, extra)
+    return out
 
 
 @_cached("geometric_scale")
