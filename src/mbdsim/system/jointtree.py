@@ -4,8 +4,10 @@ A model whose joints form a tree rooted at ground, every joint a revolute, trans
 joint between rigid bodies, with no motion drivers, is integrated in joint coordinates (one angle [rad]
 or slide [m] per joint, and its rate) by the articulated-body algorithm (`solvers.fasttree`): the
 constraints hold by construction, no projection is needed and a step costs O(N) with a small constant.
-Coordinates are measured from the assembled configuration (0 there). Anything else keeps the
-absolute-coordinate core.
+Coordinates are measured from the assembled configuration (0 there). Couplers, gears, rack and pinion
+and user coordinate constraints among the tree's joints are carried as rows f(X, t) = 0 over the joint
+coordinates (`coord_arrays`, solved by solvers.treecoord). Anything else keeps the absolute-coordinate core
+(couplers in closed loops: the reference path).
 
 `tree_arrays(sys, rows, q, v)` returns (mode, arrays): mode 1 and the arrays of the joint tree when the
 model qualifies, else mode 0 and empty arrays of the same types (one compiled signature for all):
@@ -24,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 ONE_DOF = {"revolute": 1, "translational": 2, "fixed": 0}
+KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide", "screw", "cvel")   # (system.assemble's)
 
 
 def empty_arrays(nf: int) -> tuple:
@@ -37,8 +40,12 @@ def _why_not(sys, rows) -> str | None:
     model = sys.model
     if model.motions:
         return "motion drivers"
-    if len(sys.aux_q_idx) or len(sys.lock_rows):
+    if len(sys.lock_rows) or any(g.kind == "curve" for g in sys.groups):
         return "path or friction constraints"
+    if any(g.kind not in KERNEL_KINDS + ("coord",) for g in sys.groups):
+        return "rows the compiled core does not carry"
+    if any(sn.text is None for sn in getattr(model, "sensors", {}).values()):
+        return "sensors written as Python callables"
     if len(rows) != sys.nc:
         return "redundant constraints"
     if any(b.is_particle for b in sys.bodies):
@@ -139,3 +146,71 @@ def joint_state(sys, arrays, q, v) -> np.ndarray:
             rel = fr.rd[c] - fr.rd[p] - np.cross(fr.w[p], fr.r[c] - fr.r[p])
             y[nj + qadr[c]] = a @ rel
     return y
+
+
+def coord_rows(sys) -> np.ndarray:
+    """Rows of the model's coordinate constraints (link and main rows of couplers, gears, user constraints)."""
+    out = [np.arange(r0, r0 + ev.nrow) for g in sys.groups if g.kind == "coord" for ev, r0 in zip(g.fns, g.row_adr)]
+    return np.concatenate(out).astype(np.int64) if out else np.zeros(0, np.int64)
+
+
+def empty_coords() -> tuple:
+    """`coord_arrays` of a model without coordinate constraints (same types, m = 0)."""
+    i, f = np.zeros(0, np.int64), np.zeros(0)
+    return (i, f, f, np.zeros(1, np.int64), i, np.zeros((0, 2), np.int64), f, f, i, i, i, i, i, i, i,
+            np.zeros((0, 3)), i)
+
+
+def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
+    """The coordinate constraints of a joint-coordinate tree for solvers.treecoord (layout in its docstring)
+    at the assembled state (q, v): each term's tree coordinate, X_k = x0_k + s_k theta_k (x0: the assembled
+    value: the auxiliary angle of coupler.py for a rotation, the slide for a translation), and the programs
+    f, f_t, f_tt, f_k, f_kt, f_kl of each row (system.exprvm); and the programs' stack size."""
+    from . import exprvm
+    from .constraints import primitives as pr
+    from .frames import body_frames
+    groups = [g for g in sys.groups if g.kind == "coord"]
+    if not groups:
+        return empty_coords(), 4
+    parent, jtype, axis = arrays[0], arrays[1], arrays[2]
+    qadr = arrays[7]
+    fr = body_frames(sys, q, v)
+    cols = {k: [] for k in ("q", "s", "x0", "link", "aq", "av", "ff", "pt", "frame")}
+    ptr, pbase, mrow, progs = [0], [], [], []
+    for g in groups:
+        for ev, r0 in zip(g.fns, g.row_adr):
+            c = ev.spec
+            link = r0
+            for (geom, dof, aq, av) in ev.terms:
+                child = geom.bj if parent[geom.bj] == geom.bi else geom.bi
+                a = fr.A[parent[child]] @ axis[child]
+                if dof == "rotation":
+                    h = fr.A[geom.bi] @ np.cross(geom.f_i, geom.g_i)
+                    s_ = float(np.sign(a @ h)) * (1.0 if child == geom.bj else -1.0)
+                    x0 = float(q[aq])
+                    cols["link"].append(link)
+                    link += 1
+                else:
+                    h = fr.A[geom.bi] @ geom.h_i
+                    s_ = float(a @ h) * (1.0 if child == geom.bj else -1.0)
+                    x0 = float(pr.dot2(fr, np.array([geom.bi]), np.array([geom.bj]), geom.h_i[None],
+                                       geom.s_i[None], geom.s_j[None]).phi[0])
+                    cols["link"].append(-1)
+                for k, val in (("q", qadr[child]), ("s", s_), ("x0", x0), ("aq", aq), ("av", av),
+                               ("ff", geom.bj), ("pt", geom.s_j), ("frame", child)):
+                    cols[k].append(val)
+            names = c.variables[1:]
+            slots = {name: k for k, name in enumerate(c.variables)}
+            exprs = [c.expr, c.derivs["t"], c.derivs[("t", "t")], *(c.derivs[n] for n in names),
+                     *(c.derivs[(n, "t")] for n in names), *(c.derivs[(a_, b_)] for a_ in names for b_ in names)]
+            pbase.append(len(progs))
+            progs.extend(exprvm.compile_expr(e, slots) for e in exprs)
+            ptr.append(ptr[-1] + len(names))
+            mrow.append(link)
+    pk = exprvm.pack(progs)
+    i64 = lambda k: np.array(cols[k], np.int64)  # noqa: E731
+    return (i64("q"), np.array(cols["s"], float), np.array(cols["x0"], float), np.array(ptr, np.int64),
+            np.array(pbase, np.int64), pk.code, pk.consts, pk.tables, pk.start, pk.end, np.array(mrow, np.int64),
+            i64("link"), i64("aq"), i64("av"), i64("ff"), np.array(cols["pt"], float).reshape(-1, 3),
+            i64("frame")), max(4, int(pk.stack_size))
+
