@@ -86,10 +86,7 @@ def _project(cm, wk, t, y, tol, exact_factor=True):
     """`fastdyn.project` of the state y = [q, v], or on the joint-coordinate tree the projection onto its
     coordinate constraints (solvers.treecoord; nothing to do without them); status."""
     if cm[31][5] == 1:
-        if cm[47][3].shape[0] <= 1:
-            return OK
-        st, _ = treecoord.project(cm, wk, t, y, tol)
-        return st
+        return treecoord.project(cm, wk, t, y, tol)[0]
     nq = cm[31][0]
     return project(cm, wk, t, y[:nq], y[nq:], tol, exact_factor)
 
@@ -428,13 +425,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return (SENSOR_STOP if s_ == OK else s_), iout
         for i in range(n):
             y[i] = ynew[i]
-        if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the coordinate
-            s_, moved = OK, False   # constraints' projection (solvers.treecoord) moved ynew
-            if cm[47][3].shape[0] > 1:
-                s_, moved = treecoord.project(cm, wk, t_new, y, proj_tol)
-                if s_ != OK:
-                    st[0], st[1] = t, h
-                    return s_, iout
+        if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the projection onto
+            s_, moved = treecoord.project(cm, wk, t_new, y, proj_tol)   # coordinate constraints moved ynew
+            if s_ != OK:
+                st[0], st[1] = t, h
+                return s_, iout
             if moved:
                 stats[3] += 1
                 s_ = rhs(cm, wk, t_new, y, f)

@@ -357,9 +357,9 @@ def project(cm, wk, t, y, tol):
     """Project the joint state y (in place) onto the coordinate constraints at t [s] when it is off them by
     more than tol (relative): the metric Minv from the articulated inertias at y (one articulated-body
     sweep, zero loads), then `newton`. Returns (status: 0 OK, 1 singular, 2 no convergence (fastdyn's
-    OK, SINGULAR, PROJECTION); whether y changed)."""
+    OK, SINGULAR, PROJECTION); whether y changed). Nothing to do without coordinate constraints."""
     co, cw, tw = cm[47], wk[49], wk[43]
-    if residual(co, cw, t, y, tol):
+    if co[3].shape[0] <= 1 or residual(co, cw, t, y, tol):
         return 0, False
     nj = y.shape[0] // 2
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
