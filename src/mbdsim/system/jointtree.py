@@ -26,6 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 ONE_DOF = {"revolute": 1, "translational": 2, "fixed": 0}
+TREE_DRIVERS = True   # motion drivers of tree joints as rows theta_k - f(t) = 0 (solvers.treecoord)
 KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide", "screw", "cvel")   # (system.assemble's)
 
 
@@ -38,8 +39,8 @@ def empty_arrays(nf: int) -> tuple:
 def _why_not(sys, rows) -> str | None:
     """Reason the model cannot take the joint-coordinate path, or None."""
     model = sys.model
-    if model.motions:
-        return "motion drivers"
+    if model.motions and not (TREE_DRIVERS and all(_drive_programs(m) is not None for m in model.motions.values())):
+        return "motion drivers" + ("" if TREE_DRIVERS else " (TREE_DRIVERS off)")
     if len(sys.lock_rows) or any(g.kind == "curve" for g in sys.groups):
         return "path or friction constraints"
     if any(g.kind not in KERNEL_KINDS + ("coord",) for g in sys.groups):
@@ -149,8 +150,10 @@ def joint_state(sys, arrays, q, v) -> np.ndarray:
 
 
 def coord_rows(sys) -> np.ndarray:
-    """Rows of the model's coordinate constraints (link and main rows of couplers, gears, user constraints)."""
+    """Rows of the model's coordinate constraints (link and main rows of couplers, gears, user constraints)
+    and of its motion drivers: the rows the tree solves in joint coordinates (`coord_arrays`)."""
     out = [np.arange(r0, r0 + ev.nrow) for g in sys.groups if g.kind == "coord" for ev, r0 in zip(g.fns, g.row_adr)]
+    out += [np.asarray(sys.owner_rows[name], np.int64) for name in sys.model.motions]
     return np.concatenate(out).astype(np.int64) if out else np.zeros(0, np.int64)
 
 
@@ -167,13 +170,11 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
     value: the auxiliary angle of coupler.py for a rotation, the slide for a translation), and the programs
     f, f_t, f_tt, f_k, f_kt, f_kl of each row (system.exprvm); and the programs' stack size."""
     from . import exprvm
-    from .constraints import primitives as pr
     from .frames import body_frames
     groups = [g for g in sys.groups if g.kind == "coord"]
-    if not groups:
+    motions = list(sys.model.motions.values())
+    if not groups and not motions:
         return empty_coords(), 4
-    parent, jtype, axis = arrays[0], arrays[1], arrays[2]
-    qadr = arrays[7]
     fr = body_frames(sys, q, v)
     cols = {k: [] for k in ("q", "s", "x0", "link", "aq", "av", "ff", "pt", "frame")}
     ptr, pbase, mrow, progs = [0], [], [], []
@@ -182,23 +183,9 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
             c = ev.spec
             link = r0
             for (geom, dof, aq, av) in ev.terms:
-                child = geom.bj if parent[geom.bj] == geom.bi else geom.bi
-                a = fr.A[parent[child]] @ axis[child]
-                if dof == "rotation":
-                    h = fr.A[geom.bi] @ np.cross(geom.f_i, geom.g_i)
-                    s_ = float(np.sign(a @ h)) * (1.0 if child == geom.bj else -1.0)
-                    x0 = float(q[aq])
-                    cols["link"].append(link)
-                    link += 1
-                else:
-                    h = fr.A[geom.bi] @ geom.h_i
-                    s_ = float(a @ h) * (1.0 if child == geom.bj else -1.0)
-                    x0 = float(pr.dot2(fr, np.array([geom.bi]), np.array([geom.bj]), geom.h_i[None],
-                                       geom.s_i[None], geom.s_j[None]).phi[0])
-                    cols["link"].append(-1)
-                for k, val in (("q", qadr[child]), ("s", s_), ("x0", x0), ("aq", aq), ("av", av),
-                               ("ff", geom.bj), ("pt", geom.s_j), ("frame", child)):
-                    cols[k].append(val)
+                x0 = float(q[aq]) if dof == "rotation" else None
+                _term(cols, arrays, fr, geom, dof, x0, aq, av, link if dof == "rotation" else -1)
+                link += dof == "rotation"
             names = c.variables[1:]
             slots = {name: k for k, name in enumerate(c.variables)}
             exprs = [c.expr, c.derivs["t"], c.derivs[("t", "t")], *(c.derivs[n] for n in names),
@@ -207,6 +194,13 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
             progs.extend(exprvm.compile_expr(e, slots) for e in exprs)
             ptr.append(ptr[-1] + len(names))
             mrow.append(link)
+    for mo in motions:   # motion drivers: wrap(X - g(t)) (rotation) or X - g(t) (translation) = 0
+        geom = sys.geoms[mo.joint.name]
+        _term(cols, arrays, fr, geom, mo.dof, None, -1, -1, -1)
+        pbase.append(len(progs))
+        progs.extend(_drive_programs(mo))
+        ptr.append(ptr[-1] + 1)
+        mrow.append(int(sys.owner_rows[mo.name][0]))
     pk = exprvm.pack(progs)
     i64 = lambda k: np.array(cols[k], np.int64)  # noqa: E731
     return (i64("q"), np.array(cols["s"], float), np.array(cols["x0"], float), np.array(ptr, np.int64),
@@ -214,3 +208,50 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
             i64("link"), i64("aq"), i64("av"), i64("ff"), np.array(cols["pt"], float).reshape(-1, 3),
             i64("frame")), max(4, int(pk.stack_size))
 
+
+def _term(cols, arrays, fr, geom, dof, x0, aq, av, link):
+    """Append one term (a joint coordinate X = x0 + s theta of the tree) to the columns of `coord_arrays`;
+    x0 None: the joint's coordinate at the frames fr (a rotation's angle in (-pi, pi], a slide)."""
+    from .constraints import primitives as pr
+    parent, axis, qadr = arrays[0], arrays[2], arrays[7]
+    child = geom.bj if parent[geom.bj] == geom.bi else geom.bi
+    a = fr.A[parent[child]] @ axis[child]
+    sense = 1.0 if child == geom.bj else -1.0
+    bi, bj = np.array([geom.bi]), np.array([geom.bj])
+    if dof == "rotation":
+        s_ = float(np.sign(a @ (fr.A[geom.bi] @ np.cross(geom.f_i, geom.g_i)))) * sense
+        if x0 is None:
+            x0 = float(pr.angle(fr, bi, bj, geom.f_i[None], geom.g_i[None], geom.f_j[None])[0][0])
+    else:
+        s_ = float(a @ (fr.A[geom.bi] @ geom.h_i)) * sense
+        x0 = float(pr.dot2(fr, bi, bj, geom.h_i[None], geom.s_i[None], geom.s_j[None]).phi[0])
+    for k, val in (("q", qadr[child]), ("s", s_), ("x0", x0), ("aq", aq), ("av", av), ("ff", geom.bj),
+                   ("pt", geom.s_j), ("frame", child), ("link", link)):
+        cols[k].append(val)
+
+
+def _drive_programs(motion):
+    """Programs f, f_t, f_tt, f_X, f_Xt, f_XX of a motion driver's row in (t, X) (slots 0, 1): X - g(t),
+    wrapped to (-pi, pi] for a rotation as atan2(sin(X - g), cos(X - g)) (the angle row's wrap, so a
+    driver met up to whole turns at assembly holds), -g', -g'', 1, 0, 0; None when g has no compiled
+    programs (a Python callable, a quadrature integral, a driver reading model inputs)."""
+    from . import exprvm
+    fn = motion.function
+    if getattr(fn, "symbolic", None) is not None or motion.joint.kind not in ("revolute", "translational"):
+        return None
+    p = exprvm.time_programs(fn)
+    if p is None:
+        return None
+    g, g1, g2 = p
+    var = np.array([[exprvm.VAR, 1]], np.int64)
+    diff = np.concatenate([var, g.code, [[exprvm.SUB, 0]]]).astype(np.int64)
+    if motion.dof == "rotation":
+        sin_, cos_ = [[exprvm.UNARY["sin"], 0]], [[exprvm.UNARY["cos"], 0]]
+        code = np.concatenate([diff, sin_, diff, cos_, [[exprvm.ATAN2, 0]]]).astype(np.int64)
+    else:
+        code = diff
+    f = exprvm.Program(code, g.consts, g.tables, g.depth + 2)
+    neg = lambda pr_: exprvm.Program(np.concatenate([pr_.code, [[exprvm.NEG, 0]]]).astype(np.int64),  # noqa: E731
+                                     pr_.consts, pr_.tables, pr_.depth)
+    c = exprvm.constant_program
+    return (f, neg(g1), neg(g2), c(1.0), c(0.0), c(0.0))
