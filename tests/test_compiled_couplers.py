@@ -2,7 +2,7 @@
 (issue 29): every model here must report a compiled method at default settings and match its closed form
 or an independent ODE of its own (scipy's solve_ivp on the reduced one-degree-of-freedom equation).
 
-Closed forms:
+Closed forms (motion drivers of tree joints are rows of the same path: the last test):
 - two-stage gear train theta_2 = r1 theta_1, theta_3 = r2 theta_2 with a torsion spring k on the output
   shaft (free angle a): T = 1/2 J_eff theta_3'^2 with J_eff = J3 + J2 / r2^2 + J1 / (r1 r2)^2, so
   theta_3 = a (1 - cos(w t)), w = sqrt(k / J_eff), from rest at theta_3 = 0;
@@ -140,3 +140,30 @@ def test_nonlinear_user_constraint_against_the_reduced_ode():
     a = res.joint_coordinate("a")
     assert np.max(np.abs(a - ref)) <= 1e-6 * np.max(np.abs(ref))
     assert np.max(np.abs(res.joint_coordinate("b") - c * np.sin(a))) <= 1e-10
+
+
+@pytest.mark.parametrize("drive", ["velocity", "displacement", "acceleration", "callable"])
+def test_driven_turntable_bead_on_a_rod(drive):
+    """A turntable driven at Omega about z carries a bead sliding freely along a radial rod (no gravity in
+    the plane): r'' = Omega^2 r, r = r0 cosh(Omega t); the drive's torque d/dt(m r^2 Omega) =
+    m r0^2 Omega^2 sinh(2 Omega t). Drivers of tree joints are rows of the joint-coordinate path."""
+    W, r0, mass = 2.0, 0.1, 0.5
+    m = mb.Model("bead")
+    m.add_body("table", 2.0, inertia=(0.05, 0.05, 0.1))
+    m.add_body("bead", mass, inertia=(1e-4, 1e-4, 1e-4), position=(r0, 0, 0), velocity=(0, W * r0, 0),
+               angular_velocity=(0, 0, W))
+    hub = m.add_revolute("hub", "ground", "table", (0, 0, 0), (0, 0, 1))
+    m.add_translational("rod", "table", "bead", (r0, 0, 0), (1, 0, 0))
+    kw = {"velocity": dict(velocity=str(W)), "displacement": dict(displacement=f"{W}*t"),
+          "acceleration": dict(acceleration="0", initial_velocity=W),
+          "callable": dict(displacement=mb.expressions.time_function(lambda t: W * t, d1=lambda t: W,
+                                                                     d2=lambda t: 0.0))}[drive]
+    m.add_motion("spin", hub, **kw)
+    res = mb.simulate(m, 1.5, 0.01)
+    _compiled(res)
+    t = res.time
+    r = r0 + res.joint_coordinate("rod")
+    assert np.max(np.abs(r - r0 * np.cosh(W * t))) <= 1e-6 * r0 * np.cosh(W * 1.5)
+    assert np.max(np.abs(res.joint_coordinate("hub") - W * t)) <= 1e-12
+    torque = mass * r0**2 * W**2 * np.sinh(2 * W * t)
+    assert np.max(np.abs(np.abs(res.driver_effort("spin")) - torque)) <= 1e-6 * torque.max()

@@ -25,9 +25,9 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
-from . import fasttree, treecoord
+from . import fasttree
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
-                      read_state, rhs, write_state)
+                      read_state, rhs, tree_project, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
@@ -86,7 +86,7 @@ def _project(cm, wk, t, y, tol, exact_factor=True):
     """`fastdyn.project` of the state y = [q, v], or on the joint-coordinate tree the projection onto its
     coordinate constraints (solvers.treecoord; nothing to do without them); status."""
     if cm[31][5] == 1:
-        return treecoord.project(cm, wk, t, y, tol)[0]
+        return tree_project(cm, wk, t, y, tol)[0]
     nq = cm[31][0]
     return project(cm, wk, t, y[:nq], y[nq:], tol, exact_factor)
 
@@ -426,7 +426,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         for i in range(n):
             y[i] = ynew[i]
         if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the projection onto
-            s_, moved = treecoord.project(cm, wk, t_new, y, proj_tol)   # coordinate constraints moved ynew
+            s_, moved = tree_project(cm, wk, t_new, y, proj_tol)   # coordinate constraints or drivers moved ynew
             if s_ != OK:
                 st[0], st[1] = t, h
                 return s_, iout

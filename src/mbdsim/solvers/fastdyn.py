@@ -322,12 +322,29 @@ def tree_rhs(cm, wk, t, y, ydot):
     loads_into(cm, wk, t, y, r, A, rd, w, F)
     if not fasttree.aba(cm[42], y, nj, r, A, rd, w, tw[10], F, cm[9], cm[10], tw, ydot):
         return SINGULAR
-    if cm[47][3].shape[0] > 1 and not treecoord.constrain(cm[47], wk[49], cm[42], tw, t, y, r, ydot):
-        return SINGULAR   # (coordinate constraints: couplers, gears, user constraints)
+    if cm[47][3].shape[0] > 1:   # coordinate constraints (couplers, gears, user constraints) and motions
+        _tree_drivers(cm, wk, t)
+        if not treecoord.constrain(cm[47], wk[49], cm[42], tw, t, y, r, ydot):
+            return SINGULAR
     for i in range(ydot.shape[0]):
         if not np.isfinite(ydot[i]):
             return NONFINITE
     return OK
+
+
+@kernel(_nrt=False)
+def _tree_drivers(cm, wk, t):
+    """The motion drivers' values at t [s] for the tree's rows (solvers.treecoord.take_drivers)."""
+    if cm[19].shape[0] > 0:
+        drivers_at(cm, wk, t)
+        treecoord.take_drivers(cm[47], wk[49], wk[34], wk[35], wk[36])
+
+
+@kernel(_nrt=False)
+def tree_project(cm, wk, t, y, tol):
+    """`treecoord.project` of the joint state y at t [s] (drivers evaluated first): (status, moved)."""
+    _tree_drivers(cm, wk, t)
+    return treecoord.project(cm, wk, t, y, tol)
 
 
 @entry(_nrt=False)

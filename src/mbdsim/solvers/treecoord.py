@@ -16,9 +16,11 @@ after each step (`newton`: minimum-norm corrections in the metric Minv of the la
 co = cm[47] (system.jointtree.coord_arrays): term coordinate q (nt,), sign s (nt,), offset x0 (nt,),
 ptr (m + 1,), program base of each row pbase (m,) [f, f_t, f_tt, f_k (n), f_kt (n), f_kl (n n)],
 code, consts, tables, start, end (exprvm.pack), main row (m,), link row (nt,), aux q / v slot (nt,),
-force frame (nt,) and point (nt, 3) of body_j (where a slide's load pair acts), tree frame (nt,).
+force frame (nt,) and point (nt, 3) of body_j (where a slide's load pair acts), tree frame (nt,), driver
+index (m,) (-1: a coupler row; else a motion driver's row X - g(t), one term, with g, g', g'' taken from
+fastdyn.drivers_at into cw[15] by `take_drivers`) and its wrap flag (m,) (1: an angle, wrapped to +-pi).
 cw = wk[49]: x, stack, X (nt), Xd (nt), Av (nt), fv (m), gam (m), nu (m), MiAT (m, nj), Smat (m, m),
-lam (m), b (m), ydot (2 nj), tau (nj), zero loads (nf, 6).
+lam (m), b (m), ydot (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3).
 """
 from __future__ import annotations
 
@@ -39,12 +41,27 @@ def _prog(co, p, x, stack):
 def values(co, cw, t, y, nj, accel):
     """X, X', f (cw[5]), A (cw[4]), nu (cw[7]) and with `accel` gamma (cw[6]) at (t, y); returns the largest
     |f| and the largest |X| (for the projection's tolerance)."""
-    q, s, x0, ptr, pbase = co[0], co[1], co[2], co[3], co[4]
+    q, s, x0, ptr, pbase, drv = co[0], co[1], co[2], co[3], co[4], co[17]
     x, stack, X, Xd, Av, fv, gam, nu = cw[0], cw[1], cw[2], cw[3], cw[4], cw[5], cw[6], cw[7]
     fmax, xmax = 0.0, 0.0
     for i in range(ptr.shape[0] - 1):
         t0, t1 = ptr[i], ptr[i + 1]
         n = t1 - t0
+        if drv[i] >= 0:   # a motion driver: X - g(t) (wrapped for an angle), g from drivers_at
+            gd = cw[15][i]
+            X[t0] = x0[t0] + s[t0] * y[q[t0]]
+            Xd[t0] = s[t0] * y[nj + q[t0]]
+            xmax = max(xmax, abs(X[t0]))
+            u = X[t0] - gd[0]
+            if co[18][i] == 1:
+                u -= 2.0 * np.pi * np.floor((u + np.pi) / (2.0 * np.pi))
+            fv[i] = u
+            fmax = max(fmax, abs(u))
+            nu[i] = gd[1]
+            Av[t0] = s[t0]
+            if accel:
+                gam[i] = gd[2]
+            continue
         x[0] = t
         for j in range(t0, t1):
             X[j] = x0[j] + s[j] * y[q[j]]
@@ -65,6 +82,15 @@ def values(co, cw, t, y, nj, accel):
                     g += _prog(co, b + 3 + 2 * n + n * (j - t0) + (k - t0), x, stack) * Xd[j] * Xd[k]
             gam[i] = -g
     return fmax, xmax
+
+
+@kernel(_nrt=False)
+def take_drivers(co, cw, f, fd, fdd):
+    """The motion drivers' g, g', g'' (fastdyn.drivers_at's arrays) into cw[15], row by row."""
+    drv, gd = co[17], cw[15]
+    for i in range(drv.shape[0]):
+        if drv[i] >= 0:
+            gd[i, 0], gd[i, 1], gd[i, 2] = f[drv[i]], fd[drv[i]], fdd[drv[i]]
 
 
 @kernel(_nrt=False)

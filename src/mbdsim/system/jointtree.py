@@ -39,8 +39,12 @@ def empty_arrays(nf: int) -> tuple:
 def _why_not(sys, rows) -> str | None:
     """Reason the model cannot take the joint-coordinate path, or None."""
     model = sys.model
-    if model.motions and not (TREE_DRIVERS and all(_drive_programs(m) is not None for m in model.motions.values())):
-        return "motion drivers" + ("" if TREE_DRIVERS else " (TREE_DRIVERS off)")
+    if model.motions:
+        if not TREE_DRIVERS:
+            return "motion drivers"
+        moving = sum(jt.kind in ("revolute", "translational") for jt in model.joints.values())
+        if len(model.motions) + len(getattr(model, "coord_constraints", {})) >= moving:
+            return "no free coordinate (the kinematic analysis)"
     if len(sys.lock_rows) or any(g.kind == "curve" for g in sys.groups):
         return "path or friction constraints"
     if any(g.kind not in KERNEL_KINDS + ("coord",) for g in sys.groups):
@@ -161,14 +165,15 @@ def empty_coords() -> tuple:
     """`coord_arrays` of a model without coordinate constraints (same types, m = 0)."""
     i, f = np.zeros(0, np.int64), np.zeros(0)
     return (i, f, f, np.zeros(1, np.int64), i, np.zeros((0, 2), np.int64), f, f, i, i, i, i, i, i, i,
-            np.zeros((0, 3)), i)
+            np.zeros((0, 3)), i, i, i)
 
 
 def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
     """The coordinate constraints of a joint-coordinate tree for solvers.treecoord (layout in its docstring)
     at the assembled state (q, v): each term's tree coordinate, X_k = x0_k + s_k theta_k (x0: the assembled
     value: the auxiliary angle of coupler.py for a rotation, the slide for a translation), and the programs
-    f, f_t, f_tt, f_k, f_kt, f_kl of each row (system.exprvm); and the programs' stack size."""
+    f, f_t, f_tt, f_k, f_kt, f_kl of each row (system.exprvm); then one row X - g(t) per motion driver (g
+    evaluated by the compiled drivers); and the programs' stack size."""
     from . import exprvm
     from .frames import body_frames
     groups = [g for g in sys.groups if g.kind == "coord"]
@@ -177,7 +182,7 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
         return empty_coords(), 4
     fr = body_frames(sys, q, v)
     cols = {k: [] for k in ("q", "s", "x0", "link", "aq", "av", "ff", "pt", "frame")}
-    ptr, pbase, mrow, progs = [0], [], [], []
+    ptr, pbase, mrow, progs, drv, wrap = [0], [], [], [], [], []
     for g in groups:
         for ev, r0 in zip(g.fns, g.row_adr):
             c = ev.spec
@@ -194,19 +199,25 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
             progs.extend(exprvm.compile_expr(e, slots) for e in exprs)
             ptr.append(ptr[-1] + len(names))
             mrow.append(link)
-    for mo in motions:   # motion drivers: wrap(X - g(t)) (rotation) or X - g(t) (translation) = 0
-        geom = sys.geoms[mo.joint.name]
+            drv.append(-1)
+            wrap.append(0)
+    from .packing import pack_rows
+    packed_drv = (sys.derived.get("packed") or pack_rows(sys))[5]   # each row's driver index
+    for mo in motions:   # motion drivers: wrap(X - g(t)) (rotation) or X - g(t) (translation) = 0, g from
+        geom = sys.geoms[mo.joint.name]   # the compiled drivers (fastdyn.drivers_at), callables included
+        row = int(sys.owner_rows[mo.name][0])
         _term(cols, arrays, fr, geom, mo.dof, None, -1, -1, -1)
         pbase.append(len(progs))
-        progs.extend(_drive_programs(mo))
         ptr.append(ptr[-1] + 1)
-        mrow.append(int(sys.owner_rows[mo.name][0]))
+        mrow.append(row)
+        drv.append(int(packed_drv[row]))
+        wrap.append(int(mo.dof == "rotation"))
     pk = exprvm.pack(progs)
     i64 = lambda k: np.array(cols[k], np.int64)  # noqa: E731
     return (i64("q"), np.array(cols["s"], float), np.array(cols["x0"], float), np.array(ptr, np.int64),
             np.array(pbase, np.int64), pk.code, pk.consts, pk.tables, pk.start, pk.end, np.array(mrow, np.int64),
             i64("link"), i64("aq"), i64("av"), i64("ff"), np.array(cols["pt"], float).reshape(-1, 3),
-            i64("frame")), max(4, int(pk.stack_size))
+            i64("frame"), np.array(drv, np.int64), np.array(wrap, np.int64)), max(4, int(pk.stack_size))
 
 
 def _term(cols, arrays, fr, geom, dof, x0, aq, av, link):
@@ -229,29 +240,3 @@ def _term(cols, arrays, fr, geom, dof, x0, aq, av, link):
                    ("pt", geom.s_j), ("frame", child), ("link", link)):
         cols[k].append(val)
 
-
-def _drive_programs(motion):
-    """Programs f, f_t, f_tt, f_X, f_Xt, f_XX of a motion driver's row in (t, X) (slots 0, 1): X - g(t),
-    wrapped to (-pi, pi] for a rotation as atan2(sin(X - g), cos(X - g)) (the angle row's wrap, so a
-    driver met up to whole turns at assembly holds), -g', -g'', 1, 0, 0; None when g has no compiled
-    programs (a Python callable, a quadrature integral, a driver reading model inputs)."""
-    from . import exprvm
-    fn = motion.function
-    if getattr(fn, "symbolic", None) is not None or motion.joint.kind not in ("revolute", "translational"):
-        return None
-    p = exprvm.time_programs(fn)
-    if p is None:
-        return None
-    g, g1, g2 = p
-    var = np.array([[exprvm.VAR, 1]], np.int64)
-    diff = np.concatenate([var, g.code, [[exprvm.SUB, 0]]]).astype(np.int64)
-    if motion.dof == "rotation":
-        sin_, cos_ = [[exprvm.UNARY["sin"], 0]], [[exprvm.UNARY["cos"], 0]]
-        code = np.concatenate([diff, sin_, diff, cos_, [[exprvm.ATAN2, 0]]]).astype(np.int64)
-    else:
-        code = diff
-    f = exprvm.Program(code, g.consts, g.tables, g.depth + 2)
-    neg = lambda pr_: exprvm.Program(np.concatenate([pr_.code, [[exprvm.NEG, 0]]]).astype(np.int64),  # noqa: E731
-                                     pr_.consts, pr_.tables, pr_.depth)
-    c = exprvm.constant_program
-    return (f, neg(g1), neg(g2), c(1.0), c(0.0), c(0.0))
