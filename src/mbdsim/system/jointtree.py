@@ -42,6 +42,8 @@ def _why_not(sys, rows) -> str | None:
     if model.motions:
         if not TREE_DRIVERS:
             return "motion drivers"
+        if any(getattr(mo.function, "symbolic", None) is not None for mo in model.motions.values()):
+            return "motion drivers reading model inputs (re-projected when an input changes)"
         moving = sum(jt.kind in ("revolute", "translational") for jt in model.joints.values())
         if len(model.motions) + len(getattr(model, "coord_constraints", {})) >= moving:
             return "no free coordinate (the kinematic analysis)"
