@@ -1,13 +1,13 @@
 """Joint-coordinate model of a tree of one-degree-of-freedom joints (the articulated-body fast path).
 
 A model whose joints form a tree rooted at ground, every joint a revolute, translational or fixed
-joint between rigid bodies, with no motion drivers, is integrated in joint coordinates (one angle [rad]
-or slide [m] per joint, and its rate) by the articulated-body algorithm (`solvers.fasttree`): the
-constraints hold by construction, no projection is needed and a step costs O(N) with a small constant.
-Coordinates are measured from the assembled configuration (0 there). Couplers, gears, rack and pinion
-and user coordinate constraints among the tree's joints are carried as rows f(X, t) = 0 over the joint
-coordinates (`coord_arrays`, solved by solvers.treecoord). Anything else keeps the absolute-coordinate core
-(couplers in closed loops: the reference path).
+joint between rigid bodies, is integrated in joint coordinates (one angle [rad] or slide [m] per joint,
+and its rate) by the articulated-body algorithm (`solvers.fasttree`): the joints hold by construction and
+a step costs O(N) with a small constant. Coordinates are measured from the assembled configuration (0
+there). Couplers, gears, rack and pinion, user coordinate constraints and motion drivers of the tree's
+joints are carried as rows f(X, t) = 0 over the joint coordinates (`coord_arrays`, solved and projected
+on by solvers.treecoord), unless the drivers leave no free coordinate (the kinematic analysis then).
+Anything else keeps the absolute-coordinate core (couplers in closed loops: the reference path).
 
 `tree_arrays(sys, rows, q, v)` returns (mode, arrays): mode 1 and the arrays of the joint tree when the
 model qualifies, else mode 0 and empty arrays of the same types (one compiled signature for all):
