@@ -2,6 +2,7 @@
 same motion, measured in one process run (ratios count; absolute times on this machine move by 30 %).
 
     python3 bench/vocabulary.py            # writes bench/VOCABULARY.md
+    python3 bench/vocabulary.py gear       # only the cases whose name contains "gear": their rows replaced
 
 Each case: the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
 call (the Model is built once; the first call assembles and compiles it), the method each ran
@@ -91,6 +92,26 @@ def gears(geared):
     return m
 
 
+def gear_train(geared):
+    """Two-stage gear train (theta_2 = -2.5 theta_1, theta_3 = -0.4 theta_2) with a torsion spring on the
+    output shaft, from rest at a spring deflection; baseline: one shaft with the reflected inertia
+    J3 + J2 / r2^2 + J1 / (r1 r2)^2 and the same spring."""
+    J1, J2, J3, r1, r2 = 0.02, 0.05, 0.03, -2.5, -0.4
+    m = mb.Model("train", gravity=(0.0, 0.0, 0.0))
+    if geared:
+        for n, (J, x) in enumerate(((J1, 0.0), (J2, 0.3), (J3, 0.5)), start=1):
+            m.add_body(f"s{n}", 1.0, inertia=(0.03, 0.03, J), position=(x, 0, 0))
+            m.add_revolute(f"p{n}", "ground", f"s{n}", (x, 0, 0), (0, 0, 1))
+        m.add_gear("mesh1", "p1", "p2", r1)
+        m.add_gear("mesh2", "p2", "p3", r2)
+        m.add_torsion_spring("spring", "p3", 3.0, free_angle=0.4)
+    else:
+        m.add_body("s3", 1.0, inertia=(0.2, 0.2, J3 + J2 / r2**2 + J1 / (r1 * r2) ** 2), position=(0.5, 0, 0))
+        m.add_revolute("p3", "ground", "s3", (0.5, 0, 0), (0, 0, 1))
+        m.add_torsion_spring("spring", "p3", 3.0, free_angle=0.4)
+    return m
+
+
 def timed(fn):
     fn()
     ts = []
@@ -123,18 +144,24 @@ CASES = [
     ("Python-callable driver, numerical derivatives (carousel)",
      lambda: carousel(displacement=lambda t: 3 * t + 2 * np.sin(t)),
      lambda: carousel(displacement="3*t + 2*sin(t)"), "simulate", ("hub", "tip")),
-    ("gear pair + torsion spring vs the equivalent shaft (not compiled yet)", lambda: gears(True),
+    ("gear pair + torsion spring vs the equivalent shaft", lambda: gears(True),
      lambda: gears(False), "simulate", ("p1",)),
+    ("two-stage gear train + torsion spring vs the equivalent shaft", lambda: gear_train(True),
+     lambda: gear_train(False), "simulate", ("p3",)),
 ]
 
 
-def main():
+def main(only=None):
     warnings.simplefilter("ignore")
+    out = Path(__file__).with_name("VOCABULARY.md")
+    old = out.read_text().splitlines() if only and out.exists() else None
     lines = ["# Model vocabulary against its compiled baseline (issue 29)", "",
              "Written by `python3 bench/vocabulary.py`: median of %d calls after a warm-up, same process." % REPEAT,
              "", "| case | element | baseline | ratio | element's method | max joint-coordinate difference |",
              "|---|---|---|---|---|---|"]
     for name, make, make_base, analysis, joints in CASES:
+        if only and only not in name:
+            continue
         run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01)) if analysis == "simulate" else \
             (lambda m: mb.kinematics(m, end_time=2.0, output_step=0.01))
         m, mb_ = make(), make_base()
@@ -144,10 +171,13 @@ def main():
         lines.append(f"| {name} | {te * 1e3:.2f} ms | {tb * 1e3:.2f} ms | {te / tb:.2f}x | "
                      f"{re.stats.get('method', '?')} | {diff:.1e} |")
         print(lines[-1], flush=True)
-    out = Path(__file__).with_name("VOCABULARY.md")
+    if old is not None:   # the other cases' rows kept (a case's row found by its name, else appended)
+        new = {ln.split(" | ")[0]: ln for ln in lines[6:]}
+        merged = [new.pop(ln.split(" | ")[0], ln) for ln in old]
+        lines = merged + list(new.values())
     out.write_text("\n".join(lines) + "\n")
     print("wrote", out)
 
 
 if __name__ == "__main__":
-    main()
+    main(sys.argv[1] if len(sys.argv) > 1 else None)

@@ -330,7 +330,8 @@ def _stats(run, rep) -> dict:
     return {"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
             "njev": 0,   # joint coordinates: no factorisation (ABA) and nothing to project
             "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
-            "projections": 0 if run.joint_space else int(run.stats[3]), "order": 8,
+            "projections": int(run.stats[3]) if not run.joint_space or len(run.cm.coords[3]) > 1 else 0,
+            "order": 8,   # (a tree projects only onto its coordinate constraints: solvers.treecoord)
             "method": "DOP853 (compiled)",
             "formulation": "joint coordinates (articulated body)" if run.joint_space else
             "absolute coordinates (tree elimination)", "assembly": rep}

@@ -27,7 +27,7 @@ from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
 from . import fasttree
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
-                      read_state, rhs, write_state)
+                      read_state, rhs, tree_project, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
@@ -79,6 +79,16 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     else:
         h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
     return min(100.0 * h0, h1, max_step)
+
+
+@kernel(_nrt=False)
+def _project(cm, wk, t, y, tol, exact_factor=True):
+    """`fastdyn.project` of the state y = [q, v], or on the joint-coordinate tree the projection onto its
+    coordinate constraints (solvers.treecoord; nothing to do without them); status."""
+    if cm[31][5] == 1:
+        return tree_project(cm, wk, t, y, tol)[0]
+    nq = cm[31][0]
+    return project(cm, wk, t, y[:nq], y[nq:], tol, exact_factor)
 
 
 @entry(_nrt=False)
@@ -390,7 +400,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
                 to = tout[iout]
                 _dense(F, y, t, h, to, yo)
-                s_ = project(cm, wk, to, yo[:nq], yo[nq:], proj_tol, False)
+                s_ = _project(cm, wk, to, yo, proj_tol, False)
                 stats[3] += 1
                 if s_ != OK:
                     st[0], st[1] = t, h
@@ -407,7 +417,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 while iout > 0 and tout[iout - 1] > t_stop + 1e-14 * max(1.0, abs(t_stop)):
                     iout -= 1
                 _dense(F, y, t, h, t_stop, yo)
-                s_ = project(cm, wk, t_stop, yo[:nq], yo[nq:], proj_tol, False)
+                s_ = _project(cm, wk, t_stop, yo, proj_tol, False)
                 stats[3] += 1
                 for i in range(n):
                     y[i] = yo[i]
@@ -415,10 +425,18 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return (SENSOR_STOP if s_ == OK else s_), iout
         for i in range(n):
             y[i] = ynew[i]
-        if cm[31][5] == 1:   # joint coordinates: no projection, and f(t_new, ynew) is the last stage
-            for i in range(n):
-                f[i] = K[N_STAGES, i]
-            s_ = OK
+        if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the projection onto
+            s_, moved = tree_project(cm, wk, t_new, y, proj_tol)   # coordinate constraints or drivers moved ynew
+            if s_ != OK:
+                st[0], st[1] = t, h
+                return s_, iout
+            if moved:
+                stats[3] += 1
+                s_ = rhs(cm, wk, t_new, y, f)
+                stats[2] += 1
+            else:
+                for i in range(n):
+                    f[i] = K[N_STAGES, i]
         else:
             s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol)
             stats[3] += 1
@@ -491,7 +509,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     _dense_coeffs(cm, wk, co, t0, h, y0, ynew, K, ys, F)
     for k in range(tq.shape[0]):
         _dense(F, y0, t0, h, tq[k], yo)
-        s_ = project(cm, wk, tq[k], yo[:nq], yo[nq:], 1e-12)
+        s_ = _project(cm, wk, tq[k], yo, 1e-12)
         if s_ != OK:
             return s_
         write_state(cm, wk, yo, Y[k], Y[k, :0])

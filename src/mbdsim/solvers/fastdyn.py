@@ -28,7 +28,7 @@ from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
-from . import fasttree
+from . import fasttree, treecoord
 from .pycall import call_address
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
@@ -223,11 +223,20 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     y: the state the loads read (`loads_into`): q itself on the absolute path, the joint-coordinate state
     [theta, theta_dot] (continuous angles) on the tree path. refactor=False reuses the factorisation in
     wk, valid when it was made at these positions q (the factorisation depends on q only), e.g. right
-    after `project`."""
+    after `project`. A tree with coordinate constraints (solvers.treecoord) solves them in joint coordinates
+    first; their loads then act on the bodies, and their rows' multipliers and the auxiliary coordinates'
+    accelerations are written from that solve."""
+    coupled = cm[31][5] == 1 and cm[47][3].shape[0] > 1
+    if coupled:
+        st = tree_rhs(cm, wk, t, y, wk[49][12])
+        if st != OK:
+            return st
     _constraints(cm, wk, t, q, v)
     F = wk[8]
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     loads_into(cm, wk, t, y, r, A, rd, w, F)
+    if coupled:
+        treecoord.add_loads(cm[47], wk[49], cm[42], r, A, F)
     if refactor and not _factor(cm, wk):
         return SINGULAR
     x6 = wk[25]
@@ -235,6 +244,8 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
         lam[i] = 0.0
     _solve(cm, wk, F, wk[7], x6, lam)
     _from6(cm, x6, vd)
+    if coupled:
+        treecoord.fill_outputs(cm[47], wk[49], y.shape[0] // 2, wk[49][12], vd, lam)
     for i in range(vd.shape[0]):
         if not np.isfinite(vd[i]):
             return NONFINITE
@@ -311,10 +322,29 @@ def tree_rhs(cm, wk, t, y, ydot):
     loads_into(cm, wk, t, y, r, A, rd, w, F)
     if not fasttree.aba(cm[42], y, nj, r, A, rd, w, tw[10], F, cm[9], cm[10], tw, ydot):
         return SINGULAR
+    if cm[47][3].shape[0] > 1:   # coordinate constraints (couplers, gears, user constraints) and motions
+        _tree_drivers(cm, wk, t)
+        if not treecoord.constrain(cm[47], wk[49], cm[42], tw, t, y, r, ydot):
+            return SINGULAR
     for i in range(ydot.shape[0]):
         if not np.isfinite(ydot[i]):
             return NONFINITE
     return OK
+
+
+@kernel(_nrt=False)
+def _tree_drivers(cm, wk, t):
+    """The motion drivers' values at t [s] for the tree's rows (solvers.treecoord.take_drivers)."""
+    if cm[19].shape[0] > 0:
+        drivers_at(cm, wk, t)
+        treecoord.take_drivers(cm[47], wk[49], wk[34], wk[35], wk[36])
+
+
+@kernel(_nrt=False)
+def tree_project(cm, wk, t, y, tol):
+    """`treecoord.project` of the joint state y at t [s] (drivers evaluated first): (status, moved)."""
+    _tree_drivers(cm, wk, t)
+    return treecoord.project(cm, wk, t, y, tol)
 
 
 @entry(_nrt=False)
@@ -330,6 +360,7 @@ def write_state(cm, wk, y, yout, prev):
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     fasttree.kinematics(cm[42], y, y.shape[0] // 2, r, A, rd, w, tw[10], tw[11])
     fasttree.to_maximal(cm[42], cm[1], cm[0], cm[2], cm[3], cm[4], r, A, rd, w, yout, prev)
+    treecoord.write_aux(cm[47], y, cm[31][0], yout)
 
 
 @entry(_nrt=False)
@@ -343,6 +374,7 @@ def read_state(cm, wk, yrow, y):
     r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
     frames_into(yrow[:nq], yrow[nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
     fasttree.from_maximal(cm[42], y.shape[0] // 2, r, A, rd, w, y)
+    treecoord.read_aux(cm[47], yrow, y)   # coupled angles: continuous, from their auxiliary coordinates
 
 
 @entry(_nrt=False)

@@ -263,7 +263,8 @@ def aba(tree, y, nj, r, A, rd, w, P, F, mass, inertia, tw, ydot):
 
 @entry(_nrt=False)
 def to_maximal(tree, p_idx, r_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w, yout, prev):
-    """Absolute coordinates and velocities (system layout) of the frames into yout; Euler parameters with
+    """Absolute coordinates and velocities (system layout) of the frames into yout (auxiliary coordinates
+    untouched: `treecoord.write_aux`); Euler parameters with
     the sign nearest to prev's (continuous in time) when prev has the same size, else e0 >= 0."""
     nq = 0
     for k in range(r_idx.shape[0]):
@@ -271,6 +272,8 @@ def to_maximal(tree, p_idx, r_idx, rd_idx, w_idx, rigid_fid, r, A, rd, w, yout, 
             yout[r_idx[k, c]] = r[k + 1, c]
         nq += 3
     nq += 4 * p_idx.shape[0]
+    # auxiliary coordinates (continuous angles of coupled joints: one q and one v slot each) end the q part
+    nq += (yout.shape[0] - nq - 3 * (r_idx.shape[0] + p_idx.shape[0])) // 2
     for k in range(p_idx.shape[0]):
         f = rigid_fid[k]
         a00, a01, a02 = A[f, 0, 0], A[f, 0, 1], A[f, 0, 2]

@@ -97,6 +97,9 @@ class CompiledModel:
     #                           motion drivers that read model inputs (model.input_drivers)
     shape_contacts: tuple = ()   # arrays()[46]: shape contacts (geometry.pack.pack_contacts, issue 30) and an
     #                              empty record buffer (0, NREC) with its counter (solvers.fastcontact)
+    coords: tuple = ()        # arrays()[47]: coordinate constraints of a joint-coordinate tree (couplers, gears,
+    #                           user constraints: system.jointtree.coord_arrays, solvers.treecoord)
+    coord_stack: int = 4      # stack size of their programs
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -110,7 +113,7 @@ class CompiledModel:
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
-                self.shape_contacts or _shape_contacts(None, ()))
+                self.shape_contacts or _shape_contacts(None, ()), self.coords or jointtree.empty_coords())
 
 
 @dataclass
@@ -148,11 +151,24 @@ class Work:
              np.array(t.loop_rows, dtype=np.int64), np.full(2, RESELECT_RATIO),
              # 48: loads and drivers written as Python callables (solvers.pyloads): the loads (nf, 6) and
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
-             (z((nf, 6)), np.zeros(3, np.int64)))
+             (z((nf, 6)), np.zeros(3, np.int64)),
+             _coord_work(cm, nf))   # 49: coordinate constraints on the tree (solvers.treecoord)
         return cls(a)
 
     def arrays(self) -> tuple:
         return self.arrays_
+
+
+def _coord_work(cm, nf) -> tuple:
+    """Work of solvers.treecoord: x, stack, X, X', A (nt), f, gamma, nu (m), Minv A^T (m, nj), S (m, m),
+    lambda, b (m), a joint-state derivative (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3)."""
+    co = cm.coords or jointtree.empty_coords()
+    m, nt = len(co[3]) - 1, len(co[0])
+    nj = int(np.count_nonzero(cm.tree[7] >= 0)) if m else 0
+    width = int(np.max(np.diff(co[3]))) if m else 0
+    z = np.zeros
+    return (z(1 + width), z(cm.coord_stack), z(nt), z(nt), z(nt), z(m), z(m), z(m), z((m, nj)), z((m, m)), z(m),
+            z(m), z(2 * nj), z(nj), z((nf, 6)), z((m, 3)))
 
 
 def _contacts(sys) -> tuple:
@@ -316,13 +332,19 @@ def compile_system(sys, rows, state=None) -> CompiledModel:
 
 
 def _compile_system(sys, rows, state) -> CompiledModel:
-    if getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows, sensors
+    nf = sys.nbody + 1
+    rows = np.asarray(rows, dtype=np.int64)
+    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
+        jointtree.tree_arrays(sys, rows, *state)
+    coords, cstack = jointtree.coord_arrays(sys, tree, *state) if mode == 1 else (jointtree.empty_coords(), 4)
+    if mode == 1 and len(coords[3]) > 1:   # couplers on a tree: solved in joint coordinates (solvers.treecoord);
+        rows = rows[~np.isin(rows, jointtree.coord_rows(sys))]   # the absolute solve of the outputs skips them
+    elif getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows (in loops), sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
-    if len(sys.aux_q_idx):
+    elif len(sys.aux_q_idx):
         raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
     if len(sys.lock_rows):
         raise NotCompiled("joint friction (stick/slip) is not compiled yet")
-    nf = sys.nbody + 1
     M6 = np.zeros((nf, 6, 6))
     M6[:, range(6), range(6)] = 1.0
     M6[1:, range(3), range(3)] = sys.mass[1:, None]
@@ -334,10 +356,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     code, consts, tables, start, end, stack, pyd, dslots = _driver_programs(fns)
-    rows = np.asarray(rows, dtype=np.int64)
     dense = int(_singular_masses(M6[1:]))
-    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
-        jointtree.tree_arrays(sys, rows, *state)
     if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
         dense = 2   # zero DOF: the independent rows' Jacobian is square (solvers.kkt_square)
     pyl = _called_back(sys, mode, tree, state)
@@ -356,7 +375,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots), dslots, _shape_contacts(sys, pyl))
+                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack)
 
 
 def _candidates(sys, topo) -> np.ndarray:

@@ -1,11 +1,13 @@
 """Joint-coordinate model of a tree of one-degree-of-freedom joints (the articulated-body fast path).
 
 A model whose joints form a tree rooted at ground, every joint a revolute, translational or fixed
-joint between rigid bodies, with no motion drivers, is integrated in joint coordinates (one angle [rad]
-or slide [m] per joint, and its rate) by the articulated-body algorithm (`solvers.fasttree`): the
-constraints hold by construction, no projection is needed and a step costs O(N) with a small constant.
-Coordinates are measured from the assembled configuration (0 there). Anything else keeps the
-absolute-coordinate core.
+joint between rigid bodies, is integrated in joint coordinates (one angle [rad] or slide [m] per joint,
+and its rate) by the articulated-body algorithm (`solvers.fasttree`): the joints hold by construction and
+a step costs O(N) with a small constant. Coordinates are measured from the assembled configuration (0
+there). Couplers, gears, rack and pinion, user coordinate constraints and motion drivers of the tree's
+joints are carried as rows f(X, t) = 0 over the joint coordinates (`coord_arrays`, solved and projected
+on by solvers.treecoord), unless the drivers leave no free coordinate (the kinematic analysis then).
+Anything else keeps the absolute-coordinate core (couplers in closed loops: the reference path).
 
 `tree_arrays(sys, rows, q, v)` returns (mode, arrays): mode 1 and the arrays of the joint tree when the
 model qualifies, else mode 0 and empty arrays of the same types (one compiled signature for all):
@@ -24,6 +26,8 @@ from __future__ import annotations
 import numpy as np
 
 ONE_DOF = {"revolute": 1, "translational": 2, "fixed": 0}
+TREE_DRIVERS = True   # motion drivers of tree joints as rows theta_k - f(t) = 0 (solvers.treecoord)
+KERNEL_KINDS = ("sph", "dot1", "dot2", "angle", "slide", "screw", "cvel")   # (system.assemble's)
 
 
 def empty_arrays(nf: int) -> tuple:
@@ -36,9 +40,19 @@ def _why_not(sys, rows) -> str | None:
     """Reason the model cannot take the joint-coordinate path, or None."""
     model = sys.model
     if model.motions:
-        return "motion drivers"
-    if len(sys.aux_q_idx) or len(sys.lock_rows):
+        if not TREE_DRIVERS:
+            return "motion drivers"
+        if any(getattr(mo.function, "symbolic", None) is not None for mo in model.motions.values()):
+            return "motion drivers reading model inputs (re-projected when an input changes)"
+        moving = sum(jt.kind in ("revolute", "translational") for jt in model.joints.values())
+        if len(model.motions) + len(getattr(model, "coord_constraints", {})) >= moving:
+            return "no free coordinate (the kinematic analysis)"
+    if len(sys.lock_rows) or any(g.kind == "curve" for g in sys.groups):
         return "path or friction constraints"
+    if any(g.kind not in KERNEL_KINDS + ("coord",) for g in sys.groups):
+        return "rows the compiled core does not carry"
+    if any(sn.text is None for sn in getattr(model, "sensors", {}).values()):
+        return "sensors written as Python callables"
     if len(rows) != sys.nc:
         return "redundant constraints"
     if any(b.is_particle for b in sys.bodies):
@@ -139,3 +153,92 @@ def joint_state(sys, arrays, q, v) -> np.ndarray:
             rel = fr.rd[c] - fr.rd[p] - np.cross(fr.w[p], fr.r[c] - fr.r[p])
             y[nj + qadr[c]] = a @ rel
     return y
+
+
+def coord_rows(sys) -> np.ndarray:
+    """Rows of the model's coordinate constraints (link and main rows of couplers, gears, user constraints)
+    and of its motion drivers: the rows the tree solves in joint coordinates (`coord_arrays`)."""
+    out = [np.arange(r0, r0 + ev.nrow) for g in sys.groups if g.kind == "coord" for ev, r0 in zip(g.fns, g.row_adr)]
+    out += [np.asarray(sys.owner_rows[name], np.int64) for name in sys.model.motions]
+    return np.concatenate(out).astype(np.int64) if out else np.zeros(0, np.int64)
+
+
+def empty_coords() -> tuple:
+    """`coord_arrays` of a model without coordinate constraints (same types, m = 0)."""
+    i, f = np.zeros(0, np.int64), np.zeros(0)
+    return (i, f, f, np.zeros(1, np.int64), i, np.zeros((0, 2), np.int64), f, f, i, i, i, i, i, i, i,
+            np.zeros((0, 3)), i, i, i)
+
+
+def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
+    """The coordinate constraints of a joint-coordinate tree for solvers.treecoord (layout in its docstring)
+    at the assembled state (q, v): each term's tree coordinate, X_k = x0_k + s_k theta_k (x0: the assembled
+    value: the auxiliary angle of coupler.py for a rotation, the slide for a translation), and the programs
+    f, f_t, f_tt, f_k, f_kt, f_kl of each row (system.exprvm); then one row X - g(t) per motion driver (g
+    evaluated by the compiled drivers); and the programs' stack size."""
+    from . import exprvm
+    from .frames import body_frames
+    groups = [g for g in sys.groups if g.kind == "coord"]
+    motions = list(sys.model.motions.values())
+    if not groups and not motions:
+        return empty_coords(), 4
+    fr = body_frames(sys, q, v)
+    cols = {k: [] for k in ("q", "s", "x0", "link", "aq", "av", "ff", "pt", "frame")}
+    ptr, pbase, mrow, progs, drv, wrap = [0], [], [], [], [], []
+    for g in groups:
+        for ev, r0 in zip(g.fns, g.row_adr):
+            c = ev.spec
+            link = r0
+            for (geom, dof, aq, av) in ev.terms:
+                x0 = float(q[aq]) if dof == "rotation" else None
+                _term(cols, arrays, fr, geom, dof, x0, aq, av, link if dof == "rotation" else -1)
+                link += dof == "rotation"
+            names = c.variables[1:]
+            slots = {name: k for k, name in enumerate(c.variables)}
+            exprs = [c.expr, c.derivs["t"], c.derivs[("t", "t")], *(c.derivs[n] for n in names),
+                     *(c.derivs[(n, "t")] for n in names), *(c.derivs[(a_, b_)] for a_ in names for b_ in names)]
+            pbase.append(len(progs))
+            progs.extend(exprvm.compile_expr(e, slots) for e in exprs)
+            ptr.append(ptr[-1] + len(names))
+            mrow.append(link)
+            drv.append(-1)
+            wrap.append(0)
+    from .packing import pack_rows
+    packed_drv = (sys.derived.get("packed") or pack_rows(sys))[5]   # each row's driver index
+    for mo in motions:   # motion drivers: wrap(X - g(t)) (rotation) or X - g(t) (translation) = 0, g from
+        geom = sys.geoms[mo.joint.name]   # the compiled drivers (fastdyn.drivers_at), callables included
+        row = int(sys.owner_rows[mo.name][0])
+        _term(cols, arrays, fr, geom, mo.dof, None, -1, -1, -1)
+        pbase.append(len(progs))
+        ptr.append(ptr[-1] + 1)
+        mrow.append(row)
+        drv.append(int(packed_drv[row]))
+        wrap.append(int(mo.dof == "rotation"))
+    pk = exprvm.pack(progs)
+    i64 = lambda k: np.array(cols[k], np.int64)  # noqa: E731
+    return (i64("q"), np.array(cols["s"], float), np.array(cols["x0"], float), np.array(ptr, np.int64),
+            np.array(pbase, np.int64), pk.code, pk.consts, pk.tables, pk.start, pk.end, np.array(mrow, np.int64),
+            i64("link"), i64("aq"), i64("av"), i64("ff"), np.array(cols["pt"], float).reshape(-1, 3),
+            i64("frame"), np.array(drv, np.int64), np.array(wrap, np.int64)), max(4, int(pk.stack_size))
+
+
+def _term(cols, arrays, fr, geom, dof, x0, aq, av, link):
+    """Append one term (a joint coordinate X = x0 + s theta of the tree) to the columns of `coord_arrays`;
+    x0 None: the joint's coordinate at the frames fr (a rotation's angle in (-pi, pi], a slide)."""
+    from .constraints import primitives as pr
+    parent, axis, qadr = arrays[0], arrays[2], arrays[7]
+    child = geom.bj if parent[geom.bj] == geom.bi else geom.bi
+    a = fr.A[parent[child]] @ axis[child]
+    sense = 1.0 if child == geom.bj else -1.0
+    bi, bj = np.array([geom.bi]), np.array([geom.bj])
+    if dof == "rotation":
+        s_ = float(np.sign(a @ (fr.A[geom.bi] @ np.cross(geom.f_i, geom.g_i)))) * sense
+        if x0 is None:
+            x0 = float(pr.angle(fr, bi, bj, geom.f_i[None], geom.g_i[None], geom.f_j[None])[0][0])
+    else:
+        s_ = float(a @ (fr.A[geom.bi] @ geom.h_i)) * sense
+        x0 = float(pr.dot2(fr, bi, bj, geom.h_i[None], geom.s_i[None], geom.s_j[None]).phi[0])
+    for k, val in (("q", qadr[child]), ("s", s_), ("x0", x0), ("aq", aq), ("av", av), ("ff", geom.bj),
+                   ("pt", geom.s_j), ("frame", child), ("link", link)):
+        cols[k].append(val)
+
