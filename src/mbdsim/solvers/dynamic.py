@@ -192,12 +192,11 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
-            if exc.prefix is not None and _default_method(model) == "hht":   # HHT continues from there
-                from .autoswitch import continue_implicit
-                hr = None if user_rtol is None else max(user_rtol, HHT_RTOL_FLOOR)
-                res = continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
-                                        progress, reason)
-                warn_reached(res, _tolerances("hht", hr, user_atol)[0], rt, reason)
+            if exc.prefix is not None and _default_method(model) == "hht":   # the compiled Radau IIA continues
+                from .radau_run import continue_radau                       # from there, at auto's tolerance
+                res = continue_radau(sys, rep, times, exc, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
+                                     reason)
+                res.stats["rtol_reached"] = rt
                 return res
         else:
             reason = "compiled path disabled"
@@ -268,6 +267,12 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
         res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res
+    if method == "radau" and USE_COMPILED:   # the compiled Radau IIA (mbdsim.solvers.radau_run)
+        from .radau_run import integrate_radau
+        try:
+            return integrate_radau(sys, rep, times, rtol, atol, max_step, progress)
+        except NotCompiled:
+            pass
     if method in COMPILED_METHODS and USE_COMPILED:
         try:
             return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)
