@@ -1,5 +1,6 @@
-"""Dynamic analysis: `simulate` (checks, method choice, tolerances) over the compiled DOP853, the
-index-1 scipy methods and HHT (those two through the one driver of mbdsim.solvers.driver).
+"""Dynamic analysis: `simulate` (checks, method choice, tolerances) over the compiled DOP853 and Radau IIA
+(mbdsim.solvers.compiled_run, radau_run), the index-1 scipy methods and HHT (those two through the one
+driver of mbdsim.solvers.driver).
 
 Index-1 methods ("dop853" - the high-accuracy default for smooth problems -, "rk45", "radau", "bdf"):
 the equations of motion are solved for accelerations at every stage (augmented KKT system), the
@@ -51,8 +52,9 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
-    element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
-    the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise the reference
+    element of the model is compiled, handing over to the compiled Radau IIA (5th order, implicit) when
+    it detects stiffness (Radau continues from the detection time at the same target tolerance;
+    res.stats["switch_time"]; mbdsim.solvers.radau_run); otherwise the reference
     DOP853 (index-1 with projection; "hht" only when a given rtol is 1e-6 or looser; expression sensors are
     watched inside the compiled DOP853's step loop). A model with zero degrees of freedom
     (fully driven: assembly's dof == 0) on the compiled core is solved by "auto" as a kinematic
@@ -61,7 +63,8 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
-    damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
+    damping), "rk45", "radau" (implicit Radau IIA; compiled when the model allows and has no sensors),
+    "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
