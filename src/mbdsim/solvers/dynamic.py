@@ -63,7 +63,8 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
-    damping), "rk45", "radau" (implicit Radau IIA; compiled when the model allows and has no sensors),
+    damping), "rk45", "radau" (implicit Radau IIA; compiled when the model allows, has no sensors and no
+    contacts or stops),
     "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations

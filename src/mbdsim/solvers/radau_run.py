@@ -5,8 +5,9 @@ compiled kernels carry, and the automatic method's continuation after DOP853 fla
 states) whose step loop is `fastradau.run`. It keeps, for every accepted step, its start state, (t, h)
 and the coefficients of its collocation polynomial (within CHECKPOINT_BUDGET bytes), so that `Result.at`
 between outputs is the run's own dense output (projected onto the constraints, accelerations and
-multipliers from the compiled kernel), nothing integrated again. Models with expression sensors stay on
-the other paths (`NotCompiled`: sensors are watched by DOP853's step loop only).
+multipliers from the compiled kernel), nothing integrated again. For method "radau", models with expression
+sensors or switching force elements (contact onset, stops) stay on the reference path (`NotCompiled`),
+which locates their events; the automatic method's continuation runs them compiled, as its DOP853 part.
 """
 from __future__ import annotations
 
@@ -143,9 +144,14 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
 
 def integrate_radau(sys, rep, times, rtol, atol, max_step, progress=None):
     """Dynamic analysis with the compiled Radau IIA (method "radau"); NotCompiled when the model needs the
-    reference path or has expression sensors (watched by DOP853's step loop only)."""
+    reference path, has expression sensors (watched by DOP853's step loop only) or force elements with
+    switching functions (contacts, stops, friction: scipy's Radau on the reference path cuts its steps at
+    their events, mbdsim.solvers.events)."""
+    from ..system.force_elements import evaluator
     if getattr(sys.model, "sensors", None):
         raise NotCompiled("expression sensors are watched by the compiled DOP853 only")
+    if any(hasattr(evaluator(e), "switch") for e in sys.model.forces.values()):   # contacts, stops, friction:
+        raise NotCompiled("switching elements: the reference path cuts steps at their events")  # events located
     run = RadauRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v))
     return _integrate(sys, rep, run, times, progress)
 
