@@ -50,8 +50,9 @@ class OrderTrack:
 
 
 class AccuracyWarning(UserWarning):
-    """The automatic method could not run at the requested (or default) tolerance: after a stiffness
-    hand-over HHT, second order, ran at a looser rtol (`res.stats["rtol_reached"]`)."""
+    """The automatic method could not run at the requested (or default) tolerance: HHT, second order, ran
+    at a looser rtol (`res.stats["rtol_reached"]`): a stiff model the compiled core does not carry (the
+    compiled models hand over to the compiled Radau IIA at the target tolerance)."""
 
 
 def warn_reached(res, reached: float, target: float, reason: str) -> None:
