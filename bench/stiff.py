@@ -125,8 +125,14 @@ def write(rows):
              "|---|---|---:|---:|---:|---:|---|"]
     for name, method, el, ratio, err, steps, used in rows:
         lines.append(f"| {name} | {method} | {el:.3f} | {ratio:.2f} | {err:.2e} | {steps} | {used} |")
-    with open(os.path.join(HERE, "STIFF_RESULTS.md"), "w") as f:
-        f.write("\n".join(lines) + "\n")
+    path = os.path.join(HERE, "STIFF_RESULTS.md")
+    keep = ""   # the stiff chain's section (bench/stiff_chain.py) is kept
+    if os.path.exists(path):
+        old = open(path).read()
+        if "<!-- stiff chain" in old:
+            keep = "\n" + old[old.index("<!-- stiff chain"):]
+    with open(path, "w") as f:
+        f.write("\n".join(lines) + "\n" + keep)
 
 
 if __name__ == "__main__":

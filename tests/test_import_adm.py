@@ -3,6 +3,7 @@ SPRINGDAMPER, BUSHING) against closed forms and the same machine built through t
 conventions, joint types, action-reaction loads (momentum), errors with file and line, the CLI."""
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -295,7 +296,8 @@ def test_contact_in_millimetres(tmp_path):
     """A ball resting on a plane (GRAPHICS ELLIPSOID and PLANE, IMPACT contact in N/mm^1.5): its rest
     penetration is (m g / k)^(1/e)."""
     m = mb.from_adm(_adm(tmp_path, BALL))
-    with pytest.warns(mb.AccuracyWarning):
+    with warnings.catch_warnings():   # the stiff contact hands over to the compiled Radau at the target rtol
+        warnings.simplefilter("error", mb.AccuracyWarning)
         res = mb.simulate(m, 1.0, output_step=0.01)
     k = 1e5 * 1e-3 ** -1.5                                      # N/mm^1.5 -> N/m^1.5
     assert res.position("PART_2")[-1, 2] == pytest.approx(0.02 - (9.81 / k) ** (1 / 1.5), abs=1e-8)

@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 # exception classes that never reach a user: control flow inside the package, caught where raised
 INTERNAL = {
-    "Stiff": "solvers.compiled_run: the compiled DOP853 hands over to HHT",
+    "Stiff": "solvers.compiled_run: the compiled DOP853 hands over to the compiled Radau IIA",
     "NotStreamable": "solvers.dynamic: a run that cannot stream falls back",
     "NotCompiled": "system.compiled: a model the kernels do not carry takes the reference path",
     "ItemError": "io.build: turned into ModelFileError by mbdsim.io",

@@ -35,7 +35,8 @@ class Result:
     "rejected", "nfev" (function evaluations), "njev" (Jacobian evaluations), "factorizations",
     "order" (of the method that finished the run) and "order_history", a list of
     `(t_start, method, order)` segments in time order, t_start in seconds (two for an automatic run that
-    handed over to HHT on stiffness, at `stats["switch_time"]`; BDF's own order changes), plus
+    handed over to the compiled Radau IIA on stiffness, at `stats["switch_time"]`; BDF's own order
+    changes), plus
     "assembly" (the AssemblyReport)."""
 
     def __init__(self, system, time, q, v, vd, lambda_, evaluate: Callable | None = None,

@@ -1,4 +1,6 @@
-"""The automatic method's hand-over from the explicit DOP853 to HHT-alpha when it detects stiffness.
+"""The automatic method's hand-over from the explicit DOP853 to an implicit method when it detects stiffness:
+the joining of the two parts (`join`, `merge_stats`), used by the compiled Radau IIA's continuation
+(mbdsim.solvers.radau_run.continue_radau, the default) and HHT's (`continue_implicit`).
 
 The compiled DOP853 stops at the start t_s of the step its stiffness test flagged (`compiled_run.Stiff`,
 whose `prefix` holds the outputs at times <= t_s, the consistent state at t_s and the run with its step
@@ -48,8 +50,9 @@ class OrderTrack:
 
 
 class AccuracyWarning(UserWarning):
-    """The automatic method could not run at the requested (or default) tolerance: after a stiffness
-    hand-over HHT, second order, ran at a looser rtol (`res.stats["rtol_reached"]`)."""
+    """The automatic method could not run at the requested (or default) tolerance: HHT, second order, ran
+    at a looser rtol (`res.stats["rtol_reached"]`): a stiff model the compiled core does not carry (the
+    compiled models hand over to the compiled Radau IIA at the target tolerance)."""
 
 
 def warn_reached(res, reached: float, target: float, reason: str) -> None:

@@ -98,6 +98,7 @@ class CompiledRun:
         self._take_events()
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
+        self.last_state = y.copy()   # the integrator's own last state (a tree's joint state: the hand-over)
         if self.joint_space and status != 0:   # the last state as absolute coordinates (failure reports, and
             ymax = np.zeros(len(y0))            # a sensor's stop: continuous with the last output)
             fastdyn.write_state(a, w, y, ymax, Y[iout - 1] if status == fastdop.SENSOR_STOP and iout else ymax[:0])

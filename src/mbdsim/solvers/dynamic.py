@@ -1,5 +1,6 @@
-"""Dynamic analysis: `simulate` (checks, method choice, tolerances) over the compiled DOP853, the
-index-1 scipy methods and HHT (those two through the one driver of mbdsim.solvers.driver).
+"""Dynamic analysis: `simulate` (checks, method choice, tolerances) over the compiled DOP853 and Radau IIA
+(mbdsim.solvers.compiled_run, radau_run), the index-1 scipy methods and HHT (those two through the one
+driver of mbdsim.solvers.driver).
 
 Index-1 methods ("dop853" - the high-accuracy default for smooth problems -, "rk45", "radau", "bdf"):
 the equations of motion are solved for accelerations at every stage (augmented KKT system), the
@@ -51,8 +52,9 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     """Dynamic analysis from start_time to end_time [s]; output every output_step [s] (default 1/500 span).
 
     method: "auto" (default): the compiled DOP853 (8th order, O(N) equations of motion) when every
-    element of the model is compiled, handing over to HHT when it detects stiffness (HHT continues from
-    the detection time; res.stats["switch_time"]; mbdsim.solvers.autoswitch); otherwise the reference
+    element of the model is compiled, handing over to the compiled Radau IIA (5th order, implicit) when
+    it detects stiffness (Radau continues from the detection time at the same target tolerance;
+    res.stats["switch_time"]; mbdsim.solvers.radau_run); otherwise the reference
     DOP853 (index-1 with projection; "hht" only when a given rtol is 1e-6 or looser; expression sensors are
     watched inside the compiled DOP853's step loop). A model with zero degrees of freedom
     (fully driven: assembly's dof == 0) on the compiled core is solved by "auto" as a kinematic
@@ -61,7 +63,9 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
-    damping), "rk45", "radau", "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
+    damping), "rk45", "radau" (implicit Radau IIA; compiled when the model allows, has no sensors and no
+    contacts or stops),
+    "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
@@ -192,12 +196,11 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
-            if exc.prefix is not None and _default_method(model) == "hht":   # HHT continues from there
-                from .autoswitch import continue_implicit
-                hr = None if user_rtol is None else max(user_rtol, HHT_RTOL_FLOOR)
-                res = continue_implicit(sys, rep, times, exc, *_tolerances("hht", hr, user_atol), max_step,
-                                        progress, reason)
-                warn_reached(res, _tolerances("hht", hr, user_atol)[0], rt, reason)
+            if exc.prefix is not None and _default_method(model) == "hht":   # the compiled Radau IIA continues
+                from .radau_run import continue_radau                       # from there, at auto's tolerance
+                res = continue_radau(sys, rep, times, exc, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
+                                     reason)
+                res.stats["rtol_reached"] = rt
                 return res
         else:
             reason = "compiled path disabled"
@@ -268,6 +271,12 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
         res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res
+    if method == "radau" and USE_COMPILED:   # the compiled Radau IIA (mbdsim.solvers.radau_run)
+        from .radau_run import integrate_radau
+        try:
+            return integrate_radau(sys, rep, times, rtol, atol, max_step, progress)
+        except NotCompiled:
+            pass
     if method in COMPILED_METHODS and USE_COMPILED:
         try:
             return integrate_compiled(sys, rep, times, rtol, atol, max_step, progress)

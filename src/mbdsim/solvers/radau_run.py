@@ -1,0 +1,182 @@
+"""Python side of the compiled Radau IIA (mbdsim.solvers.fastradau): method "radau" on a model the
+compiled kernels carry, and the automatic method's continuation after DOP853 flags stiffness.
+
+`RadauRun` is a `CompiledRun` (the same compiled model, work arrays, outputs, failure reports and step
+states) whose step loop is `fastradau.run`. It keeps, for every accepted step, its start state, (t, h)
+and the coefficients of its collocation polynomial (within CHECKPOINT_BUDGET bytes), so that `Result.at`
+between outputs is the run's own dense output (projected onto the constraints, accelerations and
+multipliers from the compiled kernel), nothing integrated again. For method "radau", models with expression
+sensors or switching force elements (contact onset, stops) stay on the reference path (`NotCompiled`),
+which locates their events; the automatic method's continuation runs them compiled, as its DOP853 part.
+"""
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+
+from ..errors import SolverError
+from ..results.stream import ProgressError, notify
+from ..system.compiled import NotCompiled
+from . import fastdop, fastdyn, fastradau, pyloads
+from .compiled_run import (CHECKPOINT_BUDGET, CHUNK, PROGRESS_FAILED, CompiledRun, _MESSAGES, _result, failure)
+from .fastdyn import INTERRUPTED
+
+METHOD = "Radau IIA (compiled)"
+HISTORY = ("Radau", 5)   # (method, order) of its segment in res.stats["order_history"]
+
+
+class RadauRun(CompiledRun):
+    """A compiled model stepped by the compiled Radau IIA (fastradau.run); stats: steps, rejected, rhs
+    evaluations, projections, Jacobians, LU factorisation pairs."""
+
+    dense_q = None
+
+    @classmethod
+    def sharing(cls, run: CompiledRun, rtol, atol, max_step):
+        """A RadauRun on the compiled model and work arrays of `run` (the automatic method's hand-over:
+        nothing compiled again), with its own tolerances and statistics."""
+        new = object.__new__(cls)
+        new.__dict__.update({k: v for k, v in run.__dict__.items() if k != "checkpoints"})
+        new.rtol, new.atol = float(rtol), float(atol)
+        new.max_step = np.inf if not max_step else float(max_step)
+        new.stats = np.zeros(6, dtype=np.int64)
+        new.stiff_check, new.sensor_events, new.run_error = False, [], None
+        return new
+
+    def integrate(self, t0, y0, tout, progress=None, checkpoints=True, partial=None, y_start=None):
+        """As CompiledRun.integrate, stepping with Radau IIA; y_start: the integrator's state at t0 (a
+        tree's joint state with continuous angles) when known, else taken from y0 (absolute [q, v])."""
+        a, w = self.cm.arrays(), self.work.arrays()
+        nout = len(tout)
+        start_row = y_start is None and self.joint_space
+        if y_start is not None:
+            y = np.array(y_start, dtype=float)
+        else:
+            y = np.zeros(self.state_size) if self.joint_space else np.array(y0, dtype=float)
+        n = len(y)
+        Y = np.zeros((nout, len(y0)))
+        Y[0] = y0
+        iout = 1 if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)) else 0
+        f = np.zeros(n)
+        st = np.zeros(fastradau.N_ST)
+        st[0] = t0
+        Jm, LR, LC = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n), dtype=np.complex128)
+        piv, S, cv = np.zeros((2, n), dtype=np.int64), np.zeros((fastradau.N_SCRATCH, n)), np.zeros(n, np.complex128)
+        keep = checkpoints and 4 * n * 8 * 64 <= CHECKPOINT_BUDGET
+        cap = 64 if keep else 0
+        SY, ST, SQ, ns = np.zeros((cap, n)), np.zeros((cap, 2)), np.zeros((cap, 3, n)), np.zeros(1, np.int64)
+        status = 0
+        try:
+            while status in (0, fastdop.CHECKPOINTS_FULL) and iout < nout:
+                if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
+                    if 2 * (SY.size + SQ.size) * 8 <= CHECKPOINT_BUDGET:
+                        SY, ST, SQ = (np.concatenate([x, np.zeros_like(x)]) for x in (SY, ST, SQ))
+                    else:
+                        keep, SY, ST, SQ = False, SY[:0], ST[:0], SQ[:0]
+                status, iout = fastradau.run(a, w, fastradau.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
+                                             self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
+                                             self.stats, Jm, LR, LC, piv, S, cv, SY, ST, SQ, ns, start_row)
+                if st[1] == 0.0:   # the start failed
+                    iout = 0
+                    break
+                notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
+        except KeyboardInterrupt:
+            status = INTERRUPTED
+        except ProgressError as exc:
+            status, self.run_error = PROGRESS_FAILED, exc
+        status, self.run_error = pyloads.settle(self.pyloads, status, self.run_error)
+        self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
+        self.dense_q = SQ[:ns[0]].copy() if keep else None
+        if self.joint_space and status != 0:
+            ymax = np.zeros(len(y0))
+            fastdyn.write_state(a, w, y, ymax, ymax[:0])
+            y = ymax
+        return Y, iout, status, st[0], y
+
+    def _from_checkpoints(self, cp, ts, full=True):
+        """(q, v, vd, lambda_) at ts from the collocation polynomial of the run's step containing each time
+        (projected onto the constraints in absolute coordinates, as the run's own outputs)."""
+        from .compiled_run import _full_multipliers
+        SY, ST = cp
+        sys = self.sys
+        a, w = self.cm.arrays(), self.work.arrays()
+        nq = sys.nq
+        Ys = np.zeros((len(ts), nq + sys.nv))
+        step = np.clip(np.searchsorted(ST[:, 0], ts, side="right") - 1, 0, len(ST) - 1)
+        yo = np.zeros(SY.shape[1])
+        for k, (t, j) in enumerate(zip(ts.tolist(), step.tolist())):
+            t0, h = float(ST[j, 0]), float(ST[j, 1])
+            fastradau.dense(self.dense_q[j], SY[j], t0, h, min(max(t, t0), t0 + h), yo)
+            if not self.joint_space and fastdyn.project(a, w, t, yo[:nq], yo[nq:], 1e-12, False) != 0:
+                raise SolverError(_MESSAGES[fastdyn.PROJECTION] + " at a dense-output time", time=t)
+            fastdyn.write_state(a, w, yo, Ys[k], Ys[k][:0])
+        VD, LAM = self.outputs(ts, Ys)
+        return Ys[:, :nq], Ys[:, nq:], VD, (_full_multipliers(sys, self.rows, ts, Ys, VD, LAM) if full else LAM)
+
+
+def _stats(run: RadauRun, rep) -> dict:
+    s = run.stats
+    return {"steps": int(s[0]), "rejected": int(s[1]), "nfev": int(s[2]), "njev": int(s[4]),
+            "nlu": int(2 * s[5]),
+            "factorizations": int(2 * s[5]) + (0 if run.joint_space else int(s[2] + 2 * s[3])),
+            "projections": 0 if run.joint_space else int(s[3]), "order": 5, "method": METHOD,
+            "formulation": "joint coordinates (articulated body)" if run.joint_space else
+            "absolute coordinates (tree elimination)", "assembly": rep}
+
+
+def _integrate(sys, rep, run, times, progress=None, y_start=None):
+    """The Result of a RadauRun over `times` from the consistent state rep (y_start: the integrator's
+    state, for a hand-over)."""
+    y0 = np.concatenate([rep.q, rep.v])
+    times = np.asarray(times, float)
+    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
+    Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial, y_start)
+    success, message, error = True, "ok", None
+    if status != 0:
+        error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed", run.run_error)
+        success = False
+    res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=_stats(run, rep))
+    res.error = error
+    res.stats["order_history"] = [(float(times[0]),) + HISTORY]
+    return res
+
+
+def integrate_radau(sys, rep, times, rtol, atol, max_step, progress=None):
+    """Dynamic analysis with the compiled Radau IIA (method "radau"); NotCompiled when the model needs the
+    reference path, has expression sensors (watched by DOP853's step loop only) or force elements with
+    switching functions (contacts, stops, friction: scipy's Radau on the reference path cuts its steps at
+    their events, mbdsim.solvers.events)."""
+    from ..system.force_elements import evaluator
+    if getattr(sys.model, "sensors", None):
+        raise NotCompiled("expression sensors are watched by the compiled DOP853 only")
+    if any(hasattr(evaluator(e), "switch") for e in sys.model.forces.values()):   # contacts, stops, friction:
+        raise NotCompiled("switching elements: the reference path cuts steps at their events")  # events located
+    run = RadauRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v))
+    return _integrate(sys, rep, run, times, progress)
+
+
+def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):
+    """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and the compiled Radau
+    IIA from its switch time t_s on, at rtol, atol; joined as autoswitch.continue_implicit joins HHT's part
+    (outputs, dense output: DOP853's steps up to t_s, Radau's collocation polynomials after; statistics;
+    order history with a ("Radau", 5) segment from t_s)."""
+    from .autoswitch import _align_quaternions, _Joined, join, merge_stats
+    pre, t_s = stiff.prefix, float(stiff.time)
+    run, tp, Y = pre["run"], pre["times"], pre["Y"]
+    nq = sys.nq
+    q_s = _align_quaternions(sys, np.array(pre["y"][:nq]), Y[-1, :nq])
+    v_s = np.array(pre["y"][nq:])
+    first = _result(sys, rep, run, tp, Y, stats=pre["stats"])
+    first.steps = lambda: run.step_states(t_s, np.concatenate([q_s, v_s]))
+    rep_s = dataclasses.replace(rep, t=t_s, q=q_s, v=v_s)
+    rest = np.concatenate([[t_s], np.asarray(times, float)[len(tp):]])
+    rr = RadauRun.sharing(run, rtol, atol, max_step)
+    y_start = getattr(run, "last_state", None) if run.joint_space else None
+    second = _integrate(sys, rep_s, rr, rest, None if progress is None else _Joined(progress, first, t_s),
+                        None if y_start is None else np.array(y_start))
+    res = join(first, second, t_s)
+    res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
+    res.stats["order_history"][-1] = (t_s,) + HISTORY
+    res.stats.update(assembly=rep, njev=second.stats["njev"], nlu=second.stats["nlu"], rtol_reached=rtol)
+    return res
