@@ -29,8 +29,11 @@ from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
-from .fastnarrow import (BOX, CAPSULE, HULL, PLANE, SPHERE, candidate, dir_local, face, inside_except, n_candidates,
-                         pose, segments_closest, support_depth, to_ground, to_local)
+from .fastbroad import boxes, partner, sort_order, sweep_axis
+from .fastgjk import penetration
+from .fastmesh import mesh_points
+from .fastnarrow import (BOX, CAPSULE, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
+                         n_candidates, segments_closest, support_depth, to_ground, to_local)
 
 RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
 NREC = 15
@@ -224,26 +227,79 @@ def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
 
 
 @kernel(_nrt=False)
+def _row(PS, s):
+    """Shape s's pose (the 12-tuple of fastnarrow.pose) from its row of sc[17]."""
+    return (PS[s, 0], PS[s, 1], PS[s, 2], PS[s, 3], PS[s, 4], PS[s, 5], PS[s, 6], PS[s, 7], PS[s, 8], PS[s, 9],
+            PS[s, 10], PS[s, 11])
+
+
+@kernel(_nrt=False)
+def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
+    """The narrow phase of one pair whose bounding boxes overlap (module docstring)."""
+    kind, rad, pr, PS = sc[1], sc[5], sc[10], sc[17]
+    a, b = pr[pair, 0], pr[pair, 1]
+    Pa, Pb = _row(PS, a), _row(PS, b)
+    ka, kb = kind[a], kind[b]
+    if ka == PLANE or kb == PLANE:
+        pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if ka == PLANE else (b, a, Pa, Pb, -1.0)
+        m0, m1, m2 = Q[5], Q[8], Q[11]   # the plane's local z
+        if m0 * (P[0] - Q[0]) + m1 * (P[1] - Q[1]) + m2 * (P[2] - Q[2]) > rad[x]:
+            return   # the bounding sphere clears the plane
+        _against(sc, pair, x, pl, -1, P, Q, Q[0], Q[1], Q[2], m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
+        _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    if ka == MESH or kb == MESH:
+        msh, x, Px, Pm, sign = (a, b, Pb, Pa, 1.0) if ka == MESH else (b, a, Pa, Pb, -1.0)
+        if (kind[x] == BOX or kind[x] == HULL) and rad[msh] <= rad[x]:
+            # a mesh no larger than the polyhedron: its vertices on the polyhedron's faces
+            _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+            return
+        S = sc[29]
+        for s in range(mesh_points(sc, x, msh, Px, Pm)):
+            if S[s, 0] > 0.0:
+                _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[s, 2], S[s, 3], S[s, 4],
+                       sign * S[s, 5], sign * S[s, 6], sign * S[s, 7], S[s, 1])
+        return
+    if ka == BOX or ka == HULL or kb == BOX or kb == HULL:
+        _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    depth, n0, n1, n2, p0, p1, p2 = penetration(sc, a, b, Pa, Pb, 1e-10 * (rad[a] + rad[b]))
+    if depth > 0.0:
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, depth)
+
+
+@kernel(_nrt=False)
 def shape_contacts(sc, r, A, rd, w, rigid, F, rec, nrec):
     """Contact loads of every packed shape pair into F (module docstring); records into rec while it has room."""
-    sh_f, kind, sh_c, sh_R, rad, pr = sc[0], sc[1], sc[2], sc[3], sc[5], sc[10]
-    for pair in range(pr.shape[0]):
-        a, b = pr[pair, 0], pr[pair, 1]
-        Pa = pose(r, A, sh_f[a], sh_c[a], sh_R[a])
-        Pb = pose(r, A, sh_f[b], sh_c[b], sh_R[b])
-        if kind[a] == PLANE or kind[b] == PLANE:
-            pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if kind[a] == PLANE else (b, a, Pa, Pb, -1.0)
-            m0, m1, m2 = Q[5], Q[8], Q[11]   # the plane's local z
-            if m0 * (P[0] - Q[0]) + m1 * (P[1] - Q[1]) + m2 * (P[2] - Q[2]) > rad[x]:
-                continue   # broad phase: the bounding sphere clears the plane
-            _against(sc, pair, x, pl, -1, P, Q, Q[0], Q[1], Q[2], m0, m1, m2, sign, r, A, rd, w, rigid, F, rec,
-                     nrec)
+    kind, ptr, adj, BB, order, stats = sc[1], sc[15], sc[16], sc[18], sc[19], sc[20]
+    if sc[10].shape[0] == 0:
+        return
+    boxes(sc, r, A)
+    ax = sweep_axis(BB)
+    sort_order(order, BB, ax)
+    k1, k2 = (ax + 1) % 3, (ax + 2) % 3
+    stats[0] = 0
+    stats[2] += 1
+    ns = kind.shape[0]
+    for ii in range(ns):
+        i = order[ax, ii]
+        if ptr[i + 1] == ptr[i]:
             continue
-        d0, d1, d2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
-        if d0 * d0 + d1 * d1 + d2 * d2 > (rad[a] + rad[b]) ** 2:
-            continue   # broad phase: bounding spheres apart
-        ka, kb = kind[a], kind[b]
-        if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
-            _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
-        else:
-            _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        hi = BB[i, 3 + ax]
+        for jj in range(ii + 1, ns):
+            j = order[ax, jj]
+            if BB[j, ax] > hi:
+                break
+            if BB[j, k1] > BB[i, 3 + k1] or BB[i, k1] > BB[j, 3 + k1] or BB[j, k2] > BB[i, 3 + k2] \
+                    or BB[i, k2] > BB[j, 3 + k2]:
+                continue
+            row = partner(ptr, adj, i, j)
+            if row < 0:
+                continue
+            while row < ptr[i + 1] and adj[row, 0] == j:
+                stats[0] += 1
+                stats[1] += 1
+                _narrow(sc, adj[row, 1], r, A, rd, w, rigid, F, rec, nrec)
+                row += 1
