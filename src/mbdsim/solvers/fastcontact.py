@@ -6,13 +6,18 @@ about the CM in body axes, from the frames r, A, rd, w (w in ground axes).  With
 rows it also records each contact point (see REC_FIELDS; nrec[0] counts them); the step loop passes an
 empty rec.
 
-Broad phase: bounding spheres (a plane: the signed distance of the other shape's bounding sphere), so a
-pair far apart costs a few flops.  Narrow phase (solvers.fastnarrow): against a plane, the candidate points
-of the shape; spheres and capsules by the closest points of their segments; against a box or convex hull,
-the separating-axis test over the polyhedra's face normals picks the reference face of least penetration,
-whose normal is the contact normal of every point: the incident shape's candidate points below it and
-inside the reference (vertices, rim points, ...) and, between two polyhedra, the reference's vertices
-inside the incident one.  Face and line contacts so get several points and the right moments.
+Broad phase (solvers.fastbroad): sweep and prune on the shapes' ground bounding boxes, so that only
+pairs whose boxes overlap reach the narrow phase (cost: shapes plus overlaps, not pairs).  Narrow phase
+per pair (solvers.fastnarrow): against a plane, the candidate points of the shape; spheres and capsules by
+the closest points of their segments; against a box or convex hull, the separating-axis test over the
+polyhedra's face normals picks the reference face of least penetration, whose normal is the contact normal
+of every point: the incident shape's candidate points below it and inside the reference (vertices, rim
+points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
+line contacts get several points and the right moments; a convex shape against a triangle mesh through
+its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
+vertices on the polyhedron's faces instead); the other convex pairs (cylinders and ellipsoids against
+curved shapes) by GJK and EPA over support functions (solvers.fastgjk), one point midway between the
+witness points.
 
 Law at each point (depth delta > 0 [m], normal n from shape_i towards shape_j, gap rate gd = n . v_rel):
 IMPACT  Fn = max(0, k delta^e - STEP(delta, 0, 0, d, c_max) gd), or with a coefficient of restitution eps
@@ -145,6 +150,9 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
                 best, ref, gbest = D, rs, g
             if not D > 0.0:
                 return   # a separating face: no contact
+    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, r, A, rd, w, rigid, F, rec,
+                                                        nrec):
+        return   # separated along an edge-edge axis, or an edge-edge contact
     rs, xs = (b, a) if ref == b else (a, b)
     Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
     sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
@@ -166,6 +174,55 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
         h = 0.5 * d
         _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
                sign * m0, sign * m1, sign * m2, d)
+
+
+@kernel(_nrt=False)
+def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, nrec):
+    """Edge-edge axes of two boxes (the cross products of their edge directions): True when one separates
+    them, or when one penetrates clearly less than the best face (below 0.95 of it; faces are preferred
+    for resting contact) and the contact at the closest points of the two supporting edges is applied."""
+    prm = sc[4]
+    ha, hb = prm[a], prm[b]
+    c0, c1, c2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
+    best, bi, bj, L0, L1, L2 = 0.95 * face_depth, -1, -1, 0.0, 0.0, 0.0
+    for i in range(3):
+        for j in range(3):
+            x0, x1, x2 = _cross(Pa[3 + i], Pa[6 + i], Pa[9 + i], Pb[3 + j], Pb[6 + j], Pb[9 + j])
+            nrm = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+            if nrm < 1e-6:
+                continue   # parallel edges: the face axes cover them
+            x0, x1, x2 = x0 / nrm, x1 / nrm, x2 / nrm
+            s = x0 * c0 + x1 * c1 + x2 * c2
+            if s < 0.0:
+                x0, x1, x2, s = -x0, -x1, -x2, -s
+            ext = 0.0
+            for k in range(3):
+                ext += abs(x0 * Pa[3 + k] + x1 * Pa[6 + k] + x2 * Pa[9 + k]) * ha[k]
+                ext += abs(x0 * Pb[3 + k] + x1 * Pb[6 + k] + x2 * Pb[9 + k]) * hb[k]
+            D = ext - s
+            if not D > 0.0:
+                return True
+            if D < best:
+                best, bi, bj, L0, L1, L2 = D, i, j, x0, x1, x2
+    if bi < 0:
+        return False
+    # a's edge along axis bi farthest along L, b's edge along axis bj farthest along -L
+    p0, p1, p2 = Pa[0], Pa[1], Pa[2]
+    q0, q1, q2 = Pb[0], Pb[1], Pb[2]
+    for k in range(3):
+        if k != bi:
+            s = ha[k] if L0 * Pa[3 + k] + L1 * Pa[6 + k] + L2 * Pa[9 + k] > 0.0 else -ha[k]
+            p0, p1, p2 = p0 + s * Pa[3 + k], p1 + s * Pa[6 + k], p2 + s * Pa[9 + k]
+        if k != bj:
+            s = -hb[k] if L0 * Pb[3 + k] + L1 * Pb[6 + k] + L2 * Pb[9 + k] > 0.0 else hb[k]
+            q0, q1, q2 = q0 + s * Pb[3 + k], q1 + s * Pb[6 + k], q2 + s * Pb[9 + k]
+    ea0, ea1, ea2 = ha[bi] * Pa[3 + bi], ha[bi] * Pa[6 + bi], ha[bi] * Pa[9 + bi]
+    eb0, eb1, eb2 = hb[bj] * Pb[3 + bj], hb[bj] * Pb[6 + bj], hb[bj] * Pb[9 + bj]
+    X, Y = segments_closest(p0 - ea0, p1 - ea1, p2 - ea2, p0 + ea0, p1 + ea1, p2 + ea2,
+                            q0 - eb0, q1 - eb1, q2 - eb2, q0 + eb0, q1 + eb1, q2 + eb2)
+    _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, 0.5 * (X[0] + Y[0]), 0.5 * (X[1] + Y[1]),
+           0.5 * (X[2] + Y[2]), L0, L1, L2, best)
+    return True
 
 
 @kernel(_nrt=False)
