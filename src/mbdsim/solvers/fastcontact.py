@@ -16,8 +16,10 @@ points, ...) and, between two polyhedra, the reference's vertices inside the inc
 line contacts get several points and the right moments; a convex shape against a triangle mesh through
 its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
 vertices on the polyhedron's faces instead); the other convex pairs (cylinders and ellipsoids against
-curved shapes) by GJK and EPA over support functions (solvers.fastgjk), one point midway between the
-witness points.
+curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
+of its point or segment from the solid (closed forms and a monotone Newton iteration: smooth in the
+state), the others (cylinders and ellipsoids among themselves) by GJK and EPA over support functions, one
+point midway between the witness points.
 
 Law at each point (depth delta > 0 [m], normal n from shape_i towards shape_j, gap rate gd = n . v_rel):
 IMPACT  Fn = max(0, k delta^e - STEP(delta, 0, 0, d, c_max) gd), or with a coefficient of restitution eps
@@ -35,7 +37,7 @@ from .._jit import kernel
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
 from .fastbroad import boxes, partner, sort_order, sweep_axis
-from .fastgjk import penetration
+from .fastgjk import penetration, rounded_penetration
 from .fastmesh import mesh_points
 from .fastnarrow import (BOX, CAPSULE, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
                          n_candidates, segments_closest, support_depth, to_ground, to_local)
@@ -322,7 +324,14 @@ def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     if ka == BOX or ka == HULL or kb == BOX or kb == HULL:
         _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
         return
-    depth, n0, n1, n2, p0, p1, p2 = penetration(sc, a, b, Pa, Pb, 1e-10 * (rad[a] + rad[b]))
+    prm = sc[4]
+    if ka == SPHERE or ka == CAPSULE:   # a rounded shape on a cylinder or an ellipsoid: n from b to a
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(ka, Pa, prm[a], kb, Pb, prm[b])
+        n0, n1, n2 = -n0, -n1, -n2
+    elif kb == SPHERE or kb == CAPSULE:
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(kb, Pb, prm[b], ka, Pa, prm[a])
+    else:
+        depth, n0, n1, n2, p0, p1, p2 = penetration(sc, a, b, Pa, Pb, 1e-10 * (rad[a] + rad[b]))
     if depth > 0.0:
         _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, depth)
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, dir_local, to_ground
+from .fastnarrow import BOX, CAPSULE, CYLINDER, ELLIPSOID, SPHERE, dir_ground, dir_local, to_ground
 
 MAX_ITER = 120     # EPA iterations (each adds one vertex); geometry.pack sizes the scratch from it
 
@@ -265,3 +265,95 @@ def penetration(sc, a, b, Pa, Pb, tol):
     x2 = li * V[i, 5] + lj * V[j, 5] + lk * V[k, 5]
     h = 0.5 * dist
     return dist, n0, n1, n2, x0 - h * n0, x1 - h * n1, x2 - h * n2
+
+
+@kernel(_nrt=False)
+def _ellipsoid_closest(a0, a1, a2, y0, y1, y2):
+    """Closest point of the ellipsoid surface (semi-axes a) to the point y (local), for y outside or inside:
+    x_i = a_i^2 y_i / (t + a_i^2) with t the root of sum (a_i y_i / (t + a_i^2))^2 = 1, by Newton from the
+    right (the function is convex and decreasing there, so the iterates fall monotonically to the root)."""
+    t = max(a0, a1, a2) * np.sqrt(y0 * y0 + y1 * y1 + y2 * y2)
+    lo = -min(a0, a1, a2) ** 2
+    for _ in range(100):
+        q0, q1, q2 = a0 * y0 / (t + a0 * a0), a1 * y1 / (t + a1 * a1), a2 * y2 / (t + a2 * a2)
+        f = q0 * q0 + q1 * q1 + q2 * q2 - 1.0
+        df = -2.0 * (q0 * q0 / (t + a0 * a0) + q1 * q1 / (t + a1 * a1) + q2 * q2 / (t + a2 * a2))
+        if not df < 0.0:
+            break
+        tn = t - f / df
+        if tn <= lo:
+            tn = 0.5 * (t + lo)
+        if abs(tn - t) <= 1e-13 * (abs(t) + a0 * a0):
+            t = tn
+            break
+        t = tn
+    return a0 * a0 * y0 / (t + a0 * a0), a1 * a1 * y1 / (t + a1 * a1), a2 * a2 * y2 / (t + a2 * a2)
+
+
+@kernel(_nrt=False)
+def _cylinder_closest(r, h, y0, y1, y2):
+    """Closest point of the cylinder's surface (radius r, half length h, local z axis) to the local point y."""
+    rho = np.sqrt(y0 * y0 + y1 * y1)
+    c, s = (y0 / rho, y1 / rho) if rho > 0.0 else (1.0, 0.0)
+    if abs(y2) <= h and rho <= r:   # inside: the nearer of the side and the end
+        if r - rho < h - abs(y2):
+            return r * c, r * s, y2
+        return y0, y1, h if y2 >= 0.0 else -h
+    return min(rho, r) * c, min(rho, r) * s, min(max(y2, -h), h)
+
+
+@kernel(_nrt=False)
+def _signed_distance(kind, P, p, x0, x1, x2):
+    """(signed distance [m] of the ground point x to a cylinder or an ellipsoid, < 0 inside; the unit
+    normal of the surface there, outward, ground; the closest surface point)."""
+    y0, y1, y2 = dir_local(P, x0 - P[0], x1 - P[1], x2 - P[2])
+    if kind == CYLINDER:
+        c0, c1, c2 = _cylinder_closest(p[0], p[1], y0, y1, y2)
+        inside = abs(y2) <= p[1] and y0 * y0 + y1 * y1 <= p[0] * p[0]
+    else:
+        c0, c1, c2 = _ellipsoid_closest(p[0], p[1], p[2], y0, y1, y2)
+        inside = (y0 / p[0]) ** 2 + (y1 / p[1]) ** 2 + (y2 / p[2]) ** 2 < 1.0
+    d0, d1, d2 = y0 - c0, y1 - c1, y2 - c2
+    L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+    g0, g1, g2 = to_ground(P, c0, c1, c2)
+    if L > 0.0:
+        s = -1.0 / L if inside else 1.0 / L
+        n0, n1, n2 = dir_ground(P, d0 * s, d1 * s, d2 * s)
+    else:
+        n0, n1, n2 = dir_ground(P, 0.0, 0.0, 1.0)
+    return (-L if inside else L), n0, n1, n2, g0, g1, g2
+
+
+@kernel(_nrt=False)
+def rounded_penetration(kind_r, Pr, pr, kind_s, Ps, ps):
+    """(depth [m], unit normal from the solid shape s (a cylinder or an ellipsoid) towards the rounded one
+    r (a sphere or capsule: a point or a segment swept by its radius), the point midway in the overlap):
+    the radius less the distance of the core from s, the segment's nearest point found by golden-section
+    search (the distance to a convex solid is convex along a segment)."""
+    h = pr[1] if kind_r == CAPSULE else 0.0
+    a0, a1, a2 = to_ground(Pr, 0.0, 0.0, -h)
+    b0, b1, b2 = to_ground(Pr, 0.0, 0.0, h)
+    t = 0.0
+    if h > 0.0:
+        lo, hi = 0.0, 1.0
+        g = 0.6180339887498949
+        u, v = hi - g * (hi - lo), lo + g * (hi - lo)
+        fu = _signed_distance(kind_s, Ps, ps, a0 + u * (b0 - a0), a1 + u * (b1 - a1), a2 + u * (b2 - a2))[0]
+        fv = _signed_distance(kind_s, Ps, ps, a0 + v * (b0 - a0), a1 + v * (b1 - a1), a2 + v * (b2 - a2))[0]
+        for _ in range(60):
+            if fu < fv:
+                hi, v, fv = v, u, fu
+                u = hi - g * (hi - lo)
+                fu = _signed_distance(kind_s, Ps, ps, a0 + u * (b0 - a0), a1 + u * (b1 - a1), a2 + u * (b2 - a2))[0]
+            else:
+                lo, u, fu = u, v, fv
+                v = lo + g * (hi - lo)
+                fv = _signed_distance(kind_s, Ps, ps, a0 + v * (b0 - a0), a1 + v * (b1 - a1), a2 + v * (b2 - a2))[0]
+        t = 0.5 * (lo + hi)
+    dist, n0, n1, n2, g0, g1, g2 = _signed_distance(kind_s, Ps, ps, a0 + t * (b0 - a0), a1 + t * (b1 - a1),
+                                                    a2 + t * (b2 - a2))
+    depth = pr[0] - dist
+    if not depth > 0.0:
+        return 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0
+    hd = 0.5 * depth
+    return depth, n0, n1, n2, g0 - hd * n0, g1 - hd * n1, g2 - hd * n2
