@@ -139,7 +139,7 @@ def pack_contacts(sys, elems) -> tuple:
             np.zeros((_EPA_EDGES, 2), np.int64),
             np.concatenate(nodes).reshape(-1, 6) if nodes else np.zeros((0, 6)),
             np.concatenate(links).reshape(-1, 4) if links else np.zeros((0, 4), np.int64),
-            np.zeros((ncand * NSLOT, 8)), np.zeros(_STACK, np.int64))
+            np.zeros((ncand * NSLOT, 9)), np.zeros(_STACK, np.int64))
 
 
 def empty_contacts() -> tuple:
@@ -149,4 +149,4 @@ def empty_contacts() -> tuple:
     return (z(0, i), z(0, i), z((0, 3)), z((0, 3, 3)), z((0, 3)), z(0), z((0, 2), i), z((0, 3)), z((0, 2), i),
             z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
             z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
-            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 8)), z(0, i))
+            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i))

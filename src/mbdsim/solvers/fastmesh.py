@@ -12,11 +12,13 @@ axes; an explicit stack, sc[30]) and, per triangle met (its outward normal m by 
   vertices, cylinder rim points, the ellipsoid's deepest point) that lie below it (by less than the
   shape's bounding radius) and whose foot lies on the triangle, with normal m.
 
-The points of one candidate met through several triangles are reduced to the deepest per normal direction
-(normals within COS_SAME of each other count as one: a point over a shared edge of a flat or gently
-curved mesh is not counted twice), up to NSLOT directions per candidate (a sphere in a groove touches
-both walks).  They are left in the slot rows of sc[29] (used, depth [m], point [m], normal m), which
-solvers.fastcontact applies.
+The points of one candidate met through several triangles are merged per normal direction (normals within
+COS_SAME of the slot's mean count as one: a point over a shared edge of a flat or gently curved mesh is
+not counted twice), up to NSLOT directions per candidate (a sphere in a groove touches both walls): the
+largest depth, and the point and normal averaged with the weights depth^2, so that the contact moves
+continuously from one triangle to the next (a ball rolling over the facets of a bowl feels no jumps of
+the normal).  They are left in the slot rows of sc[29] (used, depth [m], point [m], normal m, weight),
+which solvers.fastcontact applies.
 """
 from __future__ import annotations
 
@@ -88,13 +90,19 @@ def _on_triangle(y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, tol):
 
 @kernel(_nrt=False)
 def _keep(S, k, depth, x0, x1, x2, n0, n1, n2):
-    """Keep the point in candidate k's slots: the deepest per normal direction (module docstring)."""
+    """Add the point to candidate k's slots: to the slot whose mean normal is within COS_SAME of n, else
+    to a free slot (else over the shallowest, if deeper).  A slot keeps the largest depth and the depth^2
+    weighted sums of points and normals (module docstring)."""
     free, low, lowd = -1, -1, np.inf
+    wgt = depth * depth
     for s in range(k * NSLOT, (k + 1) * NSLOT):
         if S[s, 0] > 0.0:
-            if n0 * S[s, 5] + n1 * S[s, 6] + n2 * S[s, 7] > COS_SAME:
-                if depth > S[s, 1]:
-                    S[s, 1], S[s, 2], S[s, 3], S[s, 4], S[s, 5], S[s, 6], S[s, 7] = depth, x0, x1, x2, n0, n1, n2
+            L = np.sqrt(S[s, 5] * S[s, 5] + S[s, 6] * S[s, 6] + S[s, 7] * S[s, 7])
+            if n0 * S[s, 5] + n1 * S[s, 6] + n2 * S[s, 7] > COS_SAME * L:
+                S[s, 1] = max(S[s, 1], depth)
+                S[s, 2], S[s, 3], S[s, 4] = S[s, 2] + wgt * x0, S[s, 3] + wgt * x1, S[s, 4] + wgt * x2
+                S[s, 5], S[s, 6], S[s, 7] = S[s, 5] + wgt * n0, S[s, 6] + wgt * n1, S[s, 7] + wgt * n2
+                S[s, 8] += wgt
                 return
             if S[s, 1] < lowd:
                 low, lowd = s, S[s, 1]
@@ -102,8 +110,8 @@ def _keep(S, k, depth, x0, x1, x2, n0, n1, n2):
             free = s
     s = free if free >= 0 else (low if depth > lowd else -1)
     if s >= 0:
-        S[s, 0], S[s, 1], S[s, 2], S[s, 3], S[s, 4] = 1.0, depth, x0, x1, x2
-        S[s, 5], S[s, 6], S[s, 7] = n0, n1, n2
+        S[s, 0], S[s, 1], S[s, 2], S[s, 3], S[s, 4] = 1.0, depth, wgt * x0, wgt * x1, wgt * x2
+        S[s, 5], S[s, 6], S[s, 7], S[s, 8] = wgt * n0, wgt * n1, wgt * n2, wgt
 
 
 @kernel(_nrt=False)
@@ -125,8 +133,9 @@ def _triangle(sc, x, Px, Pm, t, S):
         for k in range(2 if kd == CAPSULE else 1):
             z = 0.0 if kd == SPHERE else (p[1] if k == 0 else -p[1])
             e0, e1, e2 = to_ground(Px, 0.0, 0.0, z)
-            if m0 * (e0 - a0) + m1 * (e1 - a1) + m2 * (e2 - a2) <= 0.0:
-                continue   # the centre behind the triangle
+            hgt = m0 * (e0 - a0) + m1 * (e1 - a1) + m2 * (e2 - a2)
+            if hgt <= 0.0 or hgt >= p[0]:
+                continue   # the centre behind the triangle, or clear of its plane
             q0, q1, q2 = closest_on_triangle(e0, e1, e2, a0, a1, a2, b0, b1, b2, c0, c1, c2)
             d0, d1, d2 = e0 - q0, e1 - q1, e2 - q2
             dist = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
@@ -184,4 +193,11 @@ def mesh_points(sc, x, msh, Px, Pm):
             stack[top] = links[nd, 0]
             stack[top + 1] = links[nd, 1]
             top += 2
+    for s in range(nrow):   # the weighted means: a contact that moves continuously over the triangles
+        if S[s, 0] > 0.0 and S[s, 8] > 0.0:
+            L = np.sqrt(S[s, 5] * S[s, 5] + S[s, 6] * S[s, 6] + S[s, 7] * S[s, 7])
+            S[s, 2], S[s, 3], S[s, 4] = S[s, 2] / S[s, 8], S[s, 3] / S[s, 8], S[s, 4] / S[s, 8]
+            S[s, 5], S[s, 6], S[s, 7] = S[s, 5] / L, S[s, 6] / L, S[s, 7] / L
+        else:
+            S[s, 0] = 0.0
     return nrow
