@@ -51,7 +51,7 @@ def test_box_dropped_tilted_on_a_mesh_floor_comes_to_rest_flat():
     floor = m.ground.add_shape("floor", mb.Mesh(v, f))
     m.add_contact("c", floor, b.add_shape("geo", mb.Box((a, a, a))), k, e, 400.0, 1e-5, mu=0.5,
                   friction_velocity=1e-3)
-    res = mb.simulate(m, 1.5, 0.01, method="dop853", rtol=1e-6)
+    res = mb.simulate(m, 1.5, 0.01, method="dop853", rtol=1e-6, monitor=False)   # (contact dissipates)
     assert res.success
     assert abs(res.position("box")[-1, 2] - (a / 2 - d)) < 2e-2 * d
     Rf = res.orientation("box")[-1]
@@ -63,7 +63,7 @@ def test_ball_rolls_in_a_mesh_bowl_at_the_closed_form_period():
     mesh, the reference side): small oscillations at omega^2 = 5 g / (7 (R - r + delta)), delta the
     contact penetration."""
     R, r, rho, k, e = 0.5, 0.05, 1000.0, 1e6, 1.5
-    L, n = 0.08, 24
+    L, n = 0.08, 48   # facets of 3.3 mm: the period converges with the facet size (1.9% at 6.7 mm)
     v, f = grid_surface(-L, -L, n, 2 * L / n, lambda x, y: R - np.sqrt(R * R - x * x - y * y))
     ball = mb.Sphere(radius=r)
     mass = ball.mass_properties(rho)[0]
