@@ -97,7 +97,8 @@ def test_epa_depth_and_normal_against_closed_forms(case):
     dz = 2e-4
     geo_a, geo_b, top = {"ellipsoid on cylinder": (mb.Cylinder(0.05, 0.3, axis="x"), mb.Ellipsoid((0.06, 0.05, 0.03)),
                                                    0.05 + 0.03),
-                         "crossed cylinders": (mb.Cylinder(0.04, 0.3, axis="x"), mb.Cylinder(0.03, 0.2, axis="y"), 0.07),
+                         "crossed cylinders": (mb.Cylinder(0.04, 0.3, axis="x"), mb.Cylinder(0.03, 0.2, axis="y"),
+                                               0.07),
                          "ellipsoid on ellipsoid": (mb.Ellipsoid((0.2, 0.1, 0.05)), mb.Ellipsoid((0.06, 0.05, 0.03)),
                                                     0.08)}[case]
     m = mb.Model()
@@ -112,8 +113,8 @@ def test_epa_depth_and_normal_against_closed_forms(case):
     depth, n0, n1, n2, *pt = penetration(sc, 0, 1, P[0], P[1], 1e-10 * (sc[5][0] + sc[5][1]))
     assert abs(depth - dz) < 1e-9 * (sc[5][0] + sc[5][1]), (depth, dz)
     assert abs(n2 - 1.0) < 1e-8 and abs(n0) < 1e-4 and abs(n1) < 1e-4
-    assert abs(pt[2] - (top - 0.5 * dz - (top - (0.05 if case == "ellipsoid on cylinder" else
-                                                 (0.04 if case == "crossed cylinders" else 0.05))))) < 1e-6
+    top_a = {"ellipsoid on cylinder": 0.05, "crossed cylinders": 0.04, "ellipsoid on ellipsoid": 0.05}[case]
+    assert abs(pt[2] - (top_a - 0.5 * dz)) < 1e-6   # midway in the overlap
 
 
 def _narrow_count(m, elem):
