@@ -65,13 +65,29 @@ def _local(shape):
     return PLANE, shape.s_B, axis_frame(shape.n_B), (0.0, 0.0, 0.0), None, None, np.inf
 
 
+# sizes of the narrow phase's scratch arrays (solvers.fastgjk, solvers.fastmesh)
+_EPA_FACES, _EPA_EDGES, _STACK = 3000, 128, 128
+
+
 def pack_contacts(sys, elems) -> tuple:
     """The packed tuple `sc` of fastcontact.shape_contacts for the ShapeContact elements `elems`:
-    (frame (ns,), kind (ns,), c (ns, 3), R (ns, 3, 3), params (ns, 3), bounding radius (ns,),
-    vertex ranges (ns, 2), vertices (nv, 3), plane ranges (ns, 2), planes (npl, 4), pairs (np, 2),
-    pair parameters (np, 11: fastcontact.PAR_FIELDS))."""
+    (0) frame (ns,), (1) kind (ns,), (2) c (ns, 3), (3) R (ns, 3, 3), (4) params (ns, 3), (5) bounding
+    radius (ns,), (6) vertex ranges (ns, 2), (7) vertices (nv, 3), (8) plane ranges (ns, 2), (9) planes
+    (npl, 4), (10) pairs (np, 2), (11) pair parameters (np, 11: fastcontact.PAR_FIELDS), (12) an empty
+    record buffer (0, NREC) and (13) its counter (1,) (the step loop's), (14) local bounding boxes of hulls
+    and meshes (ns, 6: centre, half extents [m]), (15, 16) each shape's partners: row ranges (ns + 1,) into
+    (other shape, pair) rows sorted by the other shape, (17) poses (ns, 12), (18) ground bounding boxes
+    (ns, 6), (19) sweep order per axis (3, ns), (20) broad-phase counters (4,) (solvers.fastbroad),
+    (21) per shape: triangle range and node range of its mesh (ns, 4), (22) triangles (nt, 3: rows of (7)),
+    (23-26) EPA scratch (solvers.fastgjk), (27) hierarchy node boxes (nn, 6), (28) node links (nn, 4)
+    (geometry.bvh), (29) mesh contact slots (solvers.fastmesh), (30) the hierarchy walk's stack."""
+    from ..solvers.fastcontact import NREC
+    from ..solvers.fastgjk import MAX_ITER
+    from ..solvers.fastmesh import NSLOT
+    from .bvh import build
     index, rows, verts, planes, pairs, par = {}, [], [], [], [], []
-    nv = npl = 0
+    lbox, meta, tris, nodes, links = [], [], [], [], []
+    nv = npl = nt = nn = 0
     for ei, e in enumerate(elems):
         for a, b in e.pairs:
             ids = []
@@ -82,6 +98,22 @@ def pack_contacts(sys, elems) -> tuple:
                     pl = np.zeros((0, 4)) if pl is None else np.asarray(pl, float)
                     index[id(s)] = len(rows)
                     rows.append((sys.fid[s.body], kind, c, R, p, rad, (nv, nv + len(v)), (npl, npl + len(pl))))
+                    lo, hi = (v.min(axis=0), v.max(axis=0)) if len(v) else (np.zeros(3), np.zeros(3))
+                    lbox.append(np.concatenate([0.5 * (lo + hi), 0.5 * (hi - lo)]))
+                    m = (nt, nt, nn, nn)
+                    if kind == MESH:
+                        f = np.asarray(s.geometry.faces, np.int64)
+                        order, nb, nl = build(v, f)
+                        tris.append(f[order] + nv)
+                        nodes.append(nb)
+                        nl = nl.copy()
+                        inner = nl[:, 0] >= 0
+                        nl[inner, :2] += nn
+                        nl[~inner, 2] += nt
+                        links.append(nl)
+                        m = (nt, nt + len(f), nn, nn + len(nb))
+                        nt, nn = nt + len(f), nn + len(nb)
+                    meta.append(m)
                     verts.append(v)
                     planes.append(pl)
                     nv, npl = nv + len(v), npl + len(pl)
@@ -90,15 +122,31 @@ def pack_contacts(sys, elems) -> tuple:
             par.append(e.parameters() + (float(ei),))
     ns, n = len(rows), len(pairs)
     col = lambda k, dt=float: np.array([r[k] for r in rows], dtype=dt)  # noqa: E731
+    adj = sorted([(i, j, p) for p, (i, j) in enumerate(pairs)] + [(j, i, p) for p, (i, j) in enumerate(pairs)])
+    ptr = np.searchsorted(np.array([x[0] for x in adj], np.int64), np.arange(ns + 1)).astype(np.int64)
+    ncand = max([8] + [r[6][1] - r[6][0] for r in rows if r[1] == HULL])
     return (col(0, np.int64).reshape(ns), col(1, np.int64).reshape(ns), col(2).reshape(ns, 3),
             col(3).reshape(ns, 3, 3), col(4).reshape(ns, 3), col(5).reshape(ns), col(6, np.int64).reshape(ns, 2),
             np.concatenate(verts).reshape(-1, 3) if verts else np.zeros((0, 3)),
             col(7, np.int64).reshape(ns, 2), np.concatenate(planes).reshape(-1, 4) if planes else np.zeros((0, 4)),
-            np.array(pairs, np.int64).reshape(n, 2), np.array(par, float).reshape(n, 11))
+            np.array(pairs, np.int64).reshape(n, 2), np.array(par, float).reshape(n, 11),
+            np.zeros((0, NREC)), np.zeros(1, np.int64), np.array(lbox, float).reshape(ns, 6), ptr,
+            np.array([x[1:] for x in adj], np.int64).reshape(-1, 2), np.zeros((ns, 12)), np.zeros((ns, 6)),
+            np.tile(np.arange(ns, dtype=np.int64), (3, 1)), np.zeros(4, np.int64),
+            np.array(meta, np.int64).reshape(ns, 4),
+            np.concatenate(tris).reshape(-1, 3) if tris else np.zeros((0, 3), np.int64),
+            np.zeros((MAX_ITER + 8, 6)), np.zeros((_EPA_FACES, 3), np.int64), np.zeros((_EPA_FACES, 5)),
+            np.zeros((_EPA_EDGES, 2), np.int64),
+            np.concatenate(nodes).reshape(-1, 6) if nodes else np.zeros((0, 6)),
+            np.concatenate(links).reshape(-1, 4) if links else np.zeros((0, 4), np.int64),
+            np.zeros((ncand * NSLOT, 9)), np.zeros(_STACK, np.int64))
 
 
 def empty_contacts() -> tuple:
-    """The packed tuple of a model without shape contact."""
-    z = np.zeros
-    return (z(0, np.int64), z(0, np.int64), z((0, 3)), z((0, 3, 3)), z((0, 3)), z(0), z((0, 2), np.int64),
-            z((0, 3)), z((0, 2), np.int64), z((0, 4)), z((0, 2), np.int64), z((0, 11)))
+    """The packed tuple of a model without shape contact (the same types, no shapes)."""
+    from ..solvers.fastcontact import NREC
+    z, i = np.zeros, np.int64
+    return (z(0, i), z(0, i), z((0, 3)), z((0, 3, 3)), z((0, 3)), z(0), z((0, 2), i), z((0, 3)), z((0, 2), i),
+            z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
+            z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
+            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i))

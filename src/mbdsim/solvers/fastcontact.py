@@ -6,13 +6,20 @@ about the CM in body axes, from the frames r, A, rd, w (w in ground axes).  With
 rows it also records each contact point (see REC_FIELDS; nrec[0] counts them); the step loop passes an
 empty rec.
 
-Broad phase: bounding spheres (a plane: the signed distance of the other shape's bounding sphere), so a
-pair far apart costs a few flops.  Narrow phase (solvers.fastnarrow): against a plane, the candidate points
-of the shape; spheres and capsules by the closest points of their segments; against a box or convex hull,
-the separating-axis test over the polyhedra's face normals picks the reference face of least penetration,
-whose normal is the contact normal of every point: the incident shape's candidate points below it and
-inside the reference (vertices, rim points, ...) and, between two polyhedra, the reference's vertices
-inside the incident one.  Face and line contacts so get several points and the right moments.
+Broad phase (solvers.fastbroad): sweep and prune on the shapes' ground bounding boxes, so that only
+pairs whose boxes overlap reach the narrow phase (cost: shapes plus overlaps, not pairs).  Narrow phase
+per pair (solvers.fastnarrow): against a plane, the candidate points of the shape; spheres and capsules by
+the closest points of their segments; against a box or convex hull, the separating-axis test over the
+polyhedra's face normals picks the reference face of least penetration, whose normal is the contact normal
+of every point: the incident shape's candidate points below it and inside the reference (vertices, rim
+points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
+line contacts get several points and the right moments; a convex shape against a triangle mesh through
+its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
+vertices on the polyhedron's faces instead); the other convex pairs (cylinders and ellipsoids against
+curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
+of its point or segment from the solid (closed forms and a monotone Newton iteration: smooth in the
+state), the others (cylinders and ellipsoids among themselves) by GJK and EPA over support functions, one
+point midway between the witness points.
 
 Law at each point (depth delta > 0 [m], normal n from shape_i towards shape_j, gap rate gd = n . v_rel):
 IMPACT  Fn = max(0, k delta^e - STEP(delta, 0, 0, d, c_max) gd), or with a coefficient of restitution eps
@@ -29,8 +36,11 @@ from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
-from .fastnarrow import (BOX, CAPSULE, HULL, PLANE, SPHERE, candidate, dir_local, face, inside_except, n_candidates,
-                         pose, segments_closest, support_depth, to_ground, to_local)
+from .fastbroad import boxes, partner, sort_order, sweep_axis
+from .fastgjk import penetration, rounded_penetration
+from .fastmesh import mesh_points
+from .fastnarrow import (BOX, CAPSULE, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
+                         n_candidates, segments_closest, support_depth, to_ground, to_local)
 
 RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
 NREC = 15
@@ -142,6 +152,9 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
                 best, ref, gbest = D, rs, g
             if not D > 0.0:
                 return   # a separating face: no contact
+    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, r, A, rd, w, rigid, F, rec,
+                                                        nrec):
+        return   # separated along an edge-edge axis, or an edge-edge contact
     rs, xs = (b, a) if ref == b else (a, b)
     Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
     sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
@@ -163,6 +176,55 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
         h = 0.5 * d
         _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
                sign * m0, sign * m1, sign * m2, d)
+
+
+@kernel(_nrt=False)
+def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, nrec):
+    """Edge-edge axes of two boxes (the cross products of their edge directions): True when one separates
+    them, or when one penetrates clearly less than the best face (below 0.95 of it; faces are preferred
+    for resting contact) and the contact at the closest points of the two supporting edges is applied."""
+    prm = sc[4]
+    ha, hb = prm[a], prm[b]
+    c0, c1, c2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
+    best, bi, bj, L0, L1, L2 = 0.95 * face_depth, -1, -1, 0.0, 0.0, 0.0
+    for i in range(3):
+        for j in range(3):
+            x0, x1, x2 = _cross(Pa[3 + i], Pa[6 + i], Pa[9 + i], Pb[3 + j], Pb[6 + j], Pb[9 + j])
+            nrm = np.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+            if nrm < 1e-6:
+                continue   # parallel edges: the face axes cover them
+            x0, x1, x2 = x0 / nrm, x1 / nrm, x2 / nrm
+            s = x0 * c0 + x1 * c1 + x2 * c2
+            if s < 0.0:
+                x0, x1, x2, s = -x0, -x1, -x2, -s
+            ext = 0.0
+            for k in range(3):
+                ext += abs(x0 * Pa[3 + k] + x1 * Pa[6 + k] + x2 * Pa[9 + k]) * ha[k]
+                ext += abs(x0 * Pb[3 + k] + x1 * Pb[6 + k] + x2 * Pb[9 + k]) * hb[k]
+            D = ext - s
+            if not D > 0.0:
+                return True
+            if D < best:
+                best, bi, bj, L0, L1, L2 = D, i, j, x0, x1, x2
+    if bi < 0:
+        return False
+    # a's edge along axis bi farthest along L, b's edge along axis bj farthest along -L
+    p0, p1, p2 = Pa[0], Pa[1], Pa[2]
+    q0, q1, q2 = Pb[0], Pb[1], Pb[2]
+    for k in range(3):
+        if k != bi:
+            s = ha[k] if L0 * Pa[3 + k] + L1 * Pa[6 + k] + L2 * Pa[9 + k] > 0.0 else -ha[k]
+            p0, p1, p2 = p0 + s * Pa[3 + k], p1 + s * Pa[6 + k], p2 + s * Pa[9 + k]
+        if k != bj:
+            s = -hb[k] if L0 * Pb[3 + k] + L1 * Pb[6 + k] + L2 * Pb[9 + k] > 0.0 else hb[k]
+            q0, q1, q2 = q0 + s * Pb[3 + k], q1 + s * Pb[6 + k], q2 + s * Pb[9 + k]
+    ea0, ea1, ea2 = ha[bi] * Pa[3 + bi], ha[bi] * Pa[6 + bi], ha[bi] * Pa[9 + bi]
+    eb0, eb1, eb2 = hb[bj] * Pb[3 + bj], hb[bj] * Pb[6 + bj], hb[bj] * Pb[9 + bj]
+    X, Y = segments_closest(p0 - ea0, p1 - ea1, p2 - ea2, p0 + ea0, p1 + ea1, p2 + ea2,
+                            q0 - eb0, q1 - eb1, q2 - eb2, q0 + eb0, q1 + eb1, q2 + eb2)
+    _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, 0.5 * (X[0] + Y[0]), 0.5 * (X[1] + Y[1]),
+           0.5 * (X[2] + Y[2]), L0, L1, L2, best)
+    return True
 
 
 @kernel(_nrt=False)
@@ -224,26 +286,86 @@ def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
 
 
 @kernel(_nrt=False)
+def _row(PS, s):
+    """Shape s's pose (the 12-tuple of fastnarrow.pose) from its row of sc[17]."""
+    return (PS[s, 0], PS[s, 1], PS[s, 2], PS[s, 3], PS[s, 4], PS[s, 5], PS[s, 6], PS[s, 7], PS[s, 8], PS[s, 9],
+            PS[s, 10], PS[s, 11])
+
+
+@kernel(_nrt=False)
+def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
+    """The narrow phase of one pair whose bounding boxes overlap (module docstring)."""
+    kind, rad, pr, PS = sc[1], sc[5], sc[10], sc[17]
+    a, b = pr[pair, 0], pr[pair, 1]
+    Pa, Pb = _row(PS, a), _row(PS, b)
+    ka, kb = kind[a], kind[b]
+    if ka == PLANE or kb == PLANE:
+        pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if ka == PLANE else (b, a, Pa, Pb, -1.0)
+        m0, m1, m2 = Q[5], Q[8], Q[11]   # the plane's local z
+        if m0 * (P[0] - Q[0]) + m1 * (P[1] - Q[1]) + m2 * (P[2] - Q[2]) > rad[x]:
+            return   # the bounding sphere clears the plane
+        _against(sc, pair, x, pl, -1, P, Q, Q[0], Q[1], Q[2], m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
+        _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    if ka == MESH or kb == MESH:
+        msh, x, Px, Pm, sign = (a, b, Pb, Pa, 1.0) if ka == MESH else (b, a, Pa, Pb, -1.0)
+        if (kind[x] == BOX or kind[x] == HULL) and rad[msh] <= rad[x]:
+            # a mesh no larger than the polyhedron: its vertices on the polyhedron's faces
+            _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+            return
+        S = sc[29]
+        for s in range(mesh_points(sc, x, msh, Px, Pm)):
+            if S[s, 0] > 0.0:
+                _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[s, 2], S[s, 3], S[s, 4],
+                       sign * S[s, 5], sign * S[s, 6], sign * S[s, 7], S[s, 1])
+        return
+    if ka == BOX or ka == HULL or kb == BOX or kb == HULL:
+        _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return
+    prm = sc[4]
+    if ka == SPHERE or ka == CAPSULE:   # a rounded shape on a cylinder or an ellipsoid: n from b to a
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(ka, Pa, prm[a], kb, Pb, prm[b])
+        n0, n1, n2 = -n0, -n1, -n2
+    elif kb == SPHERE or kb == CAPSULE:
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(kb, Pb, prm[b], ka, Pa, prm[a])
+    else:
+        depth, n0, n1, n2, p0, p1, p2 = penetration(sc, a, b, Pa, Pb, 1e-10 * (rad[a] + rad[b]))
+    if depth > 0.0:
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, depth)
+
+
+@kernel(_nrt=False)
 def shape_contacts(sc, r, A, rd, w, rigid, F, rec, nrec):
     """Contact loads of every packed shape pair into F (module docstring); records into rec while it has room."""
-    sh_f, kind, sh_c, sh_R, rad, pr = sc[0], sc[1], sc[2], sc[3], sc[5], sc[10]
-    for pair in range(pr.shape[0]):
-        a, b = pr[pair, 0], pr[pair, 1]
-        Pa = pose(r, A, sh_f[a], sh_c[a], sh_R[a])
-        Pb = pose(r, A, sh_f[b], sh_c[b], sh_R[b])
-        if kind[a] == PLANE or kind[b] == PLANE:
-            pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if kind[a] == PLANE else (b, a, Pa, Pb, -1.0)
-            m0, m1, m2 = Q[5], Q[8], Q[11]   # the plane's local z
-            if m0 * (P[0] - Q[0]) + m1 * (P[1] - Q[1]) + m2 * (P[2] - Q[2]) > rad[x]:
-                continue   # broad phase: the bounding sphere clears the plane
-            _against(sc, pair, x, pl, -1, P, Q, Q[0], Q[1], Q[2], m0, m1, m2, sign, r, A, rd, w, rigid, F, rec,
-                     nrec)
+    kind, ptr, adj, BB, order, stats = sc[1], sc[15], sc[16], sc[18], sc[19], sc[20]
+    if sc[10].shape[0] == 0:
+        return
+    boxes(sc, r, A)
+    ax = sweep_axis(BB)
+    sort_order(order, BB, ax)
+    k1, k2 = (ax + 1) % 3, (ax + 2) % 3
+    stats[0] = 0
+    stats[2] += 1
+    ns = kind.shape[0]
+    for ii in range(ns):
+        i = order[ax, ii]
+        if ptr[i + 1] == ptr[i]:
             continue
-        d0, d1, d2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
-        if d0 * d0 + d1 * d1 + d2 * d2 > (rad[a] + rad[b]) ** 2:
-            continue   # broad phase: bounding spheres apart
-        ka, kb = kind[a], kind[b]
-        if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
-            _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
-        else:
-            _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        hi = BB[i, 3 + ax]
+        for jj in range(ii + 1, ns):
+            j = order[ax, jj]
+            if BB[j, ax] > hi:
+                break
+            if BB[j, k1] > BB[i, 3 + k1] or BB[i, k1] > BB[j, 3 + k1] or BB[j, k2] > BB[i, 3 + k2] \
+                    or BB[i, k2] > BB[j, 3 + k2]:
+                continue
+            row = partner(ptr, adj, i, j)
+            if row < 0:
+                continue
+            while row < ptr[i + 1] and adj[row, 0] == j:
+                stats[0] += 1
+                stats[1] += 1
+                _narrow(sc, adj[row, 1], r, A, rd, w, rigid, F, rec, nrec)
+                row += 1

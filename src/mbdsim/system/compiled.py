@@ -194,13 +194,11 @@ def _contacts(sys) -> tuple:
 
 def _shape_contacts(sys, skip) -> tuple:
     """The model's shape contacts (model.contacts.ShapeContact, but those named in `skip`) for
-    `fastcontact.shape_contacts`: geometry.pack.pack_contacts plus an empty record buffer and its counter."""
+    `fastcontact.shape_contacts`: geometry.pack.pack_contacts (with its empty record buffer and counter)."""
     from ..geometry.pack import empty_contacts, pack_contacts
-    from ..solvers.fastcontact import NREC
     elems = [] if sys is None else [e for e in sys.model.forces.values()
                                     if type(e) is ShapeContact and e.name not in skip]
-    sc = pack_contacts(sys, elems) if elems else empty_contacts()
-    return (*sc, np.zeros((0, NREC)), np.zeros(1, np.int64))
+    return pack_contacts(sys, elems) if elems else empty_contacts()
 
 
 def _singular_masses(M6) -> bool:
