@@ -3,8 +3,8 @@ test suite's controller process (tests/conftest.py) use it, so that the cache is
 processes compiling different kernels side by side, instead of by every worker.
 
 PARTS: "dynamics" (the compiled step loop on a joint-coordinate tree and on a closed loop, with the output
-kernels: dense output, reactions, `Result.at`) and "kinematics" (the kinematic sweep, assembly, statics and
-the Python path's kernels: HHT). `python -m mbdsim._warmup PART...` runs the parts in this process; `warm()`
+kernels: dense output, reactions, `Result.at`), "kinematics" (the kinematic sweep, assembly, statics and
+the Python path's kernels: HHT) and "stepping" (the compiled Radau IIA and the Simulator's step loop). `python -m mbdsim._warmup PART...` runs the parts in this process; `warm()`
 runs each part in its own process, in parallel, and returns their wall times [s].
 """
 from __future__ import annotations
@@ -16,7 +16,7 @@ import sys
 import time
 import warnings
 
-PARTS = ("dynamics", "kinematics")
+PARTS = ("dynamics", "kinematics", "stepping")
 
 
 def _pendulum():
@@ -73,11 +73,21 @@ def kinematics() -> None:
     mb.equilibrium(model)
 
 
+def stepping() -> None:
+    """The compiled Radau IIA (method "radau", the stiff hand-over's stepper) and the Simulator's step loop."""
+    import mbdsim as mb
+    model = _pendulum()[0]
+    mb.simulate(model, end_time=0.05, output_step=0.01, method="radau")
+    sim = mb.Simulator(model)
+    sim.step(0.01)
+    sim.outputs()
+
+
 def run_parts(names) -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         for name in names:
-            {"dynamics": dynamics, "kinematics": kinematics}[name]()
+            {"dynamics": dynamics, "kinematics": kinematics, "stepping": stepping}[name]()
 
 
 def warm(parts=PARTS, quiet: bool = True) -> dict:
