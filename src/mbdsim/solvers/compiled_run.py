@@ -368,6 +368,11 @@ def residual_check(run, t_out, Y):
     return check
 
 
+# bytes of dense Jacobians that the minimum-norm multipliers of a model with redundant rows hold at once
+# (samples are taken in chunks within it; a model whose single sample exceeds it gets a clear error)
+MULTIPLIER_BYTES = 512 * 2 ** 20
+
+
 def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
@@ -377,6 +382,21 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`)."""
     if len(rows) == sys.nc or not len(times):
         return LAM
+    per_sample = 8 * sys.nc * sys.nv   # bytes of one sample's dense Jacobian
+    if per_sample > MULTIPLIER_BYTES:
+        names = sorted({sys.row_owner[r] for r in np.setdiff1d(np.arange(sys.nc), rows)})
+        raise MbdsimError(
+            f"the minimum-norm multipliers of the {sys.nc - len(rows)} redundant constraint rows (of "
+            f"{', '.join(names[:5])}{', ...' if len(names) > 5 else ''}) need "
+            f"a dense {sys.nc} x {sys.nv} Jacobian per sample ({per_sample / 1e9:.2g} GB, over the "
+            f"{MULTIPLIER_BYTES / 1e9:.2g} GB budget): remove the redundant rows (e.g. spherical or "
+            "universal joints instead of revolutes in a closed loop) to have reactions on a model this large; "
+            "positions, velocities and accelerations are not affected")
+    step = max(1, MULTIPLIER_BYTES // per_sample)
+    if len(times) > step:   # in chunks of samples, so that the Jacobians in memory stay within the budget
+        parts = [_full_multipliers(sys, rows, times[k:k + step], Y[k:k + step], None, LAM[k:k + step])
+                 for k in range(0, len(times), step)]
+        return np.concatenate(parts)
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows` unless re-selected
     rows = np.asarray(rows, dtype=np.int64)
     key = ("dependent rows", rows.tobytes())
