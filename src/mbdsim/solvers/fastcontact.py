@@ -15,7 +15,10 @@ of every point: the incident shape's candidate points below it and inside the re
 points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
 line contacts get several points and the right moments; a convex shape against a triangle mesh through
 its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
-vertices on the polyhedron's faces instead); the other convex pairs (cylinders and ellipsoids against
+vertices on the polyhedron's faces instead); two triangle meshes by the vertices of each against the
+other's triangles (`_mesh_pair`, a penalty approximation for finely tessellated meshes); two cylinders, or a
+capsule and a cylinder, with axes within LINE_SIN of parallel along their line (`_line_pair`: a point at
+each end of the overlap of the axes); the other convex pairs (cylinders and ellipsoids against
 curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
 of its point or segment from the solid (closed forms and a monotone Newton iteration: smooth in the
 state), the others (cylinders and ellipsoids among themselves) by GJK and EPA over support functions, one
