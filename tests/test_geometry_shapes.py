@@ -63,8 +63,9 @@ def test_bad_geometry_and_pairs_are_named_errors(tmp_path):
         b.add_shape("x", "box")
     cb = b.add_shape("cyl", mb.Cylinder(0.1, 0.2))
     tri = (np.vstack([np.eye(3), np.zeros((1, 3))]), [[0, 1, 2], [3, 1, 0]])
-    with pytest.raises(ModelError, match="contact 'k'.shape_j.*mesh-mesh"):
-        m.add_contact("k", b.add_shape("m", mb.Mesh(*tri)), c.add_shape("m", mb.Mesh(*tri)), 1e5, 1.5, 10, 1e-3)
+    with pytest.raises(ModelError, match="contact 'k'.shape_j.*plane-plane"):
+        m.add_contact("k", mb.Plane(b, (0, 0, 0), (0, 0, 1)), mb.Plane(c, (0, 0, 0), (0, 0, 1)), 1e5, 1.5, 10, 1e-3)
+    m.add_contact("mm", b.add_shape("m", mb.Mesh(*tri)), c.add_shape("m", mb.Mesh(*tri)), 1e5, 1.5, 10, 1e-3)
     with pytest.raises(ModelError, match="contact 'k'.transition_velocity"):
         m.add_contact("k", cb, c.add_shape("box", mb.Box((1, 1, 1))), 1e5, 1.5, 10, 1e-3, mu_static=0.5,
                       mu_dynamic=0.4, stiction_velocity=0.1, transition_velocity=0.01)

@@ -124,7 +124,9 @@ def pack_contacts(sys, elems) -> tuple:
     col = lambda k, dt=float: np.array([r[k] for r in rows], dtype=dt)  # noqa: E731
     adj = sorted([(i, j, p) for p, (i, j) in enumerate(pairs)] + [(j, i, p) for p, (i, j) in enumerate(pairs)])
     ptr = np.searchsorted(np.array([x[0] for x in adj], np.int64), np.arange(ns + 1)).astype(np.int64)
-    ncand = max([8] + [r[6][1] - r[6][0] for r in rows if r[1] == HULL])
+    mm = {i for i, j in pairs if rows[i][1] == MESH and rows[j][1] == MESH} | \
+        {j for i, j in pairs if rows[i][1] == MESH and rows[j][1] == MESH}   # meshes whose vertices push
+    ncand = max([8] + [r[6][1] - r[6][0] for k, r in enumerate(rows) if r[1] == HULL or k in mm])
     return (col(0, np.int64).reshape(ns), col(1, np.int64).reshape(ns), col(2).reshape(ns, 3),
             col(3).reshape(ns, 3, 3), col(4).reshape(ns, 3), col(5).reshape(ns), col(6, np.int64).reshape(ns, 2),
             np.concatenate(verts).reshape(-1, 3) if verts else np.zeros((0, 3)),

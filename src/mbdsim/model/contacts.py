@@ -73,9 +73,9 @@ def friction_options(entity, mu, friction_velocity, mu_static, mu_dynamic, stict
 
 def supported(kind_a: str, kind_b: str) -> bool:
     """Whether the narrow phase handles this pair of kinds (fastnarrow.KIND_NAMES): any pair of a plane
-    and another shape, any two convex shapes (closed forms, separating axes, GJK/EPA) and a convex shape
-    against a triangle mesh; not two planes or two triangle meshes."""
-    return not (kind_a == kind_b and kind_a in ("plane", "mesh"))
+    and another shape, any two convex shapes (closed forms, separating axes, GJK/EPA), a convex shape
+    against a triangle mesh and two triangle meshes (vertices against triangles); not two planes."""
+    return not (kind_a == kind_b == "plane")
 
 
 def shape_list(entity, field, value) -> list:
@@ -103,7 +103,7 @@ def make_pairs(entity, shapes_i, shapes_j) -> list:
             ka, kb = kind_of(a), kind_of(b)
             if not supported(ka, kb):
                 raise ModelError(entity, "shape_j", f"{ka}-{kb} contact is not supported (supported: any shape "
-                                 "against a plane, any two convex shapes, a convex shape against a triangle mesh)")
+                                 "against a plane, any two convex shapes, a convex shape or a triangle mesh against a triangle mesh)")
             pairs.append((a, b))
     if not pairs:
         raise ModelError(entity, "shape_j", "no pair of shapes on two different bodies")

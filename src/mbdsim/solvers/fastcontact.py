@@ -15,7 +15,10 @@ of every point: the incident shape's candidate points below it and inside the re
 points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
 line contacts get several points and the right moments; a convex shape against a triangle mesh through
 its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
-vertices on the polyhedron's faces instead); the other convex pairs (cylinders and ellipsoids against
+vertices on the polyhedron's faces instead); two triangle meshes by the vertices of each against the
+other's triangles (`_mesh_pair`, a penalty approximation for finely tessellated meshes); two cylinders, or a
+capsule and a cylinder, with axes within LINE_SIN of parallel along their line (`_line_pair`: a point at
+each end of the overlap of the axes); the other convex pairs (cylinders and ellipsoids against
 curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
 of its point or segment from the solid (closed forms and a monotone Newton iteration: smooth in the
 state), the others (cylinders and ellipsoids among themselves) by GJK and EPA over support functions, one
@@ -38,10 +41,11 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from ..system.exprloads_kernel import _cross, _force as _point_force
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
-from .fastmesh import mesh_points
-from .fastnarrow import (BOX, CAPSULE, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
+from .fastmesh import NSLOT, mesh_points
+from .fastnarrow import (BOX, CAPSULE, CYLINDER, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
                          n_candidates, segments_closest, support_depth, to_ground, to_local)
 
+LINE_SIN = 0.02   # sine of the largest angle between two axes that still touch along a line
 RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
 NREC = 15
 REC_FIELDS = ("pair", "x", "y", "z", "nx", "ny", "nz", "penetration", "normal_force", "friction_x",
@@ -293,6 +297,65 @@ def _row(PS, s):
 
 
 @kernel(_nrt=False)
+def _line_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+    """Two cylinders, or a capsule and a cylinder, whose axes are within LINE_SIN of parallel and whose
+    projections overlap: a line contact, one point at each end of the overlap of the two axes (clipped on
+    a's axis), each of depth r_a + r_b minus the distance of b's axis line from that point of a's axis, the
+    normal along that distance, the point midway in the overlap of the two surfaces.  False (no points
+    applied) when the axes are not parallel enough, the projections do not overlap or the axes cross
+    (then the caller's single point, GJK/EPA or the closed form)."""
+    prm = sc[4]
+    u0, u1, u2 = Pa[5], Pa[8], Pa[11]
+    v0, v1, v2 = Pb[5], Pb[8], Pb[11]
+    c = u0 * v0 + u1 * v1 + u2 * v2
+    x0, x1, x2 = u1 * v2 - u2 * v1, u2 * v0 - u0 * v2, u0 * v1 - u1 * v0
+    if x0 * x0 + x1 * x1 + x2 * x2 > LINE_SIN * LINE_SIN:
+        return False
+    ra, ha, rb, hb = prm[a, 0], prm[a, 1], prm[b, 0], prm[b, 1]
+    tb = (Pb[0] - Pa[0]) * u0 + (Pb[1] - Pa[1]) * u1 + (Pb[2] - Pa[2]) * u2
+    lo, hi = max(-ha, tb - abs(c) * hb), min(ha, tb + abs(c) * hb)
+    if not lo < hi:
+        return False
+    y0, y1, y2 = Pa[0] + lo * u0, Pa[1] + lo * u1, Pa[2] + lo * u2
+    z0, z1, z2 = Pa[0] + hi * u0, Pa[1] + hi * u1, Pa[2] + hi * u2
+    s = (y0 - Pb[0]) * v0 + (y1 - Pb[1]) * v1 + (y2 - Pb[2]) * v2
+    d0, d1, d2 = Pb[0] + s * v0 - y0, Pb[1] + s * v1 - y1, Pb[2] + s * v2 - y2
+    s = (z0 - Pb[0]) * v0 + (z1 - Pb[1]) * v1 + (z2 - Pb[2]) * v2
+    e0, e1, e2 = Pb[0] + s * v0 - z0, Pb[1] + s * v1 - z1, Pb[2] + s * v2 - z2
+    Ly, Lz = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2), np.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+    if not (Ly > 1e-6 * (ra + rb) and Lz > 1e-6 * (ra + rb)):
+        return False   # the axes (nearly) cross: no line contact
+    if ra + rb - Ly > 0.0:
+        h = 0.5 * (ra - rb + Ly) / Ly
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, y0 + h * d0, y1 + h * d1, y2 + h * d2,
+               d0 / Ly, d1 / Ly, d2 / Ly, ra + rb - Ly)
+    if ra + rb - Lz > 0.0:
+        h = 0.5 * (ra - rb + Lz) / Lz
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, z0 + h * e0, z1 + h * e1, z2 + h * e2,
+               e0 / Lz, e1 / Lz, e2 / Lz, ra + rb - Lz)
+    return True
+
+
+@kernel(_nrt=False)
+def _mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+    """Two triangle meshes (a penalty approximation for finely tessellated meshes): the vertices of each
+    below the other's triangles (fastmesh.mesh_points, depth capped at a skin), per vertex the direction
+    of least depth (the nearest face of a closed mesh), each a point of the contact law."""
+    S = sc[29]
+    for side in range(2):
+        x, msh, Px, Pm, sign = (b, a, Pb, Pa, 1.0) if side == 0 else (a, b, Pa, Pb, -1.0)
+        nrow = mesh_points(sc, x, msh, Px, Pm)
+        for k in range(nrow // NSLOT):
+            best, bd = -1, np.inf
+            for s in range(k * NSLOT, (k + 1) * NSLOT):
+                if S[s, 0] > 0.0 and S[s, 1] < bd:
+                    best, bd = s, S[s, 1]
+            if best >= 0:
+                _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[best, 2], S[best, 3], S[best, 4],
+                       sign * S[best, 5], sign * S[best, 6], sign * S[best, 7], S[best, 1])
+
+
+@kernel(_nrt=False)
 def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     """The narrow phase of one pair whose bounding boxes overlap (module docstring)."""
     kind, rad, pr, PS = sc[1], sc[5], sc[10], sc[17]
@@ -309,6 +372,9 @@ def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     if (ka == SPHERE or ka == CAPSULE) and (kb == SPHERE or kb == CAPSULE):
         _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
         return
+    if ka == MESH and kb == MESH:
+        _mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return
     if ka == MESH or kb == MESH:
         msh, x, Px, Pm, sign = (a, b, Pb, Pa, 1.0) if ka == MESH else (b, a, Pa, Pb, -1.0)
         if (kind[x] == BOX or kind[x] == HULL) and rad[msh] <= rad[x]:
@@ -324,6 +390,9 @@ def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     if ka == BOX or ka == HULL or kb == BOX or kb == HULL:
         _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
         return
+    if (ka == CYLINDER and (kb == CYLINDER or kb == CAPSULE)) or (kb == CYLINDER and ka == CAPSULE):
+        if _line_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+            return
     prm = sc[4]
     if ka == SPHERE or ka == CAPSULE:   # a rounded shape on a cylinder or an ellipsoid: n from b to a
         depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(ka, Pa, prm[a], kb, Pb, prm[b])

@@ -19,6 +19,12 @@ largest depth, and the point and normal averaged with the weights depth^2, so th
 continuously from one triangle to the next (a ball rolling over the facets of a bowl feels no jumps of
 the normal).  They are left in the slot rows of sc[29] (used, depth [m], point [m], normal m, weight),
 which solvers.fastcontact applies.
+
+Two triangle meshes (a penalty approximation, fine for finely tessellated meshes): the vertices of each
+are the candidate points against the other's triangles, counted only when less than SKIN times the smaller
+of the two bounding radii below a triangle (a vertex outside a closed mesh is behind its far faces, but
+deeper than that); solvers.fastcontact keeps, per vertex, the direction of least depth (the nearest face).
+Edge-edge crossings of two coarse meshes are not seen: only vertices push.
 """
 from __future__ import annotations
 
@@ -26,10 +32,11 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import CAPSULE, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastnarrow import CAPSULE, MESH, SPHERE, candidate, dir_local, n_candidates, to_ground
 
 NSLOT = 4          # contact directions kept per candidate point
 COS_SAME = 0.95    # normals closer than this (cosine) are one direction
+SKIN = 0.5         # a mesh's vertex counts below another mesh's triangle to SKIN x the smaller bounding radius
 
 
 @kernel(_nrt=False)
@@ -115,8 +122,9 @@ def _keep(S, k, depth, x0, x1, x2, n0, n1, n2):
 
 
 @kernel(_nrt=False)
-def _triangle(sc, x, Px, Pm, t, S):
-    """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points into the slots S."""
+def _triangle(sc, x, Px, Pm, t, S, cap):
+    """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points no deeper than cap [m] into
+    the slots S."""
     kind, prm, sv, verts, rad, tri = sc[1], sc[4], sc[6], sc[7], sc[5], sc[22]
     a0, a1, a2 = to_ground(Pm, verts[tri[t, 0], 0], verts[tri[t, 0], 1], verts[tri[t, 0], 2])
     b0, b1, b2 = to_ground(Pm, verts[tri[t, 1], 0], verts[tri[t, 1], 1], verts[tri[t, 1], 2])
@@ -149,7 +157,7 @@ def _triangle(sc, x, Px, Pm, t, S):
     for k in range(n_candidates(kd, sv[x, 1] - sv[x, 0])):
         y0, y1, y2 = candidate(kd, Px, p, verts, sv[x, 0], m0, m1, m2, k)
         d = m0 * (a0 - y0) + m1 * (a1 - y1) + m2 * (a2 - y2)
-        if not (d > 0.0 and d < rad[x]):
+        if not (d > 0.0 and d < cap):
             continue
         if not _on_triangle(y0 + d * m0, y1 + d * m1, y2 + d * m2, a0, a1, a2, b0, b1, b2, c0, c1, c2, tol):
             continue
@@ -163,6 +171,7 @@ def mesh_points(sc, x, msh, Px, Pm):
     docstring); returns how many slot rows to read."""
     kind, sv, BB, meta, nodes, links, S, stack = sc[1], sc[6], sc[18], sc[21], sc[27], sc[28], sc[29], sc[30]
     kd = kind[x]
+    cap = sc[5][x] if kd != MESH else SKIN * min(sc[5][x], sc[5][msh])
     nc = 2 if kd == CAPSULE else (1 if kd == SPHERE else n_candidates(kd, sv[x, 1] - sv[x, 0]))
     nrow = min(nc * NSLOT, S.shape[0])
     for s in range(nrow):
@@ -188,7 +197,7 @@ def mesh_points(sc, x, msh, Px, Pm):
         if links[nd, 0] < 0:
             for t in range(links[nd, 2], links[nd, 2] + links[nd, 3]):
                 if nc * NSLOT <= S.shape[0]:
-                    _triangle(sc, x, Px, Pm, t, S)
+                    _triangle(sc, x, Px, Pm, t, S, cap)
         elif top + 2 <= stack.shape[0]:
             stack[top] = links[nd, 0]
             stack[top + 1] = links[nd, 1]
