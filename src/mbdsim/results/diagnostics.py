@@ -11,8 +11,10 @@ the value; `Result.diagnostics` keeps the history.
   (joint coordinates, or projected to 1e-12 with a failure status otherwise): its first and last sample
   are checked, both in one compiled call (Result.residual_check).
 - energy_error: (T + V + D - W) - (T + V + D - W)(t0) [J]: kinetic T, potential V (gravity and elastic
-  elements), dissipated D (damping, friction, contact: trapezoidal rule on the samples) and the work W of
-  applied forces and torques (trapezoidal rule of their power); tolerance ENERGY_TOL times the energy scale
+  elements), dissipated D (damping, friction, sphere and shape contacts: `Result.dissipated_energy`, the
+  dissipation power integrated on the run's dense output step by step, so that impacts and modes ringing
+  faster than the output step are counted) and the work W of applied forces and torques (trapezoidal
+  rule of their power); tolerance ENERGY_TOL times the energy scale
   (the largest of T, |V - V(t0)|, D, |W| over the run, 1e-6 |V| and 1e-12 J) plus a trapezoid allowance when
   D or W are present (ENERGY_TOL_QUADRATURE). Not checked for driven models (motions do work through
   their multipliers) or unknown element types: `energy_error` is then None with the reason in `notes`.
@@ -28,7 +30,7 @@ import numpy as np
 
 CONSTRAINT_TOL = 1e-6
 ENERGY_TOL = 1e-4
-ENERGY_TOL_QUADRATURE = 0.1   # trapezoidal D and W on the samples: only gross imbalances
+ENERGY_TOL_QUADRATURE = 0.1   # D (integrator error) and W (trapezoidal on the samples): gross imbalances
 PENETRATION_FRACTION = 0.5   # half the sphere inside its partner: the point-contact model no longer holds
 MAX_SAMPLES = 32   # constraint residuals are evaluated one sample at a time: a coarse, cheap check
 
@@ -100,7 +102,6 @@ def _energy_terms(res):
     from ..model.element_specs import Bushing
     from ..model.forces import Force, Torque
     from ..system.force_elements import evaluator
-    from .energy import dissipation_power
     sys = res.system
     if "HHT" in str(res.stats.get("method", "")):
         return None, "energy balance not checked: HHT dissipates high frequencies numerically by design"
@@ -118,7 +119,10 @@ def _energy_terms(res):
             return None, (f"energy balance not checked: bushing '{e.name}' has unequal rotational stiffnesses "
                           "(Adams' small-angle BUSHING torque -K a is not conservative for finite rotations)")
     T, V = res.kinetic_energy(), res.potential_energy()
-    P_d = dissipation_power(sys, res.frames, res.time) if any(
+    # the dissipated energy the Result reports: the dissipation power integrated on the run's own dense
+    # output (step-wise, to 1e-10), not the trapezoidal rule on the output samples, which misses the
+    # power of contact impacts and of modes ringing faster than the output step
+    D = res.dissipated_energy() if any(
         hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None
     P_w = None
     if applied:
@@ -134,7 +138,7 @@ def _energy_terms(res):
                     P_w[i] += float(evaluator(e).generalized(sys, f1, e, t, st) @ res.v[i])
         except Exception as exc:  # noqa: BLE001 - a user load failing here: monitor skipped, run unaffected
             return None, f"energy balance not checked: applied load failed ({type(exc).__name__})"
-    return (T, V, P_d, P_w), None
+    return (T, V, D, P_w), None
 
 
 def _trapz_cum(P, t, start=0.0):
@@ -163,9 +167,9 @@ def update(diag: Diagnostics, res, first: bool = True) -> Diagnostics:
         diag._carry["energy_off"] = True
         diag.energy_error = None
     else:
-        T, V, P_d, P_w = terms
+        T, V, D_run, P_w = terms
         c = diag._carry
-        D = _trapz_cum(P_d, t, c.get("D", 0.0))
+        D = None if D_run is None else c.get("D", 0.0) + D_run   # D_run starts at 0 at the chunk's first sample
         W = _trapz_cum(P_w, t, c.get("W", 0.0))
         bal = T + V + (0.0 if D is None else D) - (0.0 if W is None else W)
         c.setdefault("E0", float(bal[0]))
@@ -175,7 +179,7 @@ def update(diag: Diagnostics, res, first: bool = True) -> Diagnostics:
         scale = max(diag.energy_scale, float(np.max(T)), float(np.max(np.abs(V - c["V0"]))), abs(c["D"]),
                     abs(c["W"]), 1e-6 * float(np.max(np.abs(V))), 1e-12)   # round-off floor: 1e-10 |V|
         diag.energy_scale = scale
-        tol = (ENERGY_TOL_QUADRATURE if (P_d is not None or P_w is not None) else ENERGY_TOL) * scale
+        tol = (ENERGY_TOL_QUADRATURE if (D is not None or P_w is not None) else ENERGY_TOL) * scale
         diag.tolerances["energy_error"] = tol
         prev = diag.energy_error if diag.energy_error is not None else np.zeros(0)
         diag.energy_error = np.concatenate([prev, err[skip:]])
