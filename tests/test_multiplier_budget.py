@@ -1,8 +1,6 @@
 """Minimum-norm multipliers of redundant rows (reactions of a closed loop of revolutes) within a memory
 budget: samples in chunks give the same reactions, and a model whose single sample exceeds the budget gets
 a clear error naming the redundant rows' joints instead of a MemoryError (issue 35)."""
-import math
-
 import numpy as np
 import pytest
 
@@ -11,19 +9,9 @@ from mbdsim.solvers import compiled_run
 
 
 def _four_bar():
-    from scipy.spatial.transform import Rotation
-    z = lambda a: Rotation.from_rotvec((0.0, 0.0, a))  # noqa: E731
-    m = mb.Model("four_bar", gravity=(0, -9.81, 0))
-    crank = m.add_body("crank", 0.5, inertia=(1e-4, 5e-4, 5e-4), position=(0.0, 0.05, 0.0), orientation=z(math.pi / 2))
-    coupler = m.add_body("coupler", 1.0, inertia=(1e-4, 0.015, 0.015), position=(0.15, 0.25, 0.0),
-                         orientation=z(math.pi / 4))
-    rocker = m.add_body("rocker", 0.8, inertia=(1e-4, 0.0113, 0.0113), position=(0.35, 0.2, 0.0),
-                        orientation=z(math.atan2(-0.4, 0.1)))
-    m.add_revolute("O2", m.ground, crank, point=(0, 0, 0), axis=(0, 0, 1))
-    m.add_revolute("A", crank, coupler, point=(0, 0.1, 0), axis=(0, 0, 1))
-    m.add_revolute("B", coupler, rocker, point=(0.3, 0.4, 0), axis=(0, 0, 1))
-    m.add_revolute("O4", rocker, m.ground, point=(0.4, 0, 0), axis=(0, 0, 1))
-    return m
+    """The warm-up's planar crank-rocker of four revolutes (3 redundant rows in 3D), undriven."""
+    from mbdsim._warmup import _four_bar as four_bar
+    return four_bar(False)
 
 
 def test_chunked_multipliers_equal_whole(monkeypatch):

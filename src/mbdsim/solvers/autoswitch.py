@@ -1,22 +1,20 @@
 """The automatic method's hand-over from the explicit DOP853 to an implicit method when it detects stiffness:
 the joining of the two parts (`join`, `merge_stats`), used by the compiled Radau IIA's continuation
-(mbdsim.solvers.radau_run.continue_radau, the default) and HHT's (`continue_implicit`).
+(mbdsim.solvers.radau_run.continue_radau; the earlier HHT continuation is gone with the compiled Radau).
 
 The compiled DOP853 stops at the start t_s of the step its stiffness test flagged (`compiled_run.Stiff`,
 whose `prefix` holds the outputs at times <= t_s, the consistent state at t_s and the run with its step
-checkpoints). HHT then continues from that state over the remaining output times, and the two parts are
+checkpoints). Radau IIA then continues from that state over the remaining output times, and the two parts are
 joined into one Result: outputs, accelerations and multipliers (on demand for the explicit part, as in a
-compiled run), dense output (`Result.at`: the explicit run's own steps up to t_s, HHT's interpolant
-after), the solver's step states, and the statistics (sums, and `order_history` naming which method
-and order held from which time). Nothing before t_s is integrated twice.
+compiled run), dense output (`Result.at`: the explicit run's own steps up to t_s, Radau's collocation
+polynomials after), the solver's step states, and the statistics (sums, and `order_history` naming
+which method and order held from which time). Nothing before t_s is integrated twice.
 
 Order history (res.stats["order_history"]): a list of (t_start [s], method, order) segments in time
 order; each method keeps a fixed order (DOP853: 8, HHT-alpha: 2, scipy's RK45: 5, Radau: 5) except
 scipy's BDF, which changes its order (1..5) itself and whose changes are recorded as they happen.
 """
 from __future__ import annotations
-
-import dataclasses
 
 import numpy as np
 
@@ -64,51 +62,6 @@ def warn_reached(res, reached: float, target: float, reason: str) -> None:
         warn(f"simulate: {reason}; HHT (second order) ran at rtol {reached:g}, so the outputs from there are "
              f"accurate to about that, not to the target {target:g} (give rtol to tighten HHT, at the cost of "
              "its second order)", AccuracyWarning)
-
-
-def continue_implicit(sys, rep, times, stiff, rtol, atol, max_step, progress, reason) -> Result:
-    """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and HHT from its
-    switch time on (rtol, atol: HHT's tolerances); `reason` goes into res.stats["method"]. Accelerations
-and multipliers at every output come from the compiled kernel when first asked for (as in a compiled
-run), and HHT's output states are projected by the compiled kernel (absolute-coordinate models), so
-HHT's part spends its time on its steps."""
-    from .compiled_run import _full_multipliers, _result
-    from .hht import integrate_hht
-    pre, t_s = stiff.prefix, float(stiff.time)
-    run, tp, Y = pre["run"], pre["times"], pre["Y"]
-    nq = sys.nq
-    q_s = _align_quaternions(sys, np.array(pre["y"][:nq]), Y[-1, :nq])
-    v_s = np.array(pre["y"][nq:])
-    first = _result(sys, rep, run, tp, Y, stats=pre["stats"])
-    first.steps = lambda: run.step_states(t_s, np.concatenate([q_s, v_s]))
-    rep_s = dataclasses.replace(rep, t=t_s, q=q_s, v=v_s)
-    rest = np.concatenate([[t_s], np.asarray(times, float)[len(tp):]])
-    def outputs(ts, Yh):   # accelerations and multipliers at HHT's outputs: the compiled kernel, on demand
-        VD, LAM = run.outputs(ts, Yh)
-        return VD, _full_multipliers(sys, rep.rows, ts, Yh, VD, LAM)
-
-    second = integrate_hht(sys, rep_s, rest, rtol, atol, max_step, outputs=outputs,
-                           project=None if run.joint_space else _compiled_projection(run),
-                           progress=None if progress is None else _Joined(progress, first, t_s))
-    res = join(first, second, t_s)
-    res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
-    res.stats["assembly"] = rep
-    return res
-
-
-def _compiled_projection(run):
-    """(t [s], y = [q, v]) -> (q, v) projected by the compiled kernel (mass-weighted minimum-norm Newton
-    steps, tolerance 1e-12, as the compiled run's own outputs); SolverError when it does not converge."""
-    from ..errors import SolverError
-    from .fastdyn import OK, project
-    a, w, nq = run.cm.arrays(), run.work.arrays(), run.sys.nq
-
-    def projected(t, y):
-        y = np.array(y, dtype=float)
-        if project(a, w, float(t), y[:nq], y[nq:], 1e-12, False) != OK:
-            raise SolverError("projection of an output onto the constraints does not converge", time=float(t))
-        return y[:nq], y[nq:]
-    return projected
 
 
 def join(first: Result, second: Result, t_s: float) -> Result:

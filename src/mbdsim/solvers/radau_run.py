@@ -158,7 +158,7 @@ def integrate_radau(sys, rep, times, rtol, atol, max_step, progress=None):
 
 def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):
     """Result over `times` from the explicit prefix of `stiff` (a compiled_run.Stiff) and the compiled Radau
-    IIA from its switch time t_s on, at rtol, atol; joined as autoswitch.continue_implicit joins HHT's part
+    IIA from its switch time t_s on, at rtol, atol; joined by autoswitch.join
     (outputs, dense output: DOP853's steps up to t_s, Radau's collocation polynomials after; statistics;
     order history with a ("Radau", 5) segment from t_s)."""
     from .autoswitch import _align_quaternions, _Joined, join, merge_stats
