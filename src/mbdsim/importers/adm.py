@@ -17,6 +17,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import ModelFileError
+from . import adm_contact
 from . import adm_forces as forces
 from . import adm_joints as joints
 from . import adm_parts as parts
@@ -66,6 +67,7 @@ def from_adm(path: PathLike) -> Model:
         raise ModelFileError("file", "path", "a binary file, not an Adams dataset", source)
     statements = read_statements(text, source)
     imp = AdmImport(source, Model(path.stem or "model"))
+    imp.folder = str(path.resolve().parent)
     by_name: dict = {}
     for st in statements:
         if st.name in REFUSED:
@@ -103,7 +105,7 @@ def _build(imp, by_name) -> None:
         parts.accgrav(imp, st)
     graphics: dict = {}
     for st in get("GRAPHICS"):
-        forces.graphics(imp, st, graphics)
+        adm_contact.graphics(imp, st, graphics)
     later: list = []
     for st in get("JOINT"):
         joints.joint(imp, st, later)
@@ -131,4 +133,4 @@ def _build(imp, by_name) -> None:
     for st in get("FRICTION"):
         forces.friction(imp, st)
     for st in get("CONTACT"):
-        forces.contact(imp, st, graphics)
+        adm_contact.contact(imp, st, graphics)

@@ -73,6 +73,7 @@ class AdmImport:
     splines: dict = field(default_factory=dict)        # SPLINE id -> (xs, ys, linear extrapolation)
     notes: list = field(default_factory=list)
     names: set = field(default_factory=set)
+    folder: str = ""                                  # the dataset's folder (EXTERNAL FILE= is relative to it)
 
     # ------------------------------------------------------------- errors and notes
     def fail(self, st: Statement, fld: str, message: str, line: int | None = None):
