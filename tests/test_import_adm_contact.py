@@ -39,6 +39,8 @@ CONTACT/1, IGEOM=2, JGEOM=1, IMPACT, STIFFNESS={k_mm!r}, EXPONENT={e!r}, DAMPING
 , COULOMB_FRICTION=ON, MU_STATIC=0.5, MU_DYNAMIC=0.4, STICTION_TRANSITION_VELOCITY=0.1,
 , FRICTION_TRANSITION_VELOCITY=1
 """))
+    box = m.bodies["PART_2"].shapes["GRAPHICS_2"]               # corner + half the lengths = the CM
+    assert np.allclose(box.s_B, 0.0, atol=1e-12) and np.allclose(box.geometry.size, a)
     res = mb.simulate(m, 1.0, 0.01)
     assert res.success
     z = res.position("PART_2")[-1, 2]
@@ -73,6 +75,8 @@ CONTACT/1, IGEOM=2, JGEOM=1, IMPACT, STIFFNESS=1000, EXPONENT=1, DAMPING=0.2, DM
 , COULOMB_FRICTION=ON, MU_STATIC=0.6, MU_DYNAMIC=0.5, STICTION_TRANSITION_VELOCITY=0.01,
 , FRICTION_TRANSITION_VELOCITY=0.1
 """))
+    cyl = m.bodies["PART_2"].shapes["GRAPHICS_2"]               # CM marker at the base, extending along its z
+    assert np.allclose(cyl.s_B, 0.0, atol=1e-12) and np.allclose(cyl.R_BG[:, 2], (1, 0, 0))
     res = mb.simulate(m, 0.4, 0.005, method="dop853", rtol=1e-8)
     assert res.success
     s = res.position("PART_2") @ t

@@ -8,8 +8,7 @@ first order).  FIELD (matrices by columns): diagonal -> a bushing; coupled -> ex
 same linear law (field_loads).  VFORCE/VTORQUE/GFORCE: expression components in the RM marker's axes on I, the
 reaction on the JFLOAT marker's part at I's current position (as a force at the floating marker's
 initial point plus the moment of the offset).  FRICTION: mbdsim's event-driven joint friction (the
-stiction transition parameters are approximated by exact stick/slip).  CONTACT: sphere-sphere and
-sphere-plane GRAPHICS (ELLIPSOID with equal scales, PLANE) with the IMPACT law.
+stiction transition parameters are approximated by exact stick/slip).  CONTACT and GRAPHICS: adm_contact.
 """
 from __future__ import annotations
 
