@@ -76,7 +76,8 @@ def _expression_curve(texts, d1, d2):
 
 
 class Curve:
-    """Parametric curve s -> C(s) [m] in ground at t=0; see the module docstring."""
+    """Parametric curve s -> C(s) [m] in ground at t=0: a callable s -> 3 numbers, or three expression
+    strings in s (x, y, z [m]; exact symbolic derivatives); see the module docstring."""
 
     def __init__(self, function, s_range, d1=None, d2=None, closed=False, step=None):
         self.expressions = None
