@@ -7,8 +7,6 @@ to SI here.  Expression strings go to the whitelist parser `mbdsim.parse`: nothi
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
 from ..errors import ModelError
@@ -33,30 +31,6 @@ class ItemError(ModelError):
     def __init__(self, entity, field, message, path):
         super().__init__(entity, field, message)
         self.path, self.message = tuple(path), message
-
-
-@dataclass(frozen=True)
-class ExprCurve:
-    """C(s) [m] from three expression strings of s (whitelist parser); exact derivatives by differentiation."""
-
-    texts: tuple
-
-    def __post_init__(self):
-        from ..expressions import parse
-        exprs = tuple(parse(str(t), variables=("s",)) for t in self.texts)
-        object.__setattr__(self, "_e", (exprs, tuple(e.derivative("s") for e in exprs)))
-
-    def _stack(self, exprs, s):
-        return np.array([np.asarray(e(s)) + 0 * np.asarray(s) for e in exprs])
-
-    def __call__(self, s):
-        return self._stack(self._e[0], s)
-
-    def d1(self, s):
-        return self._stack(self._e[1], s)
-
-    def d2(self, s):
-        return self._stack(tuple(e.derivative("s") for e in self._e[1]), s)
 
 
 def rotation_matrix(entity: str, field: str, spec) -> np.ndarray | None:
@@ -236,11 +210,10 @@ class Builder:
         if c.type == "spline":
             curve = mb.Spline(c.points, closed=c.closed)
         else:
-            try:
-                fn = ExprCurve((c.x, c.y, c.z))
-            except ValueError as exc:   # ExpressionError is a ValueError
+            try:   # three expression strings of s: exact symbolic derivatives (model.curves)
+                curve = mb.Curve((str(c.x), str(c.y), str(c.z)), c.s_range, closed=c.closed)
+            except ModelError as exc:
                 self.fail(entity, "curve", str(exc))
-            curve = mb.Curve(fn, c.s_range, d1=fn.d1, d2=fn.d2, closed=c.closed)
         self.model.add_point_on_curve(j.name, self.location(entity, "marker", j.marker),
                                       self.body(entity, "body", j.body), curve)
 

@@ -149,12 +149,11 @@ def _body_joint(j) -> dict:
 
 def _curve(entity, curve) -> dict:
     from ..model.curves import Spline
-    from .build import ExprCurve
     if isinstance(curve, Spline):
         pts = curve.points[:-1] if curve.closed else curve.points
         return {"type": "spline", "points": [_vec(p) for p in pts], "closed": curve.closed}
-    if isinstance(curve._f, ExprCurve):
-        x, y, z = (str(t) for t in curve._f.texts)
+    if getattr(curve, "expressions", None) is not None:
+        x, y, z = (e.text for e in curve.expressions)
         return {"type": "curve", "x": x, "y": y, "z": z, "s_range": _vec(curve.s_range), "closed": curve.closed}
     raise ModelError(entity, "curve", "a curve given as a Python callable cannot be stored in a model file; "
                      "use mb.Spline or expression strings of s in the file")

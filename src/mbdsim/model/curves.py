@@ -8,6 +8,9 @@ carried by the body it is fixed on).  `derivatives(s)` returns (C, dC/ds, d2C/ds
   arguments and agrees with a central difference, else by Richardson-extrapolated central
   differences (step `step`, default 1e-4 (b - a)); without d2, d2C/ds2 by Richardson differences of
   dC/ds.  User derivatives are checked against differences at construction.
+- `Curve(("x(s)", "y(s)", "z(s)"), s_range)`: the three coordinates as expression strings in `s`
+  (mbdsim.expressions grammar); dC/ds and d2C/ds2 are the exact symbolic derivatives, and the
+  parsed expressions are kept in `curve.expressions` (for the compiled core, issue 29).
 - `Spline(points, closed=False)`: C2 cubic spline (scipy CubicSpline, not-a-knot ends; periodic when
   closed) through the points, parametrised by cumulative chord length [m] (s ~ arc length), with
   exact derivatives.
@@ -49,10 +52,37 @@ def _richardson(fn, s, h):
     return (4 * d(h / 2) - d(h)) / 3
 
 
+def _expression_curve(texts, d1, d2):
+    """(exprs, C, C', C'') of three coordinate expressions in s; exact symbolic derivatives."""
+    from ..expressions import ExpressionError, parse
+    if d1 is not None or d2 is not None:
+        raise ModelError(ENTITY, "d1", "an expression curve takes its derivatives from the expressions: "
+                         "leave d1 and d2 out")
+    exprs = []
+    for axis, text in zip("xyz", texts):
+        try:
+            exprs.append(parse(text, ("s",)))
+        except ExpressionError as exc:
+            raise ModelError(ENTITY, f"function[{axis}]", str(exc)) from None
+    try:
+        e1 = [e.derivative("s") for e in exprs]
+        e2 = [e.derivative("s") for e in e1]
+    except ExpressionError as exc:
+        raise ModelError(ENTITY, "function", str(exc)) from None
+
+    def vec(es):
+        return lambda s: np.array([e.evaluate(s) for e in es])
+    return tuple(exprs), vec(exprs), vec(e1), vec(e2)
+
+
 class Curve:
-    """Parametric curve s -> C(s) [m] in ground at t=0; see the module docstring."""
+    """Parametric curve s -> C(s) [m] in ground at t=0: a callable s -> 3 numbers, or three expression
+    strings in s (x, y, z [m]; exact symbolic derivatives); see the module docstring."""
 
     def __init__(self, function, s_range, d1=None, d2=None, closed=False, step=None):
+        self.expressions = None
+        if isinstance(function, (tuple, list)) and len(function) == 3 and all(isinstance(f, str) for f in function):
+            self.expressions, function, d1, d2 = _expression_curve(function, d1, d2)
         if not callable(function):
             raise ModelError(ENTITY, "function", f"expected a callable s -> point, got {function!r}")
         try:
