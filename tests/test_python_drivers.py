@@ -95,3 +95,29 @@ def test_callable_driver_in_a_kinematic_sweep():
     assert res.success and "compiled" in res.stats.get("method", ""), res.stats
     assert np.max(np.abs(res.joint_coordinate("O") - 0.5 * res.time**3)) < 1e-10
     assert np.max(np.abs(res.joint_velocity("O") - 1.5 * res.time**2)) < 1e-7
+
+
+def test_njit_driver_is_fingerprinted_as_its_python_function():
+    """A numba.njit dispatcher in a model is walked as the function it compiles (its own fields are numba's
+    caches: walking them cost seconds per run); another function gives another digest, and the callable
+    is flagged (results computed by calling it are not cached)."""
+    import time
+
+    import numba
+
+    from mbdsim.system.fingerprint import fingerprint
+
+    @numba.njit
+    def f(t):
+        return 3 * t + 2 * np.sin(t)
+
+    @numba.njit
+    def g(t):
+        return 3 * t
+
+    f(0.5), g(0.5)   # compiled: the dispatchers hold their overloads, types and environments
+    mf, mg = _carousel(displacement=f), _carousel(displacement=g)
+    t0 = time.perf_counter()
+    a, callables = fingerprint(mf)
+    assert time.perf_counter() - t0 < 0.2 and callables
+    assert a == fingerprint(mf)[0] != fingerprint(mg)[0]
