@@ -26,12 +26,37 @@ def test_callable_driver_with_exact_derivatives_matches_the_expression():
 
 
 def test_plain_callable_driver_runs_compiled():
-    """Numerical derivatives (complex step for d1, Richardson for d2): the motion to 1e-7."""
+    """Numerical derivatives (the driver callback's 9-point stencil, solvers.pydrive): the motion to 1e-8."""
     a = _run(_carousel(displacement=lambda t: 3 * t + 2 * np.sin(t)))
     b = _run(_carousel(displacement="3*t + 2*sin(t)"))
     assert a.success and "compiled" in a.stats["method"], a.stats["method"]
     assert np.max(np.abs(a.joint_coordinate("hub") - b.joint_coordinate("hub"))) < 1e-10
-    assert np.max(np.abs(a.joint_coordinate("tip") - b.joint_coordinate("tip"))) < 1e-7
+    assert np.max(np.abs(a.joint_coordinate("tip") - b.joint_coordinate("tip"))) < 1e-8
+
+
+def test_stencil_derivatives_against_closed_forms_and_the_tableau_fallback():
+    """solvers.pydrive.triple: d1, d2 of a smooth f to 1e-10 relative; sin(300 t) (too fast for the
+    stencil's 0.01 s step: the 4th/8th-order check fails) still to 1e-8 through the Ridders tableau; an f
+    that raises beyond 1 s keeps its derivatives at 0.98 s (the tableau's finer steps)."""
+    from mbdsim.solvers.pydrive import triple
+    tf = mb.expressions.time_function
+    cases = [(lambda t: 3 * t + 2 * np.sin(t), lambda t: 3 + 2 * np.cos(t), lambda t: -2 * np.sin(t)),
+             (lambda t: np.sin(300 * t), lambda t: 300 * np.cos(300 * t), lambda t: -9e4 * np.sin(300 * t)),
+             (np.exp, np.exp, np.exp)]
+    for f, d1, d2 in cases:
+        tri = triple(tf(f))
+        for t in (0.0, 0.37, 1.9):
+            v, a, b = tri(t)
+            assert v == f(t)
+            assert abs(a - d1(t)) <= 1e-10 * max(1.0, abs(d1(t))), (f, t)
+            assert abs(b - d2(t)) <= 1e-8 * max(1.0, abs(d2(t))), (f, t)
+
+    def lost(t):
+        if t > 1.0:
+            raise RuntimeError("sensor lost")
+        return np.sin(t)
+    v, a, b = triple(tf(lost))(0.98)
+    assert abs(a - np.cos(0.98)) < 1e-8 and abs(b + np.sin(0.98)) < 1e-6
 
 
 def test_velocity_driver_without_closed_form_runs_compiled_like_the_reference_path():
@@ -70,3 +95,29 @@ def test_callable_driver_in_a_kinematic_sweep():
     assert res.success and "compiled" in res.stats.get("method", ""), res.stats
     assert np.max(np.abs(res.joint_coordinate("O") - 0.5 * res.time**3)) < 1e-10
     assert np.max(np.abs(res.joint_velocity("O") - 1.5 * res.time**2)) < 1e-7
+
+
+def test_njit_driver_is_fingerprinted_as_its_python_function():
+    """A numba.njit dispatcher in a model is walked as the function it compiles (its own fields are numba's
+    caches: walking them cost seconds per run); another function gives another digest, and the callable
+    is flagged (results computed by calling it are not cached)."""
+    import time
+
+    import numba
+
+    from mbdsim.system.fingerprint import fingerprint
+
+    @numba.njit
+    def f(t):
+        return 3 * t + 2 * np.sin(t)
+
+    @numba.njit
+    def g(t):
+        return 3 * t
+
+    f(0.5), g(0.5)   # compiled: the dispatchers hold their overloads, types and environments
+    mf, mg = _carousel(displacement=f), _carousel(displacement=g)
+    t0 = time.perf_counter()
+    a, callables = fingerprint(mf)
+    assert time.perf_counter() - t0 < 0.2 and callables
+    assert a == fingerprint(mf)[0] != fingerprint(mg)[0]

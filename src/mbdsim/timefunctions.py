@@ -13,6 +13,8 @@ d2 per s^2. Build them with :func:`time_function` (re-exported by :mod:`mbdsim.e
   functions whose time scale is 0.003 s or longer (e.g. sin(300 t)); faster features, or kinks
   within 0.1 s of t, need explicit d1/d2 or an expression. Steps at which the callable raises (it
   fails beyond some time) are skipped, so its derivatives are those of the finer steps.
+  (Inside the compiled step loop, a driver's d1/d2 come from a cheaper 9-point stencil checked
+  against its own 4th-order differences, falling back to these: solvers.pydrive.)
 
 :func:`integrated` and :func:`double_integrated` turn a velocity or acceleration driver into a
 displacement TimeFunction: an exact expression when the driver's expression has a closed-form

@@ -25,6 +25,7 @@ time (a KeyboardInterrupt inside the callable makes every later call fail: an in
 from __future__ import annotations
 
 import ctypes
+import math
 
 import numpy as np
 
@@ -33,6 +34,7 @@ from ..results.state import State
 from ..system.force_elements import evaluator
 from ..system.frames import Frames
 from . import fasttree
+from .pydrive import triple
 
 _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_double)
 
@@ -56,7 +58,8 @@ class PythonLoads:
             fns = sys.derived["packed"][6]
             drv, owner = sys.derived["packed"][5], sys.row_owner
             rows = {int(d): r for r, d in enumerate(drv) if d >= 0}
-            self.drivers = [(d, fns[d], f"motion '{owner[rows[d]]}'") for d in cm.python_drivers]
+            self.drivers = [(d, triple(fns[d]), f"motion '{owner[rows[d]]}'") for d in cm.python_drivers]
+            self._driver_names = ", ".join(e for _, _, e in self.drivers)
             self.ctl[2] = self._address(self._drive)
         # the velocity slots of each frame (frame f's six load slots are v[vadr[f]: vadr[f] + 6]; particles 3)
         self.slots = [(f, int(a), 6 if sys.frame_rigid[f] else 3) for f, a in enumerate(sys.frame_v_adr) if a >= 0]
@@ -68,20 +71,20 @@ class PythonLoads:
 
     def _drive(self, t):
         """The driver callback: value, d1, d2 of each Python-callable driver at t [s] into wk[34:37]."""
-        return self._guarded(lambda: self._drivers_at(t), ", ".join(e for _, _, e in self.drivers), "function",
-                             t, self._poison_drivers)
+        return self._guarded(lambda: self._drivers_at(t), self._driver_names, "function", t, self._poison_drivers)
 
     def _drivers_at(self, t):
-        for d, fn, entity in self.drivers:
-            for k, part in enumerate((fn.value, fn.d1, fn.d2)):
-                x = part(t)
-                try:
-                    x = float(np.asarray(x, dtype=float).reshape(()))
-                except (TypeError, ValueError):
-                    raise EvaluationError(entity, "function", f"returned {x!r}, not a number", time=float(t)) from None
-                if not np.isfinite(x):
-                    raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
-                self.wk[34 + k][d] = x
+        """value, d1, d2 of each driver at t (solvers.pydrive.triple: the user's functions called on the
+        float t directly, numerical derivatives from one stencil of f) into wk[34:37]."""
+        w0, w1, w2 = self.wk[34], self.wk[35], self.wk[36]
+        for d, tri, entity in self.drivers:
+            try:
+                x = tri(t)
+            except (TypeError, ValueError) as exc:
+                raise EvaluationError(entity, "function", f"did not return a number ({exc})", time=float(t)) from None
+            if not (math.isfinite(x[0]) and math.isfinite(x[1]) and math.isfinite(x[2])):
+                raise EvaluationError(entity, "function", f"is not finite ({x!r})", time=float(t))
+            w0[d], w1[d], w2[d] = x
 
     def _poison_drivers(self):
         for d, _, _ in self.drivers:

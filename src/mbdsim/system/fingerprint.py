@@ -128,6 +128,9 @@ def _walk(root, model_attrs, refs=None, portable=False) -> tuple[bytes, bool]:
             items = sorted(obj, key=repr)
             add(b"S%d" % len(items))
             extend(reversed(items))
+        elif t.__module__.startswith("numba.") and isinstance(getattr(obj, "py_func", None), types.FunctionType):
+            add(b"J")                       # a numba.njit dispatcher: as the Python function it compiles
+            push(obj.py_func)               # (its own fields are numba's caches: megabytes of objects)
         elif portable and isinstance(obj, types.FunctionType):
             add(b"P")
             push(_code(obj))
