@@ -289,8 +289,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             h = t_end - t
         for i in range(n):
             fn[i] = f[i]
-        for i in range(nv):
-            scale[i] = atol + rtol * max(abs(h * y[m + i]), 1e-3)
+        for i in range(nv):   # Newton's weights: at most 1e-6 relative, whatever a loose rtol asks
+            scale[i] = min(atol, 1e-8) + min(rtol, 1e-6) * max(abs(h * y[m + i]), 1e-3)
         converged, n_iter, rate, s_ = False, 0, -1.0, OK
         for attempt in range(2):
             if st[7] == 0.0:

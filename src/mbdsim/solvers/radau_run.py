@@ -140,7 +140,8 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
     state, for a hand-over)."""
     y0 = np.concatenate([rep.q, rep.v])
     times = np.asarray(times, float)
-    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
+    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep},  # noqa: E731
+                                   message="partial (run in progress)")
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial, y_start)
     success, message, error = True, "ok", None
     if status != 0:
