@@ -21,7 +21,10 @@ def exact_angle(t_end, L=1.0):
     return sol.y[0, -1]
 
 
-def test_second_order_convergence_fixed_steps():
+@pytest.mark.parametrize("compiled", [True, False])
+def test_second_order_convergence_fixed_steps(compiled, monkeypatch):
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", compiled)   # the compiled HHT and the reference one
     m, rod, pin = pendulum()
     th = exact_angle(1.0)
     errs = []
@@ -32,7 +35,10 @@ def test_second_order_convergence_fixed_steps():
     assert np.all(rates > 1.8), (errs, rates)
 
 
-def test_error_control_meets_tolerance_on_period():
+def test_error_control_meets_tolerance_on_period(monkeypatch):
+    """The reference (Python) HHT's error control and modified Newton (the compiled one: test_compiled_hht)."""
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", False)
     m, rod, pin = pendulum()
     w0 = np.sqrt(3 * 9.81 / 2)
     half_period = 2 / w0 * ellipk(0.5)

@@ -183,7 +183,7 @@ def test_dissipated_energy_of_an_hht_run_is_quick_and_balances():
     m.add_spring_damper("k", (coupler, (1.0, 1.0, 0)), (m.ground, (1.0, -1.0, 0)), stiffness=50.0, damping=2.0,
                         free_length=1.5)
     res = mb.simulate(m, 1.0, 0.01, method="hht")
-    assert res.success and res.stats["method"] == "HHT"
+    assert res.success and res.stats["method"].startswith("HHT")
     t0 = time.monotonic()
     D = res.dissipated_energy()   # (before: every Chebyshev point a Newton solve through Result.at, ~60 s)
     # ~1 s on an idle 2-core machine, 3 s seen with two other jobs compiling: the bound guards the 60 s

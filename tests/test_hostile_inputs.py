@@ -221,7 +221,9 @@ def test_model_files_that_are_not_regular_or_too_large_are_refused(tmp_path):
 # ----------------------------------------------------------------------------- 7. unbounded work
 def test_python_methods_stop_after_the_step_budget(monkeypatch):
     from mbdsim.solvers import driver
+    from mbdsim.solvers import dynamic
     monkeypatch.setattr(driver, "MAX_STEPS", 40)   # (1e7 by default, as the compiled integrator)
+    monkeypatch.setattr(dynamic, "USE_COMPILED", False)   # the reference (Python) HHT
     res = mb.simulate(oscillator(), 1e12, method="hht")
     assert not res.success and "step budget exhausted (40 steps)" in res.message
     assert len(res.time) >= 1 and res.time[0] == 0.0

@@ -268,6 +268,13 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
             raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
                              "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
                              "'bdf'); the HHT method cannot include it")
+        if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run)
+            from .hht import ALPHA
+            from .hht_run import integrate_hht_compiled
+            try:
+                return integrate_hht_compiled(sys, rep, times, rtol, atol, max_step, ALPHA, progress)
+            except NotCompiled:
+                pass   # sensors, switching elements: the reference HHT locates their events
         res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res

@@ -31,6 +31,19 @@ class RadauRun(CompiledRun):
     evaluations, projections, Jacobians, LU factorisation pairs."""
 
     dense_q = None
+    METHOD, HISTORY, ORDER, N_ST = METHOD, HISTORY, 5, fastradau.N_ST
+    LU_PER_FACTORISATION = 2   # a real and a complex LU
+
+    def _scratch(self, n):
+        """The step loop's work arrays kept between its calls (J, LU factors, stages)."""
+        return (np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n), dtype=np.complex128),
+                np.zeros((2, n), dtype=np.int64), np.zeros((fastradau.N_SCRATCH, n)), np.zeros(n, np.complex128))
+
+    def _step_loop(self, a, w, st, y, f, tout, iout, Y, scratch, SY, ST, SQ, ns, start_row):
+        """One call of the compiled step loop: (status, next iout)."""
+        return fastradau.run(a, w, fastradau.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y, self.rtol, self.atol,
+                             self.max_step, self.max_steps, CHUNK, 1e-12, self.stats, *scratch, SY, ST, SQ, ns,
+                             start_row)
 
     @classmethod
     def sharing(cls, run: CompiledRun, rtol, atol, max_step):
@@ -59,10 +72,9 @@ class RadauRun(CompiledRun):
         Y[0] = y0
         iout = 1 if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)) else 0
         f = np.zeros(n)
-        st = np.zeros(fastradau.N_ST)
+        st = np.zeros(self.N_ST)
         st[0] = t0
-        Jm, LR, LC = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n), dtype=np.complex128)
-        piv, S, cv = np.zeros((2, n), dtype=np.int64), np.zeros((fastradau.N_SCRATCH, n)), np.zeros(n, np.complex128)
+        scratch = self._scratch(n)
         keep = checkpoints and 4 * n * 8 * 64 <= CHECKPOINT_BUDGET
         cap = 64 if keep else 0
         SY, ST, SQ, ns = np.zeros((cap, n)), np.zeros((cap, 2)), np.zeros((cap, 3, n)), np.zeros(1, np.int64)
@@ -74,9 +86,7 @@ class RadauRun(CompiledRun):
                         SY, ST, SQ = (np.concatenate([x, np.zeros_like(x)]) for x in (SY, ST, SQ))
                     else:
                         keep, SY, ST, SQ = False, SY[:0], ST[:0], SQ[:0]
-                status, iout = fastradau.run(a, w, fastradau.COEFFS, st, y, f, float(tout[-1]), tout, iout, Y,
-                                             self.rtol, self.atol, self.max_step, self.max_steps, CHUNK, 1e-12,
-                                             self.stats, Jm, LR, LC, piv, S, cv, SY, ST, SQ, ns, start_row)
+                status, iout = self._step_loop(a, w, st, y, f, tout, iout, Y, scratch, SY, ST, SQ, ns, start_row)
                 if st[1] == 0.0:   # the start failed
                     iout = 0
                     break
@@ -117,10 +127,10 @@ class RadauRun(CompiledRun):
 
 def _stats(run: RadauRun, rep) -> dict:
     s = run.stats
-    return {"steps": int(s[0]), "rejected": int(s[1]), "nfev": int(s[2]), "njev": int(s[4]),
-            "nlu": int(2 * s[5]),
-            "factorizations": int(2 * s[5]) + (0 if run.joint_space else int(s[2] + 2 * s[3])),
-            "projections": 0 if run.joint_space else int(s[3]), "order": 5, "method": METHOD,
+    nlu = int(run.LU_PER_FACTORISATION * s[5])
+    return {"steps": int(s[0]), "rejected": int(s[1]), "nfev": int(s[2]), "njev": int(s[4]), "nlu": nlu,
+            "factorizations": nlu + (0 if run.joint_space else int(s[2] + 2 * s[3])),
+            "projections": 0 if run.joint_space else int(s[3]), "order": run.ORDER, "method": run.METHOD,
             "formulation": "joint coordinates (articulated body)" if run.joint_space else
             "absolute coordinates (tree elimination)", "assembly": rep}
 
@@ -130,7 +140,8 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
     state, for a hand-over)."""
     y0 = np.concatenate([rep.q, rep.v])
     times = np.asarray(times, float)
-    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
+    partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep},  # noqa: E731
+                                   message="partial (run in progress)")
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial, y_start)
     success, message, error = True, "ok", None
     if status != 0:
@@ -138,7 +149,7 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
         success = False
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=_stats(run, rep))
     res.error = error
-    res.stats["order_history"] = [(float(times[0]),) + HISTORY]
+    res.stats["order_history"] = [(float(times[0]),) + run.HISTORY]
     return res
 
 
