@@ -221,3 +221,134 @@ def test_over_driven_four_bar_named_on_the_sparse_route(monkeypatch):
         with pytest.raises(mb.AssemblyError, match="over-driven") as err:
             mb.assemble(model)
     assert "drive" in err.value.joints and "rocker_drive" in err.value.joints
+
+
+# ------------------------------------------------------------------------------ rows beyond the kernel's
+def _chain(kinds, held=None, gap=0.1, gravity=(0.0, -9.81, 0.0)):
+    """Links of 1 m along x drawn `gap` apart, joint k of kind kinds[k] (revolute and cylindrical about z,
+    universal with axes z, y; constant velocity along x) between markers at the link ends; held[k]:
+    the joint's initial_displacement / initial_velocity."""
+    m = mb.Model("chain", gravity=gravity)
+    prev = m.ground.add_marker("m0", (0.0, 0.0, 0.0))
+    for k, kind in enumerate(kinds):
+        x0 = k * (1.0 + gap) + gap
+        b = m.add_body(f"b{k}", 1.0, inertia=(0.01, 0.1, 0.1), position=(x0 + 0.5, 0.0, 0.0))
+        mi, mj = prev, b.add_marker("a", (x0, 0.0, 0.0))
+        kw = (held or {}).get(k, {})
+        if kind in ("universal", "constant_velocity"):
+            mi = mi.body.add_marker(f"u{k}", mi.point, orientation=_axes(kind, True))
+            mj = b.add_marker(f"v{k}", mj.point, orientation=_axes(kind, False))
+            j = getattr(m, "add_" + kind)(f"j{k}", mi, mj)
+            for f, x in kw.items():
+                setattr(j, f, np.asarray(x, dtype=float))
+        else:
+            getattr(m, "add_" + kind)(f"j{k}", mi, mj, **kw)
+        prev = b.add_marker("b", (x0 + 1.0, 0.0, 0.0))
+    return m
+
+
+def _axes(kind, first):
+    """Marker axes (columns x, y, z in ground) of a universal joint (z axes: ground z, then y) or a
+    constant-velocity joint (z axes both along the links, x along the bend axis z)."""
+    if kind == "universal":
+        return np.eye(3) if first else np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    return np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
+
+
+def _sparse_forced(make, monkeypatch):
+    """(dense report, sparse report, warnings of each) of fresh models: the sparse run with the dense
+    route refusing everything (DENSE_BYTES = 0), so that it cannot fall back."""
+    from mbdsim.solvers import assembly
+    reps, caught = [], []
+    for limit, dense_bytes in ((10**9, assembly.DENSE_BYTES), (0, 0)):
+        monkeypatch.setattr(assembly_sparse, "SPARSE_NV", limit)
+        monkeypatch.setattr(assembly, "DENSE_BYTES", dense_bytes)
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            reps.append(mb.assemble(make()))
+        caught.append(sorted({type(x.message).__name__ for x in w}))
+    return reps, caught
+
+
+RNG = np.random.default_rng(11)
+SPH = {k: dict(initial_displacement=RNG.uniform(-0.5, 0.5, 3), initial_velocity=RNG.uniform(-1, 1, 3))
+       for k in range(5)}
+
+
+def _geared(kind):
+    """Revolute chain with joint 0 held, joint 1 tied to it by a gear, a rack-and-pinion coupler (a
+    translational joint's slide to a revolute's angle) or a user constraint."""
+    def make():
+        kinds = ["revolute", "revolute", "revolute", "translational" if kind == "coupler" else "revolute"]
+        m = _chain(kinds, {0: dict(initial_displacement=0.3, initial_velocity=0.5)})
+        if kind == "gear":
+            m.add_gear("g", "j0", "j1", -2.0)
+        elif kind == "coupler":
+            m.add_coupler("rack", "j2", "j3", 0.2)
+            m.joints["j2"].initial_displacement = np.array([0.4])
+        else:
+            m.add_user_constraint("u", "sin(j0) - 0.5*j1 + 0.1*j2")
+        return m
+    return make
+
+
+def _on_curve():
+    """A chain of 3 whose last link's tip is held on a circle on ground (a loop through the curve
+    parameter), drawn 0.4 m off the circle (the rows independent as drawn: the tangent there is along
+    the chain)."""
+    m = _chain(["revolute", "spherical", "spherical"], {0: dict(initial_velocity=0.4)})
+    circle = mb.Curve(lambda s: [3.3 + 0.5 * np.cos(s), 0.1 + 0.5 * np.sin(s), 0.0], (-4.0, 4.0),
+                      d1=lambda s: [-0.5 * np.sin(s), 0.5 * np.cos(s), 0.0],
+                      d2=lambda s: [-0.5 * np.cos(s), -0.5 * np.sin(s), 0.0])
+    m.add_point_on_curve("path", m.bodies["b2"].markers["b"], m.ground, circle)
+    return m
+
+
+def _with_friction():
+    m = _chain(["revolute", "translational", "revolute"], {0: dict(initial_displacement=0.2)})
+    m.add_friction("f1", "j1", 0.3, 0.2)
+    m.add_friction("f2", "j2", 0.3, 0.2, pin_radius=0.01)
+    return m
+
+
+CASES = {
+    "spherical held": lambda: _chain(["spherical"] * 5, SPH),
+    "spherical loop held": lambda: _with_rung(_chain(["spherical"] * 4, {1: SPH[1], 2: SPH[2]})),
+    "universal held": lambda: _chain(["universal", "revolute", "universal"],
+                                     {0: dict(initial_displacement=[0.0, 0.0, 0.4], initial_velocity=[0, 0, 0.7]),
+                                      1: dict(initial_displacement=-0.2),
+                                      2: dict(initial_displacement=[0.0, 0.3, 0.0], initial_velocity=[0, -0.5, 0])}),
+    "cv held": lambda: _chain(["spherical", "constant_velocity"],
+                              {1: dict(initial_displacement=[0.0, 0.0, 0.3], initial_velocity=[0.0, 0.0, 0.6])}),
+    "gear": _geared("gear"), "coupler": _geared("coupler"), "user constraint": _geared("user"),
+    "point on curve": _on_curve, "friction": _with_friction,
+}
+
+
+def _with_rung(m):
+    """A link joined to the chain's tip and to ground by spherical joints: a closed loop (3D)."""
+    r = m.add_body("rung", 1.0, inertia=(0.01, 0.1, 0.1), position=(4.4, -0.8, 0.0))
+    m.add_spherical("ra", m.bodies["b3"].markers["b"], r.add_marker("e", (4.4, -0.05, 0.0)))
+    m.add_spherical("rb", r.add_marker("f", (4.4, -1.55, 0.0)), m.ground.add_marker("g", (4.4, -1.6, 0.0)))
+    return m
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_sparse_route_carries_couplers_paths_friction_and_rotation_vectors(case, monkeypatch):
+    """Each kind of row beyond the kernel's (couplers, gears, user constraints, the curve parameter of a
+    point-on-curve constraint, friction lock rows) and the held rotation vectors of spherical,
+    universal and constant-velocity joints: the sparse route (the dense one refusing) gives the dense
+    route's state to round-off, every held value held."""
+    (dense, sparse), (wd, ws) = _sparse_forced(CASES[case], monkeypatch)
+    assert dense.residual < 1e-12 and sparse.residual < 1e-12
+    assert np.abs(dense.q - sparse.q).max() < 1e-12 and np.abs(dense.v - sparse.v).max() < 1e-12
+    assert np.array_equal(dense.rows, sparse.rows) and dense.dof == sparse.dof
+    assert wd == ws == [] and dense.changed == sparse.changed == []
+    assert list(dense.moved) == list(sparse.moved) and len(sparse.moved)
+    s = sparse.system
+    for jt in s.model.joints.values():   # the held values are met (the dense route's measure of them)
+        from mbdsim.solvers.held import joint_values
+        x, rate, _, _, _ = joint_values(s, jt, sparse.q, sparse.v)
+        for given, got in ((jt.initial_displacement, x), (jt.initial_velocity, rate)):
+            if given is not None:
+                assert np.abs(np.asarray(got) - given).max() < 1e-12, jt.name
