@@ -8,6 +8,7 @@ it would refuse), so that success proves the sparse route took them:
   one drawn hanging and simulated: each top pin carries half the weight of the ladder (symmetry).
 In process: small models give the same assembled state on the sparse and the dense route."""
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -352,3 +353,73 @@ def test_sparse_route_carries_couplers_paths_friction_and_rotation_vectors(case,
         for given, got in ((jt.initial_displacement, x), (jt.initial_velocity, rate)):
             if given is not None:
                 assert np.abs(np.asarray(got) - given).max() < 1e-12, jt.name
+
+
+GEARED = textwrap.dedent('''
+    import json, resource, sys, warnings
+    import numpy as np
+    resource.setrlimit(resource.RLIMIT_AS, (1536 * 2**20, 1536 * 2**20))   # one dense phi_q alone: 1.3 GB
+    import mbdsim as mb
+    from scipy.spatial.transform import Rotation
+    from mbdsim.solvers import assembly
+    assembly.DENSE_BYTES = 0   # the dense route refuses everything: only the sparse one can succeed
+    N, gap = 3000, 0.1
+    rng = np.random.default_rng(5)
+    th, om = rng.uniform(-0.3, 0.3, (N, 3)), rng.uniform(-1.0, 1.0, (N, 3))
+    m = mb.Model("geared", gravity=(0.0, -9.81, 0.0))
+    prev = m.ground.add_marker("m0", (0.0, 0.0, 0.0))
+    for k in range(N):
+        x0 = k * (1.0 + gap) + gap
+        b = m.add_body(f"b{k}", 1.0, inertia=(0.01, 0.1, 0.1), position=(x0 + 0.5, 0.0, 0.0))
+        a = b.add_marker("a", (x0, 0.0, 0.0))
+        if k == 0:
+            m.add_revolute("j0", prev, a, initial_displacement=0.3, initial_velocity=0.5)
+        elif k == 1:
+            m.add_revolute("j1", prev, a)
+        else:
+            m.add_spherical(f"j{k}", prev, a, initial_displacement=th[k], initial_velocity=om[k])
+        prev = b.add_marker("b", (x0 + 1.0, 0.0, 0.0))
+    m.add_gear("g", "j0", "j1", -2.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # nothing held may be changed
+        rep = mb.assemble(m)
+    s = rep.system
+    # closed form: attitudes A_k (joint 1 at -2 x 0.3 rad about z by the gear, then each ball joint's
+    # rotation vector in the link before), angular velocities W_k (ground), left ends P_k and their
+    # velocities VP_k
+    Rz = lambda a: Rotation.from_rotvec([0.0, 0.0, a]).as_matrix()
+    A, W = np.zeros((N, 3, 3)), np.zeros((N, 3))
+    A[0], W[0] = Rz(0.3), [0.0, 0.0, 0.5]
+    A[1], W[1] = A[0] @ Rz(-0.6), W[0] + A[0] @ [0.0, 0.0, -1.0]
+    R = Rotation.from_rotvec(th).as_matrix()
+    for k in range(2, N):
+        A[k], W[k] = A[k - 1] @ R[k], W[k - 1] + A[k - 1] @ om[k]
+    e = A[:, :, 0]
+    P = np.concatenate([np.zeros((1, 3)), np.cumsum(e, 0)[:-1]])
+    VP = np.concatenate([np.zeros((1, 3)), np.cumsum(np.cross(W, e), 0)[:-1]])
+    r, p, rd, wB = rep.q[s.r_idx], rep.q[s.p_idx], rep.v[s.rd_idx], rep.v[s.w_idx]
+    vref = VP + 0.5 * np.cross(W, e)
+    print(json.dumps(dict(
+        pos=float(np.abs(r - (P + 0.5 * e)).max()),
+        att=float(np.abs(Rotation.from_quat(p[:, [1, 2, 3, 0]]).as_matrix() - A).max()),
+        vel=float(np.abs(rd - vref).max() / np.abs(vref).max()),
+        omega=float(np.abs(np.einsum("kji,kj->ki", A, W) - wB).max() / np.abs(W).max()),
+        psi=rep.q[s.aux_q_idx].tolist(), psid=rep.v[s.aux_v_idx].tolist(), residual=rep.residual,
+        dof=rep.dof, nv=s.nv, nc=s.nc)))
+''')
+
+
+def test_3000_body_chain_with_a_gear_and_held_ball_joints_matches_the_closed_form():
+    """A 3,000-body chain drawn with gaps: two revolutes tied by a gear (ratio -2, the first held at
+    0.3 rad and 0.5 rad/s), then ball joints each given a rotation vector and a relative angular
+    velocity; assembled in a child process under a 1.5 GB address-space limit (one dense phi_q would be
+    1.3 GB) with the dense route refusing, against the closed form of the chain."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    proc = subprocess.run([sys.executable, "-c", GEARED], capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["nv"] == 6 * 3000 + 2 and out["nc"] == 2 * 5 + 2998 * 3 + 3 and out["dof"] == out["nv"] - out["nc"]
+    assert out["residual"] < 1e-12
+    assert out["psi"] == pytest.approx([0.3, -0.6], abs=1e-14) and out["psid"] == pytest.approx([0.5, -1.0], abs=1e-12)
+    assert out["pos"] < 1e-10 and out["att"] < 1e-12   # 3.3 km of chain
+    assert out["vel"] < 1e-12 and out["omega"] < 1e-12

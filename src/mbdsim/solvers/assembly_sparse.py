@@ -2,10 +2,12 @@
 route of a 10,000-body model's assembly).
 
 The general assembly (solvers.assembly) works on the dense constraint Jacobian.  Above SPARSE_NV velocity
-variables, a System whose rows the compiled kernel evaluates assembles here with the same steps in
-sparse form:
+variables, a System assembles here with the same steps in sparse form:
 
-- the Jacobian phi_q as a CSR matrix from the kernel's compact rows (`assembly_large.sparse_terms`);
+- the Jacobian phi_q as a CSR matrix from the kernel's compact rows, with the columns of the curve
+  parameters of point-on-curve rows and the rows of couplers, gears and user constraints
+  (`assembly_rows.sparse_terms_all`); the lock rows of joint friction only where in force (none at
+  the start);
 - the rows kept: the spanning tree's rows (independent by structure), then the loop rows and the held
   values independent of them (`system.rows.independent_rows_sparse`, dense only in loop rows x nv);
 - Newton steps least in the position metric D (diagonal): dx = D^-1 A^T (A D^-1 A^T)^-1 r with
@@ -16,14 +18,17 @@ sparse form:
   joint rates and body velocities.
 
 The held joint coordinates are the kernel's own angle and slide rows (`held.coordinate_rows`: a motion
-driver's rows without its target), so nothing is evaluated twice.  Given values that are consistent
-are held exactly, as on the dense route (the same state to round-off).  A held value dependent on the
-constraints and the values before it is not fitted in the kinetic-energy metric as on the dense route:
-its row is dropped, the others held exactly, and it is reported (InitialConditionWarning) when not met.
-`assemble_sparse` returns None (the dense route then decides, or refuses above 2 GB) for systems with
-rows the kernel does not evaluate (couplers, path constraints, joint friction), held values of joints
-with rotation-vector coordinates (spherical, universal, constant velocity), dependent tree rows at the
-drawn configuration, or more loop rows than `rows.LOOP_BYTES` allows; `sparse_reason` says which.
+driver's rows without its target), so nothing is evaluated twice, and the rotation vectors of spherical,
+universal and constant-velocity joints (`assembly_rows.rotvec_rows`, `held.joint_values`' measure).  Given
+values that are consistent are held exactly, as on the dense route (the same state to round-off).  A
+held value dependent on the constraints and the values before it is not fitted in the kinetic-energy
+metric as on the dense route: its row is dropped, the others held exactly, and it is reported
+(InitialConditionWarning) when not met.  `assemble_sparse` returns why not (a str: the dense route then
+decides, or refuses above 2 GB) for held values of a planar joint on a particle, dependent tree rows at the
+drawn configuration, or more loop rows than `rows.LOOP_BYTES` allows; `sparse_reason` says which.  The
+rows are chosen once as drawn and once more where those kept are met: a loop drawn at a singular
+configuration (a row dependent as drawn and not met) may not close here where the dense route's
+least-squares steps close it.
 """
 from __future__ import annotations
 
