@@ -6,7 +6,11 @@ it would refuse), so that success proves the sparse route took them:
   form of the chain's geometry and velocities (link k at the sum of the first k+1 angles);
 - a 2,000-body ladder of spherical joints with 20 closed loops, one drawn with its rungs short (gaps),
   one drawn hanging and simulated: each top pin carries half the weight of the ladder (symmetry).
-In process: small models give the same assembled state on the sparse and the dense route."""
+- a 3,000-body chain with a gear and held ball joints (rotation vectors and rates) under a 1.5 GB
+  limit, against the closed form of its attitudes, positions and velocities.
+In process: small models give the same assembled state on the sparse and the dense route, among them
+couplers, gears, user constraints, a point-on-curve loop, friction lock rows and held rotation vectors
+of spherical, universal and constant-velocity joints (the sparse run with the dense route refusing)."""
 import json
 import os
 import subprocess
