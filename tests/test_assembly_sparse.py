@@ -6,8 +6,13 @@ it would refuse), so that success proves the sparse route took them:
   form of the chain's geometry and velocities (link k at the sum of the first k+1 angles);
 - a 2,000-body ladder of spherical joints with 20 closed loops, one drawn with its rungs short (gaps),
   one drawn hanging and simulated: each top pin carries half the weight of the ladder (symmetry).
-In process: small models give the same assembled state on the sparse and the dense route."""
+- a 3,000-body chain with a gear and held ball joints (rotation vectors and rates) under a 1.5 GB
+  limit, against the closed form of its attitudes, positions and velocities.
+In process: small models give the same assembled state on the sparse and the dense route, among them
+couplers, gears, user constraints, a point-on-curve loop, friction lock rows and held rotation vectors
+of spherical, universal and constant-velocity joints (the sparse run with the dense route refusing)."""
 import json
+import os
 import subprocess
 import sys
 import textwrap
@@ -221,3 +226,204 @@ def test_over_driven_four_bar_named_on_the_sparse_route(monkeypatch):
         with pytest.raises(mb.AssemblyError, match="over-driven") as err:
             mb.assemble(model)
     assert "drive" in err.value.joints and "rocker_drive" in err.value.joints
+
+
+# ------------------------------------------------------------------------------ rows beyond the kernel's
+def _chain(kinds, held=None, gap=0.1, gravity=(0.0, -9.81, 0.0)):
+    """Links of 1 m along x drawn `gap` apart, joint k of kind kinds[k] (revolute and cylindrical about z,
+    universal with axes z, y; constant velocity along x) between markers at the link ends; held[k]:
+    the joint's initial_displacement / initial_velocity."""
+    m = mb.Model("chain", gravity=gravity)
+    prev = m.ground.add_marker("m0", (0.0, 0.0, 0.0))
+    for k, kind in enumerate(kinds):
+        x0 = k * (1.0 + gap) + gap
+        b = m.add_body(f"b{k}", 1.0, inertia=(0.01, 0.1, 0.1), position=(x0 + 0.5, 0.0, 0.0))
+        mi, mj = prev, b.add_marker("a", (x0, 0.0, 0.0))
+        kw = (held or {}).get(k, {})
+        if kind in ("universal", "constant_velocity"):
+            mi = mi.body.add_marker(f"u{k}", mi.point, orientation=_axes(kind, True))
+            mj = b.add_marker(f"v{k}", mj.point, orientation=_axes(kind, False))
+            j = getattr(m, "add_" + kind)(f"j{k}", mi, mj)
+            for f, x in kw.items():
+                setattr(j, f, np.asarray(x, dtype=float))
+        else:
+            getattr(m, "add_" + kind)(f"j{k}", mi, mj, **kw)
+        prev = b.add_marker("b", (x0 + 1.0, 0.0, 0.0))
+    return m
+
+
+def _axes(kind, first):
+    """Marker axes (columns x, y, z in ground) of a universal joint (z axes: ground z, then y) or a
+    constant-velocity joint (z axes both along the links, x along the bend axis z)."""
+    if kind == "universal":
+        return np.eye(3) if first else np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    return np.array([[0.0, 0.0, 1.0], [0.0, -1.0, 0.0], [1.0, 0.0, 0.0]])
+
+
+def _sparse_forced(make, monkeypatch):
+    """(dense report, sparse report, warnings of each) of fresh models: the sparse run with the dense
+    route refusing everything (DENSE_BYTES = 0), so that it cannot fall back."""
+    from mbdsim.solvers import assembly
+    reps, caught = [], []
+    for limit, dense_bytes in ((10**9, assembly.DENSE_BYTES), (0, 0)):
+        monkeypatch.setattr(assembly_sparse, "SPARSE_NV", limit)
+        monkeypatch.setattr(assembly, "DENSE_BYTES", dense_bytes)
+        with warnings.catch_warnings(record=True) as w:
+            warnings.simplefilter("always")
+            reps.append(mb.assemble(make()))
+        caught.append(sorted({type(x.message).__name__ for x in w}))
+    return reps, caught
+
+
+RNG = np.random.default_rng(11)
+SPH = {k: dict(initial_displacement=RNG.uniform(-0.5, 0.5, 3), initial_velocity=RNG.uniform(-1, 1, 3))
+       for k in range(5)}
+
+
+def _geared(kind):
+    """Revolute chain with joint 0 held, joint 1 tied to it by a gear, a rack-and-pinion coupler (a
+    translational joint's slide to a revolute's angle) or a user constraint."""
+    def make():
+        kinds = ["revolute", "revolute", "revolute", "translational" if kind == "coupler" else "revolute"]
+        m = _chain(kinds, {0: dict(initial_displacement=0.3, initial_velocity=0.5)})
+        if kind == "gear":
+            m.add_gear("g", "j0", "j1", -2.0)
+        elif kind == "coupler":
+            m.add_coupler("rack", "j2", "j3", 0.2)
+            m.joints["j2"].initial_displacement = np.array([0.4])
+        else:
+            m.add_user_constraint("u", "sin(j0) - 0.5*j1 + 0.1*j2")
+        return m
+    return make
+
+
+def _on_curve():
+    """A chain of 3 whose last link's tip is held on a circle on ground (a loop through the curve
+    parameter), drawn 0.4 m off the circle (the rows independent as drawn: the tangent there is along
+    the chain)."""
+    m = _chain(["revolute", "spherical", "spherical"], {0: dict(initial_velocity=0.4)})
+    circle = mb.Curve(lambda s: [3.3 + 0.5 * np.cos(s), 0.1 + 0.5 * np.sin(s), 0.0], (-4.0, 4.0),
+                      d1=lambda s: [-0.5 * np.sin(s), 0.5 * np.cos(s), 0.0],
+                      d2=lambda s: [-0.5 * np.cos(s), -0.5 * np.sin(s), 0.0])
+    m.add_point_on_curve("path", m.bodies["b2"].markers["b"], m.ground, circle)
+    return m
+
+
+def _with_friction():
+    m = _chain(["revolute", "translational", "revolute"], {0: dict(initial_displacement=0.2)})
+    m.add_friction("f1", "j1", 0.3, 0.2)
+    m.add_friction("f2", "j2", 0.3, 0.2, pin_radius=0.01)
+    return m
+
+
+CASES = {
+    "spherical held": lambda: _chain(["spherical"] * 5, SPH),
+    "spherical loop held": lambda: _with_rung(_chain(["spherical"] * 4, {1: SPH[1], 2: SPH[2]})),
+    "universal held": lambda: _chain(["universal", "revolute", "universal"],
+                                     {0: dict(initial_displacement=[0.0, 0.0, 0.4], initial_velocity=[0, 0, 0.7]),
+                                      1: dict(initial_displacement=-0.2),
+                                      2: dict(initial_displacement=[0.0, 0.3, 0.0], initial_velocity=[0, -0.5, 0])}),
+    "cv held": lambda: _chain(["spherical", "constant_velocity"],
+                              {1: dict(initial_displacement=[0.0, 0.0, 0.3], initial_velocity=[0.0, 0.0, 0.6])}),
+    "gear": _geared("gear"), "coupler": _geared("coupler"), "user constraint": _geared("user"),
+    "point on curve": _on_curve, "friction": _with_friction,
+}
+
+
+def _with_rung(m):
+    """A link joined to the chain's tip and to ground by spherical joints: a closed loop (3D)."""
+    r = m.add_body("rung", 1.0, inertia=(0.01, 0.1, 0.1), position=(4.4, -0.8, 0.0))
+    m.add_spherical("ra", m.bodies["b3"].markers["b"], r.add_marker("e", (4.4, -0.05, 0.0)))
+    m.add_spherical("rb", r.add_marker("f", (4.4, -1.55, 0.0)), m.ground.add_marker("g", (4.4, -1.6, 0.0)))
+    return m
+
+
+@pytest.mark.parametrize("case", list(CASES))
+def test_sparse_route_carries_couplers_paths_friction_and_rotation_vectors(case, monkeypatch):
+    """Each kind of row beyond the kernel's (couplers, gears, user constraints, the curve parameter of a
+    point-on-curve constraint, friction lock rows) and the held rotation vectors of spherical,
+    universal and constant-velocity joints: the sparse route (the dense one refusing) gives the dense
+    route's state to round-off, every held value held."""
+    (dense, sparse), (wd, ws) = _sparse_forced(CASES[case], monkeypatch)
+    assert dense.residual < 1e-12 and sparse.residual < 1e-12
+    assert np.abs(dense.q - sparse.q).max() < 1e-12 and np.abs(dense.v - sparse.v).max() < 1e-12
+    assert np.array_equal(dense.rows, sparse.rows) and dense.dof == sparse.dof
+    assert wd == ws == [] and dense.changed == sparse.changed == []
+    assert list(dense.moved) == list(sparse.moved) and len(sparse.moved)
+    s = sparse.system
+    for jt in s.model.joints.values():   # the held values are met (the dense route's measure of them)
+        from mbdsim.solvers.held import joint_values
+        x, rate, _, _, _ = joint_values(s, jt, sparse.q, sparse.v)
+        for given, got in ((jt.initial_displacement, x), (jt.initial_velocity, rate)):
+            if given is not None:
+                assert np.abs(np.asarray(got) - given).max() < 1e-12, jt.name
+
+
+GEARED = textwrap.dedent('''
+    import json, resource, sys, warnings
+    import numpy as np
+    resource.setrlimit(resource.RLIMIT_AS, (1536 * 2**20, 1536 * 2**20))   # one dense phi_q alone: 1.3 GB
+    import mbdsim as mb
+    from scipy.spatial.transform import Rotation
+    from mbdsim.solvers import assembly
+    assembly.DENSE_BYTES = 0   # the dense route refuses everything: only the sparse one can succeed
+    N, gap = 3000, 0.1
+    rng = np.random.default_rng(5)
+    th, om = rng.uniform(-0.3, 0.3, (N, 3)), rng.uniform(-1.0, 1.0, (N, 3))
+    m = mb.Model("geared", gravity=(0.0, -9.81, 0.0))
+    prev = m.ground.add_marker("m0", (0.0, 0.0, 0.0))
+    for k in range(N):
+        x0 = k * (1.0 + gap) + gap
+        b = m.add_body(f"b{k}", 1.0, inertia=(0.01, 0.1, 0.1), position=(x0 + 0.5, 0.0, 0.0))
+        a = b.add_marker("a", (x0, 0.0, 0.0))
+        if k == 0:
+            m.add_revolute("j0", prev, a, initial_displacement=0.3, initial_velocity=0.5)
+        elif k == 1:
+            m.add_revolute("j1", prev, a)
+        else:
+            m.add_spherical(f"j{k}", prev, a, initial_displacement=th[k], initial_velocity=om[k])
+        prev = b.add_marker("b", (x0 + 1.0, 0.0, 0.0))
+    m.add_gear("g", "j0", "j1", -2.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # nothing held may be changed
+        rep = mb.assemble(m)
+    s = rep.system
+    # closed form: attitudes A_k (joint 1 at -2 x 0.3 rad about z by the gear, then each ball joint's
+    # rotation vector in the link before), angular velocities W_k (ground), left ends P_k and their
+    # velocities VP_k
+    Rz = lambda a: Rotation.from_rotvec([0.0, 0.0, a]).as_matrix()
+    A, W = np.zeros((N, 3, 3)), np.zeros((N, 3))
+    A[0], W[0] = Rz(0.3), [0.0, 0.0, 0.5]
+    A[1], W[1] = A[0] @ Rz(-0.6), W[0] + A[0] @ [0.0, 0.0, -1.0]
+    R = Rotation.from_rotvec(th).as_matrix()
+    for k in range(2, N):
+        A[k], W[k] = A[k - 1] @ R[k], W[k - 1] + A[k - 1] @ om[k]
+    e = A[:, :, 0]
+    P = np.concatenate([np.zeros((1, 3)), np.cumsum(e, 0)[:-1]])
+    VP = np.concatenate([np.zeros((1, 3)), np.cumsum(np.cross(W, e), 0)[:-1]])
+    r, p, rd, wB = rep.q[s.r_idx], rep.q[s.p_idx], rep.v[s.rd_idx], rep.v[s.w_idx]
+    vref = VP + 0.5 * np.cross(W, e)
+    print(json.dumps(dict(
+        pos=float(np.abs(r - (P + 0.5 * e)).max()),
+        att=float(np.abs(Rotation.from_quat(p[:, [1, 2, 3, 0]]).as_matrix() - A).max()),
+        vel=float(np.abs(rd - vref).max() / np.abs(vref).max()),
+        omega=float(np.abs(np.einsum("kji,kj->ki", A, W) - wB).max() / np.abs(W).max()),
+        psi=rep.q[s.aux_q_idx].tolist(), psid=rep.v[s.aux_v_idx].tolist(), residual=rep.residual,
+        dof=rep.dof, nv=s.nv, nc=s.nc)))
+''')
+
+
+def test_3000_body_chain_with_a_gear_and_held_ball_joints_matches_the_closed_form():
+    """A 3,000-body chain drawn with gaps: two revolutes tied by a gear (ratio -2, the first held at
+    0.3 rad and 0.5 rad/s), then ball joints each given a rotation vector and a relative angular
+    velocity; assembled in a child process under a 1.5 GB address-space limit (one dense phi_q would be
+    1.3 GB) with the dense route refusing, against the closed form of the chain."""
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    proc = subprocess.run([sys.executable, "-c", GEARED], capture_output=True, text=True, timeout=300, env=env)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    out = json.loads(proc.stdout.strip().splitlines()[-1])
+    assert out["nv"] == 6 * 3000 + 2 and out["nc"] == 2 * 5 + 2998 * 3 + 3 and out["dof"] == out["nv"] - out["nc"]
+    assert out["residual"] < 1e-12
+    assert out["psi"] == pytest.approx([0.3, -0.6], abs=1e-14) and out["psid"] == pytest.approx([0.5, -1.0], abs=1e-12)
+    assert out["pos"] < 1e-10 and out["att"] < 1e-12   # 3.3 km of chain
+    assert out["vel"] < 1e-12 and out["omega"] < 1e-12

@@ -217,6 +217,7 @@ def test_lost_tasks_are_reported_not_stored(tmp_path):
     sink.close()
     df = sink.frame(study)
     assert list(df.status) == ["ok", "ok", "lost"] and "worker died" in df.message[2]
+    assert "run 2 lost: the Dask worker running it died" in df.message[2] and "same out= file" in df.message[2]
     assert sorted(pd.read_parquet(out).run) == [0, 1]
     assert study.run(workers=0, out=out).attrs["executed"] == 1
 

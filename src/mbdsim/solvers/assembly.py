@@ -168,9 +168,8 @@ def _assemble_state(sys: System, q0, v0, t=0.0, tol=1e-12) -> AssemblyReport:
         raise AssemblyError(f"assembly of {sys.nbody} bodies ({sys.nv} velocity variables, {sys.nc} constraint "
                             f"equations) needs dense matrices of {8.0 * sys.nv * sys.nc / 2**30:.1f} GB "
                             f"here because {solved or why_dense(sys)}; a large model assembles without "
-                            "them when the compiled kernels evaluate all its constraints (no couplers, paths "
-                            "or joint friction), its tree joints are independent and its loops close "
-                            "few rows", time=float(t))
+                            "them when its tree joints are independent as drawn and its loops (couplers and "
+                            "paths among them) close few rows", time=float(t))
     rows_all = sys.fixed_rows   # friction locks: run time
     own_q = q0 is sys.q0
     try:

@@ -129,7 +129,16 @@ def _progress(enabled, total, done):
 
 
 def _lost_rows(study, chunk, exc):
-    msg = f"{type(exc).__name__}: {exc}"
+    """Rows 'lost' for the runs of a chunk whose task Dask gave up on, the message saying why in words: a
+    worker process that died (a variant ending its process: os._exit, a crash in native code, memory)
+    takes its task and the data scattered to it with it, and Dask's own words ("FutureCancelledError ...
+    already forgotten") name neither."""
+    runs = [int(run) for run, _ in chunk]
+    span = f"run {runs[0]}" if len(runs) == 1 else f"runs {runs[0]}-{runs[-1]}"
+    msg = (f"{span} lost: the Dask worker running it died or its task was dropped (a variant that ends its "
+           "process, crashes in native code or exhausts memory does this; it may also take other runs' "
+           "tasks with it); run the study again with the same out= file to retry the lost runs, or with "
+           f"workers=0 to see a variant's own error ({type(exc).__name__}: {exc})")
     return [{"run": run, **params, **{k: math.nan for k in study.plan.outputs}, "status": "lost",
              "message": msg, "wall_time": math.nan, "worker": ""} for run, params in chunk]
 

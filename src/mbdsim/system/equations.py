@@ -180,14 +180,28 @@ def jacobians(sys, q) -> np.ndarray:
 def jacobian_blocks(sys, fr, rows):
     """Compact Jacobian rows (N, len(rows), 2, 6) of constraint `rows` at the Frames `fr` (N samples):
     block 0 on the row's frame bi, block 1 on bj (sys.derived["packed"] kinds), in the velocity
-    variables' axes; None when a row is not a kernel kind (the caller uses `jacobians`)."""
-    if not sys.kernel_rows:
+    variables' axes; None when one of `rows` is not a row the kernel evaluates as packed (a coupler's,
+    a point-on-curve's: the caller uses `jacobians`)."""
+    rows = np.asarray(rows, dtype=np.int64)
+    if not sys.kernel_rows and _outside_kernel(sys)[rows].any():
         return None
     kind, bi, bj, V, par, drv, fns = _packed(sys)
-    rows = np.asarray(rows, dtype=np.int64)
     R, A = np.ascontiguousarray(fr.r, dtype=float), np.ascontiguousarray(fr.A, dtype=float)
     return kernels.jacobian_blocks(R, A, kind[rows], bi[rows], bj[rows], np.ascontiguousarray(V[rows]),
                                    par[rows], drv[rows], len(fns), sys.frame_rigid)
+
+
+def _outside_kernel(sys):
+    """(nc,) True for the rows the kernel does not evaluate as packed (coupler and point-on-curve rows)."""
+    out = sys.derived.get("rows outside the kernel")
+    if out is None:
+        out = np.zeros(sys.nc, dtype=bool)
+        for g in sys.groups:
+            if g.kind not in kernels.KIND and g.kind != "sph":
+                out[_rows_of(g) if g.kind == "curve" else np.concatenate(
+                    [np.arange(r, r + ev.nrow) for r, ev in zip(g.row_adr, g.fns)])] = True
+        sys.derived["rows outside the kernel"] = out
+    return out
 
 
 def constraint_terms_numpy(sys, q, v, t, jacobian=True):

@@ -136,7 +136,7 @@ def compact_blocks_independent(sys, Jc, bj, blocks, thr) -> bool:
                for rows, adr, width in blocks)
 
 
-def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=None, tol=1e-9):
+def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=None, tol=1e-9, off=None):
     """`independent_rows` of all nc rows of a large System without dense (nc, nv) matrices, and of extra
     rows H of lower priority (held values), as (kept rows of J, kept rows of H), or None when the tree
     rows are dependent or the loop rows too many (more than LOOP_BYTES of dense projected rows).
@@ -147,9 +147,12 @@ def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=No
     batched SVD per block shape); an H row of a tree joint joins its block (a block that becomes
     dependent drops its H rows).  The loop rows, then the other H rows, are projected onto the null
     space of the kept tree rows (sparse normal equations, O(N) for chains and trees; the projection is
-    dense: loop rows x nv) and kept by the pivoted QR of `_tree_first_rows` (same rule, same tolerance)."""
+    dense: loop rows x nv) and kept by the pivoted QR of `_tree_first_rows` (same rule, same tolerance).
+    Rows `off` (loop rows: switched rows not in force, such as friction locks) are left out."""
     sparse, splu = lazy_import("scipy.sparse"), lazy_import("scipy.sparse.linalg").splu
     topo, tree, loop, blocks = _tree_plan(sys)
+    if off is not None and len(off):
+        loop = np.setdiff1d(loop, off)
     scale = max(1.0, float(np.max(np.abs(J.data), initial=0.0)))
     if len(tree) == 0 or not compact_blocks_independent(sys, Jc, bj, blocks, tol * scale):
         return None
@@ -164,18 +167,21 @@ def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=No
     ptr, flat = topo.blk_ptr, topo.blk_rows
     for b, hr in by_block.items():
         c = int(topo.blk_child[b])
-        width = 6 if sys.frame_rigid[c] else 3
         hard = flat[ptr[b]:ptr[b + 1]]
-        if len(hard) + len(hr) <= width:
-            shapes.setdefault((len(hard), len(hr), width), []).append((hard, hr, sys.frame_v_adr[c]))
-    for (_, _, width), items in shapes.items():
+        shapes.setdefault((len(hard), len(hr), 6 if sys.frame_rigid[c] else 3), []).append(
+            (hard, hr, sys.frame_v_adr[c]))
+    thr = tol * max(scale, hscale)
+    for (nhard, nh, width), items in shapes.items():
         adr = np.array([a for _, _, a in items])
         hard = np.array([x for x, _, _ in items]).reshape(len(items), -1)
         hr = np.array([y for _, y, _ in items])
         cols = np.concatenate([child_columns(sys, Jc, bj, hard, adr, width),
                                child_columns(sys, Hc, hbj, hr, adr, width)], axis=1)
-        ok = np.linalg.svd(cols, compute_uv=False).min(axis=1) > tol * max(scale, hscale)
+        ok = np.linalg.svd(cols, compute_uv=False).min(axis=1) > thr if nhard + nh <= width else \
+            np.zeros(len(items), dtype=bool)
         keep_h[hr[ok].ravel()] = True
+        if not ok.all():   # the others one held row at a time, each kept where independent of those before
+            keep_h[hr[~ok][_greedy_rows(cols[~ok], nhard, thr)]] = True
     tree_h = np.flatnonzero(keep_h)
     AT = sparse.vstack([J[tree]] + ([H[tree_h]] if len(tree_h) else [])).tocsr()
     extra = np.flatnonzero(hblock < 0) if m else np.zeros(0, dtype=int)
@@ -202,6 +208,24 @@ def independent_rows_sparse(sys, J, Jc, bj, H=None, Hc=None, hbj=None, hblock=No
             P -= st(R, st(R, (P @ PL.T).T, trans="T")).T @ PL
         keep_h[extra[_pivoted_rows(P, tol * hscale)]] = True
     return np.sort(np.concatenate(kept)), np.flatnonzero(keep_h)
+
+
+def _greedy_rows(cols, nhard, thr):
+    """(nb, k) mask of the rows nhard.. of the stacked small blocks cols (nb, k, width), each kept where
+    its part outside the span of the rows before it that are kept (the first nhard always) exceeds thr
+    (batched pseudo-inverse projections; the rows left out are zero rows of the span)."""
+    nb, k, width = cols.shape
+    M = np.zeros_like(cols)
+    M[:, :nhard] = cols[:, :nhard]
+    keep = np.zeros((nb, k), dtype=bool)
+    for r in range(nhard, k):
+        c = cols[:, r]
+        P = np.linalg.pinv(M, rcond=1e-12) @ M   # (nb, width, width) projector on the kept rows' span
+        out = c - np.einsum("ni,nij->nj", c, P)
+        ok = np.linalg.norm(out, axis=1) > thr
+        keep[:, r] = ok
+        M[ok, r] = c[ok]
+    return keep[:, nhard:]
 
 
 def _pivoted_rows(P, thr):
