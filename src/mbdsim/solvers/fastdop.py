@@ -69,7 +69,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     h0 = min(h0, max_step)
     for i in range(n):
         y1[i] = y0[i] + h0 * f0[i]
-    if rhs(cm, wk, t0 + h0, y1, work) != OK:
+    if rhs(cm, wk, t0 + h0, y1, work, True) != OK:
         return h0
     for i in range(n):
         work[i] = work[i] - f0[i]
@@ -237,14 +237,14 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
             for j in range(s):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
-        if rhs(cm, wk, t + C[s] * h, ys, K[s]) != OK:
+        if rhs(cm, wk, t + C[s] * h, ys, K[s], True) != OK:
             return False
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
-    return rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
+    return rhs(cm, wk, t + h, ynew, K[N_STAGES], True) == OK
 
 
 @kernel(_nrt=False)
@@ -258,7 +258,7 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
             for j in range(s):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
-        rhs(cm, wk, t + C[s] * h, ys, K[s])
+        rhs(cm, wk, t + C[s] * h, ys, K[s], True)
     for i in range(n):
         dy = ynew[i] - y[i]
         F[0, i] = dy
@@ -297,7 +297,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     if h <= 0.0:   # the start (st = [t0, 0]): f = ydot(t0, y) and Hairer's starting step, here rather than
         if cm[31][5] == 1:          # from Python, so that a run loads one kernel (not counted in stats);
             read_state(cm, wk, Y[0], y)   # a joint-coordinate tree's y from the absolute start row Y[0]
-        s_ = rhs(cm, wk, t, y, f)
+        s_ = rhs(cm, wk, t, y, f, True)
         if s_ != OK:
             return s_, iout
         h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
@@ -432,13 +432,13 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return s_, iout
             if moved:
                 stats[3] += 1
-                s_ = rhs(cm, wk, t_new, y, f)
+                s_ = rhs(cm, wk, t_new, y, f, True)
                 stats[2] += 1
             else:
                 for i in range(n):
                     f[i] = K[N_STAGES, i]
         else:
-            s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol)
+            s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol, True)
             stats[3] += 1
             if s_ != OK:
                 st[0], st[1] = t, h
@@ -472,7 +472,7 @@ def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_s
     no return to Python. YJ (len(tout), len(y)): scratch for a tree's joint states (0 columns otherwise)."""
     n = y.shape[0]
     t0 = st[0]
-    status = rhs(cm, wk, t0, y, f)
+    status = rhs(cm, wk, t0, y, f, True)
     iout = 0
     if status != OK:
         return status, 0
@@ -500,7 +500,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     nq = cm[31][0]
     n = y0.shape[0]
     ys, ynew, yo = sc[0], sc[1], sc[2]
-    if rhs(cm, wk, t0, y0, f) != OK:
+    if rhs(cm, wk, t0, y0, f, True) != OK:
         return SINGULAR
     for i in range(n):
         K[0, i] = f[i]
@@ -509,7 +509,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     _dense_coeffs(cm, wk, co, t0, h, y0, ynew, K, ys, F)
     for k in range(tq.shape[0]):
         _dense(F, y0, t0, h, tq[k], yo)
-        s_ = _project(cm, wk, tq[k], yo, 1e-12)
+        s_ = _project(cm, wk, tq[k], yo, 1e-12, True)
         if s_ != OK:
             return s_
         write_state(cm, wk, yo, Y[k], Y[k, :0])
