@@ -60,7 +60,7 @@ def _compare(model, seed=0, tol=1e-10):
     vd_ref, lam_ref = common.accelerations(sys, q, v, 0.0, rep.rows)
     cm = compile_system(sys, rep.rows)
     vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
-    assert fastdyn.accelerations(cm.arrays(), Work.for_model(cm).arrays(), 0.0, q, v, q, vd, lam) == 0
+    assert fastdyn.accelerations(cm.arrays(), Work.for_model(cm).arrays(), 0.0, q, v, q, vd, lam, True) == 0
     scale = 1.0 + np.max(np.abs(vd_ref))
     assert np.max(np.abs(vd - vd_ref)) <= tol * scale
     if len(rep.rows) == sys.nc:   # unique multipliers

@@ -70,7 +70,7 @@ def advance(s, t1, fresh, reproject, max_steps):
     cm, wk, st, y, f = s.cm, s.wk, s.st, s.y, s.f
     if reproject:
         nq = cm[31][0]
-        code = project(cm, wk, st[0], y[:nq], y[nq:], PROJECTION_TOL)
+        code = project(cm, wk, st[0], y[:nq], y[nq:], PROJECTION_TOL, True)
         if code != OK:
             return code, 1
         fresh = False

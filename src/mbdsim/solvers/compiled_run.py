@@ -436,7 +436,7 @@ def initial_step(a, w, t0, y0, f0, rtol, atol, max_step) -> float:
     h0 = min(h0, max_step)
     y1 = y0 + h0 * f0
     work = np.zeros(len(y0))
-    if fastdop.rhs(a, w, t0 + h0, y1, work) != fastdop.OK:
+    if fastdop.rhs(a, w, t0 + h0, y1, work, True) != fastdop.OK:
         return h0
     d2 = _rms(work - f0, scale) / h0
     if d1 <= 1e-15 and d2 <= 1e-15:

@@ -69,7 +69,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     h0 = min(h0, max_step)
     for i in range(n):
         y1[i] = y0[i] + h0 * f0[i]
-    if rhs(cm, wk, t0 + h0, y1, work) != OK:
+    if rhs(cm, wk, t0 + h0, y1, work, bool(True)) != OK:
         return h0
     for i in range(n):
         work[i] = work[i] - f0[i]
@@ -100,7 +100,7 @@ def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     nq = cm[31][0]
     for k in range(times.shape[0]):
         y = YJ[k] if YJ.shape[1] else Y[k, :nq]
-        if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], y, VD[k], LAM[k], True) != OK:
+        if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], y, VD[k], LAM[k], bool(True)) != OK:
             return k
     return times.shape[0]
 
@@ -237,14 +237,14 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
             for j in range(s):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
-        if rhs(cm, wk, t + C[s] * h, ys, K[s]) != OK:
+        if rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True)) != OK:
             return False
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
-    return rhs(cm, wk, t + h, ynew, K[N_STAGES]) == OK
+    return rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
 
 
 @kernel(_nrt=False)
@@ -258,7 +258,7 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
             for j in range(s):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
-        rhs(cm, wk, t + C[s] * h, ys, K[s])
+        rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True))
     for i in range(n):
         dy = ynew[i] - y[i]
         F[0, i] = dy
@@ -297,7 +297,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     if h <= 0.0:   # the start (st = [t0, 0]): f = ydot(t0, y) and Hairer's starting step, here rather than
         if cm[31][5] == 1:          # from Python, so that a run loads one kernel (not counted in stats);
             read_state(cm, wk, Y[0], y)   # a joint-coordinate tree's y from the absolute start row Y[0]
-        s_ = rhs(cm, wk, t, y, f)
+        s_ = rhs(cm, wk, t, y, f, bool(True))
         if s_ != OK:
             return s_, iout
         h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
@@ -400,7 +400,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
                 to = tout[iout]
                 _dense(F, y, t, h, to, yo)
-                s_ = _project(cm, wk, to, yo, proj_tol, False)
+                s_ = _project(cm, wk, to, yo, proj_tol, bool(False))
                 stats[3] += 1
                 if s_ != OK:
                     st[0], st[1] = t, h
@@ -417,7 +417,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 while iout > 0 and tout[iout - 1] > t_stop + 1e-14 * max(1.0, abs(t_stop)):
                     iout -= 1
                 _dense(F, y, t, h, t_stop, yo)
-                s_ = _project(cm, wk, t_stop, yo, proj_tol, False)
+                s_ = _project(cm, wk, t_stop, yo, proj_tol, bool(False))
                 stats[3] += 1
                 for i in range(n):
                     y[i] = yo[i]
@@ -432,18 +432,18 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return s_, iout
             if moved:
                 stats[3] += 1
-                s_ = rhs(cm, wk, t_new, y, f)
+                s_ = rhs(cm, wk, t_new, y, f, bool(True))
                 stats[2] += 1
             else:
                 for i in range(n):
                     f[i] = K[N_STAGES, i]
         else:
-            s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol)
+            s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol, bool(True))
             stats[3] += 1
             if s_ != OK:
                 st[0], st[1] = t, h
                 return s_, iout
-            s_ = rhs(cm, wk, t_new, y, f, False)   # the projection's factorisation is at these positions
+            s_ = rhs(cm, wk, t_new, y, f, bool(False))   # the projection's factorisation is at these positions
             stats[2] += 1
         for i in range(n):
             if not np.isfinite(y[i]):
@@ -472,7 +472,7 @@ def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_s
     no return to Python. YJ (len(tout), len(y)): scratch for a tree's joint states (0 columns otherwise)."""
     n = y.shape[0]
     t0 = st[0]
-    status = rhs(cm, wk, t0, y, f)
+    status = rhs(cm, wk, t0, y, f, bool(True))
     iout = 0
     if status != OK:
         return status, 0
@@ -500,7 +500,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     nq = cm[31][0]
     n = y0.shape[0]
     ys, ynew, yo = sc[0], sc[1], sc[2]
-    if rhs(cm, wk, t0, y0, f) != OK:
+    if rhs(cm, wk, t0, y0, f, bool(True)) != OK:
         return SINGULAR
     for i in range(n):
         K[0, i] = f[i]
@@ -509,7 +509,7 @@ def from_checkpoint(cm, wk, co, t0, h, y0, f, tq, Y, VD, LAM, K, F, sc):
     _dense_coeffs(cm, wk, co, t0, h, y0, ynew, K, ys, F)
     for k in range(tq.shape[0]):
         _dense(F, y0, t0, h, tq[k], yo)
-        s_ = _project(cm, wk, tq[k], yo, 1e-12)
+        s_ = _project(cm, wk, tq[k], yo, 1e-12, bool(True))
         if s_ != OK:
             return s_
         write_state(cm, wk, yo, Y[k], Y[k, :0])

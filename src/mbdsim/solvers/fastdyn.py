@@ -299,7 +299,10 @@ def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
 @entry(_nrt=False)
 def rhs(cm, wk, t, y, ydot, refactor=True):
     """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded). refactor=False:
-    as in `accelerations`. A joint-coordinate tree (dims[5] == 1) has y = [theta, theta_dot] and
+    as in `accelerations`. Kernels pass their flags as `bool(True)` / `bool(False)`, never a bare constant
+    or the default: numba compiles a callee once per literal (Literal[bool](True), Literal[bool](False),
+    omitted), and with this tuple of arrays each such copy of rhs, accelerations and project cost ~8-20 s
+    of a cold compile (issue 32; bench/RESULTS.md, Start-up). A joint-coordinate tree (dims[5] == 1) has y = [theta, theta_dot] and
     ydot = [theta_dot, theta_ddot] from the articulated-body algorithm (solvers.fasttree)."""
     if cm[31][5] == 1:
         return tree_rhs(cm, wk, t, y, ydot)

@@ -93,13 +93,13 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
         if status == SINGULAR:   # a singular Jacobian on the way: reported as a failed solve
             status = PROJECTION
         if status == OK:   # the rows in wk are at the converged q: the velocities directly
-            status = project_velocities(cm, wk, v, True)
+            status = project_velocities(cm, wk, v, bool(True))
             stats[3] += 1
             stats[4] += 1
         if status == OK and rows_dropped(cm, wk):
             stats[5] += 1
         if status == OK:
-            status = accelerations(cm, wk, t + h, q, v, q, vd, lam, False)
+            status = accelerations(cm, wk, t + h, q, v, q, vd, lam, bool(False))
         if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):
             forced = 0 if size <= CORR_REL * inc + CORR_ABS else forced + 1
             t += h
@@ -145,7 +145,7 @@ def _solved_at(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
     before = stats[1]
     status = advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6)
     if status == OK and stats[1] == before:
-        status = accelerations(cm, wk, st[0], q, v, q, vd, lam, True)
+        status = accelerations(cm, wk, st[0], q, v, q, vd, lam, bool(True))
         stats[4] += 1
     if status != OK:
         return status, False

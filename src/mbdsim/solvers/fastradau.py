@@ -122,7 +122,7 @@ def _jacobian(cm, wk, t, y, f, Jm, yt, ft):
         d = np.sqrt(2.220446049250313e-16 * max(1e-5, abs(y[j])))
         yt[j] = y[j] + d
         d = yt[j] - y[j]   # the step actually taken (representable)
-        s_ = rhs(cm, wk, t, yt, ft)
+        s_ = rhs(cm, wk, t, yt, ft, bool(True))
         yt[j] = y[j]
         if s_ != OK:
             return s_
@@ -164,7 +164,7 @@ def _newton(cm, wk, co, t, y, h, S, LR, LC, piv, cv, newton_tol, stats):
         for s in range(3):
             for i in range(n):
                 tmp[i] = y[i] + Z[s, i]
-            s_ = rhs(cm, wk, t + Cc[s] * h, tmp, F[s])
+            s_ = rhs(cm, wk, t + Cc[s] * h, tmp, F[s], bool(True))
             stats[2] += 1
             if s_ != OK:
                 return False, k + 1, rate, s_
@@ -223,7 +223,7 @@ def _error(cm, wk, co, t, y, f, h, S, LR, piv, rtol, atol, refilter, stats):
     if refilter and e > 1.0 and np.isfinite(e):
         for i in range(n):
             tmp[i] = y[i] + err[i]
-        s_ = rhs(cm, wk, t, tmp, err)
+        s_ = rhs(cm, wk, t, tmp, err, bool(True))
         stats[2] += 1
         if s_ != OK:
             return np.inf
@@ -262,7 +262,7 @@ def _initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     h0 = min(h0, max_step)
     for i in range(n):
         y1[i] = y0[i] + h0 * f0[i]
-    if rhs(cm, wk, t0 + h0, y1, work) != OK:
+    if rhs(cm, wk, t0 + h0, y1, work, bool(True)) != OK:
         return h0
     d2 = 0.0
     for i in range(n):
@@ -303,7 +303,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     if h <= 0.0:
         if start_row and cm[31][5] == 1:
             read_state(cm, wk, Y[0], y)
-        s_ = rhs(cm, wk, t, y, f)
+        s_ = rhs(cm, wk, t, y, f, bool(True))
         if s_ != OK:
             return s_, iout
         h = _initial_step(cm, wk, t, y, f, rtol, atol, max_step, S[17], S[16], S[18])
@@ -420,7 +420,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         while iout < tout.shape[0] and tout[iout] < t_new - tol_end:   # outputs inside the step
             to = tout[iout]
             dense(Q, y, t, h, to, yo)
-            s_ = _project(cm, wk, to, yo, proj_tol, False)   # a tree: its coordinate constraints and drivers
+            s_ = _project(cm, wk, to, yo, proj_tol, bool(False))   # a tree: its coordinate constraints and drivers
             stats[3] += 1
             if s_ != OK:
                 st[0], st[1] = t, h
@@ -433,7 +433,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             y[i] = ynew[i]
         st[6], st[7], st[8] = 1.0, t, h
         if cm[31][5] != 1 or cm[47][3].shape[0] > 1:   # a tree: only with coordinate constraints or drivers
-            s_ = _project(cm, wk, t_new, y, proj_tol)
+            s_ = _project(cm, wk, t_new, y, proj_tol, bool(True))
             stats[3] += 1
             if s_ != OK:
                 st[0], st[1] = t, h
@@ -442,7 +442,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             if not np.isfinite(y[i]):
                 st[0], st[1] = t, h
                 return NONFINITE, iout
-        s_ = rhs(cm, wk, t_new, y, f)
+        s_ = rhs(cm, wk, t_new, y, f, bool(True))
         stats[2] += 1
         if s_ != OK:
             st[0], st[1] = t_new, h

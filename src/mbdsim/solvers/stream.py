@@ -220,7 +220,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             p.unlink()
         y = run.state_of(y0)
         f = np.zeros(len(y))
-        status = fastdop.rhs(a, w, times[0], y, f)
+        status = fastdop.rhs(a, w, times[0], y, f, True)
         if status != 0:
             raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
         st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
@@ -247,7 +247,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         t_part = time.monotonic()
         # the kernels' work arrays at the carried state exactly as the step loop leaves them (the output
         # projection reuses the factorisation there): same whether the previous chunk ran in this process
-        fastdop.rhs(a, w, st[0], y, np.zeros(ns))
+        fastdop.rhs(a, w, st[0], y, np.zeros(ns), True)
         try:
             while status == 0 and iout < min(CHUNK_ROWS + 1, L):
                 saved = (st.copy(), y.copy(), f.copy(), run.stats.copy())
