@@ -52,6 +52,18 @@ def hull_planes(mesh) -> np.ndarray:
     return np.column_stack([n, d])[np.sort(idx)]
 
 
+def _edges(kind, shape) -> np.ndarray:
+    """Edges (ne, 2: local vertex rows) of a box or hull (coplanar-face diagonals left out), else none."""
+    if kind == BOX:
+        return np.array([(i, j) for i in range(8) for j in range(i + 1, 8)
+                         if np.count_nonzero(_BOX_SIGNS[i] != _BOX_SIGNS[j]) == 1], np.int64)
+    if kind == HULL:
+        m = shape.geometry.mesh
+        sharp = np.asarray(m.face_adjacency_angles) > 1e-6
+        return np.asarray(m.face_adjacency_edges, np.int64)[sharp].reshape(-1, 2)
+    return np.zeros((0, 2), np.int64)
+
+
 def _local(shape):
     """(kind, c [m], R, params, verts, planes, bounding radius) of a resolved shape in body axes."""
     from .shape import Shape
@@ -80,14 +92,15 @@ def pack_contacts(sys, elems) -> tuple:
     (ns, 6), (19) sweep order per axis (3, ns), (20) broad-phase counters (4,) (solvers.fastbroad),
     (21) per shape: triangle range and node range of its mesh (ns, 4), (22) triangles (nt, 3: rows of (7)),
     (23-26) EPA scratch (solvers.fastgjk), (27) hierarchy node boxes (nn, 6), (28) node links (nn, 4)
-    (geometry.bvh), (29) mesh contact slots (solvers.fastmesh), (30) the hierarchy walk's stack."""
+    (geometry.bvh), (29) mesh contact slots (solvers.fastmesh), (30) the hierarchy walk's stack, (31) edge
+    ranges (ns, 2) into (32) the edges of boxes and hulls (ne, 2: rows of (7); solvers.fastedges)."""
     from ..solvers.fastcontact import NREC
     from ..solvers.fastgjk import MAX_ITER
     from ..solvers.fastmesh import NSLOT
     from .bvh import build
     index, rows, verts, planes, pairs, par = {}, [], [], [], [], []
-    lbox, meta, tris, nodes, links = [], [], [], [], []
-    nv = npl = nt = nn = 0
+    lbox, meta, tris, nodes, links, eran, edges = [], [], [], [], [], [], []
+    nv = npl = nt = nn = ne = 0
     for ei, e in enumerate(elems):
         for a, b in e.pairs:
             ids = []
@@ -114,6 +127,10 @@ def pack_contacts(sys, elems) -> tuple:
                         m = (nt, nt + len(f), nn, nn + len(nb))
                         nt, nn = nt + len(f), nn + len(nb)
                     meta.append(m)
+                    ed = _edges(kind, s) + nv
+                    edges.append(ed)
+                    eran.append((ne, ne + len(ed)))
+                    ne += len(ed)
                     verts.append(v)
                     planes.append(pl)
                     nv, npl = nv + len(v), npl + len(pl)
@@ -141,7 +158,8 @@ def pack_contacts(sys, elems) -> tuple:
             np.zeros((_EPA_EDGES, 2), np.int64),
             np.concatenate(nodes).reshape(-1, 6) if nodes else np.zeros((0, 6)),
             np.concatenate(links).reshape(-1, 4) if links else np.zeros((0, 4), np.int64),
-            np.zeros((ncand * NSLOT, 9)), np.zeros(_STACK, np.int64))
+            np.zeros((ncand * NSLOT, 9)), np.zeros(_STACK, np.int64), np.array(eran, np.int64).reshape(ns, 2),
+            np.concatenate(edges).reshape(-1, 2) if edges else np.zeros((0, 2), np.int64))
 
 
 def empty_contacts() -> tuple:
@@ -151,4 +169,4 @@ def empty_contacts() -> tuple:
     return (z(0, i), z(0, i), z((0, 3)), z((0, 3, 3)), z((0, 3)), z(0), z((0, 2), i), z((0, 3)), z((0, 2), i),
             z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
             z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
-            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i))
+            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i), z((0, 2), i), z((0, 2), i))

@@ -39,6 +39,7 @@ from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
+from .fastedges import hull_edges
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
 from .fastmesh import NSLOT, mesh_points
@@ -159,6 +160,13 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, r, A, rd, w, rigid, F, rec,
                                                         nrec):
         return   # separated along an edge-edge axis, or an edge-edge contact
+    if (kind[a] == HULL or kind[b] == HULL) and (kind[a] == BOX or kind[a] == HULL) and \
+            (kind[b] == BOX or kind[b] == HULL):
+        st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, a, b, Pa, Pb, best)
+        if st == 1:
+            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, L0, L1, L2, D)
+        if st != 0:
+            return   # separated along an edge-edge axis (fastedges), or an edge-edge contact
     rs, xs = (b, a) if ref == b else (a, b)
     Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
     sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
