@@ -342,7 +342,9 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     elif len(sys.aux_q_idx):
         raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
     if len(sys.lock_rows):
-        raise NotCompiled("joint friction (stick/slip) is not compiled yet")
+        names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: see docs/theory.md 12c
+        raise NotCompiled(f"joint friction (stick/slip) is not compiled yet: {names} run on the event-driven "
+                          "reference DOP853 (force_elements/friction.py)")
     M6 = np.zeros((nf, 6, 6))
     M6[:, range(6), range(6)] = 1.0
     M6[1:, range(3), range(3)] = sys.mass[1:, None]
