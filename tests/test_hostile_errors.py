@@ -184,9 +184,10 @@ def test_dissipated_energy_of_an_hht_run_is_quick_and_balances():
                         free_length=1.5)
     res = mb.simulate(m, 1.0, 0.01, method="hht")
     assert res.success and res.stats["method"].startswith("HHT")
-    t0 = time.monotonic()
+    t0 = time.process_time()
     D = res.dissipated_energy()   # (before: every Chebyshev point a Newton solve through Result.at, ~60 s)
-    # ~1 s on an idle 2-core machine, 3 s seen with two other jobs compiling: the bound guards the 60 s
-    assert time.monotonic() - t0 < 10.0
+    # issue 35: within 2 s. CPU time of this process (not wall time: the machine is shared), so the bound
+    # is the issue's own and still guards the 60 s of the re-integrating version
+    assert time.process_time() - t0 < 2.0
     E = res.kinetic_energy() + res.potential_energy()
     assert D[-1] > 1.0 and abs((E[0] - E[-1]) - D[-1]) < 1e-3 * D[-1]
