@@ -2,37 +2,42 @@
 
 The kernels take the compiled model ``cm`` (`system.compiled.CompiledModel.arrays()`, about 50 slots,
 some of them nested tuples) and the work arrays ``wk`` (`Work.arrays()`) and read them as ``cm[9]``,
-``wk[44][2]``. Passed as numba tuples, each of about 200 arrays, every compiled function that takes them
-has some 1,400 scalar arguments (numba flattens a tuple of array structs), and numba and LLVM spend ~4 s
-on each such function (bench/RESULTS.md, Cold compile; bench/startup_tuples.py). A `Slots` holds the same
-tuple in compiled storage and reaches the kernels as one pointer: ``cm[k]`` with a literal k is a load of
-slot k from that storage (`_lower_slot`), so kernel bodies read their slots exactly as from a tuple, and
-a slot appended to `arrays()` / `Work` needs no edit here.
+``wk[44][2]``. Passed as numba tuples, of about 200 arrays each, every compiled function that takes them
+has some 1,400 scalar arguments (numba flattens a tuple of array structs into its calls), and numba's
+wrappers unbox all of them at every call from Python (bench/RESULTS.md, Cold compile;
+bench/startup_tuples.py). A `Slots` holds the tuple as numba's own in-memory form of it (each array's
+struct: meminfo, parent, nitems, itemsize, data, shape, strides; nested tuples inline, in order) in one
+buffer, and reaches the kernels as one pointer to it: ``cm[k]`` with a constant k is a load of slot k from
+that buffer (`_lower_slot`), so kernel bodies read their slots exactly as from a tuple, and a slot
+appended to `arrays()` / `Work` needs no edit here. The buffer is written here, in Python, from the
+arrays' addresses, shapes and strides: nothing is compiled to build it.
 
-Lifetime and sharing: the storage is a numba structref (`_OwnerType`, NRT-managed) holding a reference to
-every array of the tuple; the Python `Slots` keeps it and the tuple alive. The arrays are shared, not
-copied: what Python writes into them is what the kernels read. A kernel never owns a `Slots` (it is a
-plain pointer to them, no reference counting), so it must not outlive its Python `Slots`, which the
-runs hold for as long as they call kernels. In Python a `Slots` indexes, slices, iterates and has a length
-as the tuple it holds.
+Lifetime and sharing: the arrays are shared, not copied (what Python writes into them is what the
+kernels read); the `Slots` keeps them alive. Their structs carry no numba reference count (a null
+meminfo: reference counting skips them) and their array object as parent, so a kernel may read, write,
+slice and pass them on like any argument array, and must not keep them past the call (as any kernel
+argument). In Python a `Slots` indexes, slices, iterates and has a length as the tuple it holds.
 """
 from __future__ import annotations
 
 import operator
 
+import numpy as np
 from numba import typeof, types
 from numba.core import cgutils, imputils
-from numba.core.datamodel import models
-from numba.core.extending import (NativeValue, intrinsic, lower_builtin, overload, register_model,
-                                  typeof_impl, unbox)
+from numba.core.datamodel import default_manager, models
+from numba.core.extending import NativeValue, intrinsic, lower_builtin, overload, register_model, typeof_impl, unbox
 from numba.core.typing.templates import AbstractTemplate, infer, signature
-from numba.experimental import structref
 
-from ._jit import entry
+# numba's array struct, one pointer-sized word each (shape and strides: ndim words each)
+ARRAY_FIELDS = ("meminfo", "parent", "nitems", "itemsize", "data", "shape", "strides")
+if tuple(default_manager.lookup(types.float64[:, ::1])._fields) != ARRAY_FIELDS:   # pragma: no cover
+    raise ImportError("mbdsim._slots: this numba's array layout is not the one the kernels' slots are "
+                      f"written in ({ARRAY_FIELDS})")
 
 
 class SlotsType(types.Type):
-    """numba type of a `Slots` holding a tuple of type `tup`: a pointer to its compiled storage."""
+    """numba type of a `Slots` holding a tuple of type `tup`: a pointer to the tuple in memory."""
 
     def __init__(self, tup):
         self.tup = tup
@@ -42,36 +47,19 @@ class SlotsType(types.Type):
 register_model(SlotsType)(models.OpaqueModel)
 
 
-@structref.register
-class _OwnerType(types.StructRef):
-    """The compiled storage of a `Slots`: one field ``t``, the tuple."""
-
-    def preprocess_fields(self, fields):
-        return tuple((name, types.unliteral(t)) for name, t in fields)
-
-
-class _Owner(structref.StructRefProxy):
-    """Python handle on the storage (keeps it alive)."""
-
-
-structref.define_boxing(_OwnerType, _Owner)
-
-
-def _payload(tup):
-    return _OwnerType([("t", tup)]).get_data_type()
-
-
 class Slots:
-    """The tuple `t` of arrays (and nested tuples of arrays) in compiled storage: what the kernels take
-    as ``cm`` / ``wk`` (module docstring). Python indexing, slicing, ``len`` and iteration are the tuple's."""
+    """The tuple `t` of arrays (and nested tuples of arrays) in numba's in-memory form: what the kernels
+    take as ``cm`` / ``wk`` (module docstring). Python indexing, slicing, ``len`` and iteration are the tuple's."""
 
-    __slots__ = ("_t", "_owner", "_addr", "_numba_type_")
+    __slots__ = ("_t", "_buf", "_addr", "_numba_type_")
 
     def __init__(self, t):
         t = tuple(t)
-        self._t = t
-        self._owner, self._addr = _store(t)
-        self._numba_type_ = SlotsType(typeof(t))
+        self._numba_type_ = SlotsType(typeof(t))   # (also checks that numba takes every slot)
+        words = []
+        _words(t, words)
+        self._t, self._buf = t, np.array(words, dtype=np.intp)
+        self._addr = self._buf.ctypes.data
 
     def __getitem__(self, k):
         return self._t[k]
@@ -108,43 +96,21 @@ def _unbox_slots(typ, obj, c):
     return NativeValue(ptr, is_error=c.pyapi.c_api_error())
 
 
-def _own(t):
-    raise NotImplementedError   # compiled only (`_own_impl`)
-
-
-@overload(_own)
-def _own_impl(t):
-    typ = _OwnerType([("t", t)])
-
-    def impl(t):
-        s = structref.new(typ)
-        s.t = t
-        return s
-    return impl
-
-
-@intrinsic
-def _address(typingctx, s):
-    """The address of the storage's payload (its field ``t`` first)."""
-    def codegen(context, builder, sig, args):
-        ptr = structref._Utils(context, builder, sig.args[0]).get_data_pointer(args[0])
-        return builder.ptrtoint(ptr, cgutils.intp_t)
-    return types.intp(s), codegen
-
-
-@entry
-def _store(t):
-    """The storage of tuple t and its address (compiled once per tuple type, cached)."""
-    s = _own(t)
-    return s, _address(s)
+def _words(x, out: list) -> None:
+    """Append numba's in-memory form of x (an array, or a tuple of them, nested) to `out` (words)."""
+    if isinstance(x, tuple):
+        for y in x:
+            _words(y, out)
+        return
+    if not isinstance(x, np.ndarray):
+        raise TypeError(f"a kernel slot holds a {type(x).__name__}: only arrays and tuples of arrays")
+    out += (0, id(x), x.size, x.itemsize, x.ctypes.data, *x.shape, *x.strides)
 
 
 def _slot_ptr(context, builder, styp, ptr, k):
-    """Pointer to slot k in the storage that `ptr` (a SlotsType value) points to."""
-    payload = _payload(styp.tup)
-    ptype = context.data_model_manager[payload].get_value_type().as_pointer()
-    data = cgutils.create_struct_proxy(payload)(context, builder, ref=builder.bitcast(ptr, ptype))
-    return cgutils.gep_inbounds(builder, data._get_ptr_by_name("t"), 0, k)
+    """Pointer to slot k of the tuple that `ptr` (a SlotsType value) points to."""
+    tup = builder.bitcast(ptr, context.get_value_type(styp.tup).as_pointer())
+    return cgutils.gep_inbounds(builder, tup, 0, k)
 
 
 def _index(styp, k):
