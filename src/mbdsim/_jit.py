@@ -129,7 +129,7 @@ def _link_only() -> bool:
     try:
         from llvmlite import binding as ll
         from numba import _dynfunc
-        from numba.core.codegen import CPUCodeLibrary
+        from numba.core.codegen import CPUCodeLibrary, JITCPUCodegen
         from numba.core.cpu import CPUContext
         CPUCodeLibrary._finalize_dynamic_globals, CPUCodeLibrary._get_module_for_linking   # noqa: B018
     except (ImportError, AttributeError):
@@ -183,7 +183,16 @@ def _link_only() -> bool:
         library.mbdsim_link_only = True
         return library
 
+    set_env = JITCPUCodegen.set_env
+
+    def patched_set_env(self, env_name, env):
+        """numba's set_env, skipped for an environment that no module in the JIT engine defines (that of a
+        link-only kernel loaded from the cache: its callers' code holds its own copy)."""
+        if self._engine.get_global_value_address(env_name):
+            set_env(self, env_name, env)
+
     patched_get_executable.mbdsim = True
+    JITCPUCodegen.set_env = patched_set_env
     CPUContext.get_executable = patched_get_executable
     CPUCodeLibrary.serialize_using_object_code = patched_serialize
     CPUCodeLibrary._unserialize = classmethod(patched_unserialize)

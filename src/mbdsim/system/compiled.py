@@ -38,7 +38,8 @@ class NotCompiled(Exception):
 
 @dataclass(frozen=True)
 class CompiledModel:
-    """Arrays of one model for the compiled kernels; `arrays()` gives the tuple they take (order fixed)."""
+    """Arrays of one model for the compiled kernels; `arrays()` gives the slots they take (order fixed:
+    `tuple_`), as one `mbdsim._slots.Slots`."""
 
     r_idx: np.ndarray
     p_idx: np.ndarray
