@@ -165,14 +165,19 @@ class Work:
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
              (z((nf, 6)), np.zeros(3, np.int64)),
              _coord_work(cm, nf))   # 49: coordinate constraints on the tree (solvers.treecoord)
-        return cls(a)
+        work = cls(a)
+        work.__dict__["model"] = cm   # (for the slot types, `arrays`)
+        return work
 
     def arrays(self):
         """The slots wk[0..] as one `mbdsim._slots.Slots` (made once per Work; the same arrays as arrays_)."""
         s = self.__dict__.get("_slots")
         if s is None:
             from .._slots import Slots
-            s = self.__dict__["_slots"] = Slots(self.arrays_)
+            cm = self.__dict__.get("model")   # every Work of a model has the same slot types: typed once
+            s = self.__dict__["_slots"] = Slots(self.arrays_, None if cm is None else cm.__dict__.get("_work_type"))
+            if cm is not None:
+                object.__setattr__(cm, "_work_type", s._numba_type_)
         return s
 
 
