@@ -68,5 +68,9 @@ def test_copy_replace_and_bad_slots():
     dims = a[31].copy()
     c = a.replace(31, dims)
     assert c[31] is dims and c[9] is a[9] and typeof(c) == typeof(a)
+    w1, w2 = Work.for_model(cm).arrays(), Work.for_model(cm).arrays()   # typed once per model
+    assert typeof(w1) is typeof(w2) and typeof(w2) == typeof(Slots(w2._t)) and w1._addr != w2._addr
+    other = Slots((np.zeros(3), np.zeros((2, 2))), typeof(Slots((np.zeros(3), np.zeros(2)))))
+    assert typeof(other) == typeof(Slots((np.zeros(3), np.zeros((2, 2)))))   # a type of another size: retyped
     with pytest.raises(TypeError, match="only arrays and tuples of arrays"):
         Slots((np.zeros(2), [1.0]))
