@@ -27,7 +27,7 @@ def _both(model, seed=0):
     square = cm.arrays()
     dims = cm.dims.copy()
     dims[4] = 0
-    tree = square[:31] + (dims,) + square[32:]
+    tree = square.replace(31, dims)   # (Slots: the same kernel argument types as square)
     return sys, rep, cm, q, v, square, tree
 
 

@@ -26,8 +26,9 @@ from numba.core import event
 
 DELAY = 2.0          # [s] of compilation before the note appears
 # [s] a cold compilation of the step loop (fastdop.run and what it calls) on a 2-core machine, when this
-# machine has no record yet (bench/startup.py measures it)
-ESTIMATE_S = 60.0
+# machine has no record yet: the README pendulum's first simulate on an empty cache took 48 s of CPU, 73 s
+# wall on the shared 2-core VM at load 3 (issue 32 after Slots and link-only kernels; bench/RESULTS.md)
+ESTIMATE_S = 50.0
 
 
 def _times_file() -> Path:

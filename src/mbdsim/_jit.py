@@ -18,6 +18,21 @@ the rest is numba re-optimising every callee inside each caller (bench/RESULTS.m
 Both take numba's ``njit`` options (``_nrt``, ``inline``, ``error_model``, ``fastmath``, ...). Which numba
 internals this relies on: `Dispatcher.add_overload` and `_compile_for_args`, the flags
 ``no_cpython_wrapper`` / ``no_cfunc_wrapper`` and `caching.FunctionCache` (present since numba 0.49).
+
+Link-only kernels (issue 32). numba finalises every compiled function on its own: it links the modules of
+everything the function calls into the function's module, runs LLVM's full module optimisation over the
+lot and generates its machine code (kept in the cache). A wrapperless kernel is never run on its own:
+its callers link its module and optimise and generate code for it again, with theirs. So every kernel
+paid the optimisation and code generation of its whole call tree, once per level of the tree: most of a
+cold compile. `_link_only` finalises the wrapperless kernels (mbdsim's functions compiled without the
+CPython wrapper) link-only: their callees' modules linked in, each function already optimised on its own
+(numba's function passes, run as every module is added), no module optimisation and no machine code;
+their cache entries hold that module (kind "mbdsim-link-only"), which is all a caller needs. The entries
+(`entry`, and the Python-callable twins) are finalised by numba as before: LLVM optimises their whole
+call tree once, as it did at the top level before, so the machine code of a run is the same optimisation
+of the same functions. Relies on `CPUContext.get_executable`, `CPUCodeLibrary`'s `_linking_libraries`,
+`_get_module_for_linking`, `serialize_using_object_code` and `_unserialize`; MBDSIM_LINK_ONLY=0 or a numba
+without them keeps numba's finalisation (the cache directory's key records which, `_jitcache`).
 """
 from __future__ import annotations
 
@@ -25,7 +40,7 @@ from numba import njit
 from numba.core import caching
 from numba.core.registry import CPUDispatcher
 
-from ._jitcache import ENTRY_FLAGS, KERNEL_FLAGS   # (numba's cache directory and locator set on import)
+from ._jitcache import ENTRY_FLAGS, KERNEL_FLAGS, LINK_ONLY   # (numba's cache directory and locator set on import)
 
 _WRAPPERLESS = KERNEL_FLAGS
 
@@ -105,6 +120,86 @@ def entry(fn=None, **options):
         return njit(**ENTRY_FLAGS, **opts)(f)
     return wrap if fn is None else wrap(fn)
 
+
+def _link_only() -> bool:
+    """Install the link-only finalisation of the wrapperless kernels (module docstring, "Link-only");
+    False (numba's own finalisation kept) when disabled or when this numba lacks the internals used."""
+    if not LINK_ONLY:
+        return False
+    try:
+        from llvmlite import binding as ll
+        from numba import _dynfunc
+        from numba.core.codegen import CPUCodeLibrary, JITCPUCodegen
+        from numba.core.cpu import CPUContext
+        CPUCodeLibrary._finalize_dynamic_globals, CPUCodeLibrary._get_module_for_linking   # noqa: B018
+    except (ImportError, AttributeError):
+        return False
+    if getattr(CPUContext.get_executable, "mbdsim", False):
+        return True
+    get_executable = CPUContext.get_executable
+    serialize = CPUCodeLibrary.serialize_using_object_code
+    unserialize = CPUCodeLibrary._unserialize.__func__
+
+    def wrapperless(library, fndesc) -> bool:
+        """An mbdsim kernel compiled without the CPython wrapper (no entry point to generate)."""
+        if not (fndesc.modname or "").startswith("mbdsim.") or getattr(library, "_finalized", True):
+            return False
+        names = {f.name for f in library._final_module.functions if not f.is_declaration}
+        return fndesc.llvm_func_name in names and fndesc.llvm_cpython_wrapper_name not in names
+
+    def finalize_link_only(library):
+        """numba's finalize without its module optimisation and machine code: the callee modules linked
+        in (so that a caller links this module alone), nothing added to the JIT engine."""
+        seen = set()
+        for lib in library._linking_libraries:
+            if lib not in seen:
+                library._reload_init.update(lib._reload_init)
+                seen.add(lib)
+                library._final_module.link_in(lib._get_module_for_linking(), preserve=True)
+        library._finalize_dynamic_globals()
+        library._finalized = True
+        library.mbdsim_link_only = True
+
+    def patched_get_executable(self, library, fndesc, env):
+        if getattr(library, "mbdsim_link_only", False) or wrapperless(library, fndesc):
+            if not library._finalized:
+                finalize_link_only(library)
+            return _dynfunc.make_function(fndesc.lookup_module(), fndesc.qualname.split(".")[-1],
+                                          f"compiled wrapperless kernel {fndesc.qualname!r}", 0, env, (library,))
+        return get_executable(self, library, fndesc, env)
+
+    def patched_serialize(self):
+        if getattr(self, "mbdsim_link_only", False):
+            return (self.name, "mbdsim-link-only", self._get_module_for_linking().as_bitcode())
+        return serialize(self)
+
+    def patched_unserialize(cls, codegen, state):
+        name, kind, data = state
+        if kind != "mbdsim-link-only":
+            return unserialize(cls, codegen, state)
+        library = codegen.create_library(name)
+        library._final_module = library._shared_module = ll.parse_bitcode(data)
+        library._finalized = True
+        library.mbdsim_link_only = True
+        return library
+
+    set_env = JITCPUCodegen.set_env
+
+    def patched_set_env(self, env_name, env):
+        """numba's set_env, skipped for an environment that no module in the JIT engine defines (that of a
+        link-only kernel loaded from the cache: its callers' code holds its own copy)."""
+        if self._engine.get_global_value_address(env_name):
+            set_env(self, env_name, env)
+
+    patched_get_executable.mbdsim = True
+    JITCPUCodegen.set_env = patched_set_env
+    CPUContext.get_executable = patched_get_executable
+    CPUCodeLibrary.serialize_using_object_code = patched_serialize
+    CPUCodeLibrary._unserialize = classmethod(patched_unserialize)
+    return True
+
+
+LINKED_ONLY = _link_only()
 
 from . import _compilenote  # noqa: E402 - after the decorators: the note on long compilations (issue 32)
 

@@ -38,17 +38,20 @@ KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.p
                   "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
                   "solvers/pycall.py", "cosim/_stepper.py", "solvers/fastnarrow.py", "solvers/fastcontact.py",
                   "solvers/treecoord.py", "solvers/fastradau.py", "solvers/fastbroad.py", "solvers/fastgjk.py",
-                  "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py")
+                  "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py", "_slots.py")
 
 
 # numba's flags of mbdsim's two kinds of kernels (mbdsim._jit: @kernel, @entry); numba's index does not record
 # them, so they are part of the cache directory's key
 KERNEL_FLAGS = {"no_cpython_wrapper": True, "no_cfunc_wrapper": True}
 ENTRY_FLAGS = {"no_cfunc_wrapper": True}
+# the wrapperless kernels are finalised link-only (mbdsim._jit: no module optimisation or machine code of their
+# own; their cache entries hold the module their callers link); MBDSIM_LINK_ONLY=0 restores numba's finalisation
+LINK_ONLY = os.environ.get("MBDSIM_LINK_ONLY", "1") != "0"
 
 
 def _digest() -> str:
-    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()))).encode())
+    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()), LINK_ONLY)).encode())
     for rel in KERNEL_SOURCES:
         p = _HERE / rel
         if p.exists():

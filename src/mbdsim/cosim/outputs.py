@@ -48,8 +48,8 @@ class ExprPrograms:
         for name, k in places:
             slots[name].append((ex[14], k))
         a, w = cm.arrays(), run.work.arrays()
-        self._a = a[:43] + (ex,) + a[44:]
-        self._w = w[:44] + (exprloads_pack.work(ex, stack),) + w[45:]
+        self._a = a.replace(43, ex)   # (Slots: the kernels' argument types stay those of the run's)
+        self._w = w.replace(44, exprloads_pack.work(ex, stack))
         self.arrays = (self._a, self._w)
         self._eval = Bound(fastdop._sensor_g)
 

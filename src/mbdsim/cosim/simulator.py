@@ -29,6 +29,7 @@ from ..errors import ModelError, SolverError
 from ..solvers import fastdop, pyloads
 from ..solvers.fastdyn import INTERRUPTED
 from . import _stepper
+from .._slots import Slots
 from ._fastcall import Bound
 
 if TYPE_CHECKING:
@@ -54,12 +55,12 @@ class SimulatorState:
 
 def _copy(x):
     """A deep copy of nested tuples of arrays."""
-    return tuple(_copy(a) for a in x) if isinstance(x, tuple) else np.array(x, copy=True)
+    return tuple(_copy(a) for a in x) if isinstance(x, (tuple, Slots)) else np.array(x, copy=True)
 
 
 def _put(dst, src):
     """Copy nested tuples of arrays `src` into `dst` in place."""
-    if isinstance(dst, tuple):
+    if isinstance(dst, (tuple, Slots)):
         for d, s in zip(dst, src):
             _put(d, s)
     else:

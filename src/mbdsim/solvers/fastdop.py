@@ -57,7 +57,7 @@ def _rms(x, scale):
     return np.sqrt(s / x.shape[0])
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator;
     work, scale, y1: scratch vectors of the state's size."""
@@ -81,7 +81,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     return min(100.0 * h0, h1, max_step)
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _project(cm, wk, t, y, tol, exact_factor=True):
     """`fastdyn.project` of the state y = [q, v], or on the joint-coordinate tree the projection onto its
     coordinate constraints (solvers.treecoord; nothing to do without them); status."""
@@ -120,7 +120,7 @@ def _dense(F, y_old, t_old, h, t, out):
         out[i] += y_old[i]
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _sensor_g(cm, wk, t, y, yo, g):
     """Each expression sensor's signal minus its threshold at the integrator's state y at t [s] into g
     (frames computed here from y: the tree's forward kinematics, or the absolute coordinates with the
@@ -138,7 +138,7 @@ def _sensor_g(cm, wk, t, y, yo, g):
     sensor_values(cm[43], wk[44], t, yo, r, A, rd, w, g)
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
     """The time [s] in (t0, t0 + h] at which sensor k's value changes sign on the dense output (F, y0) of
     the step from t0, by the Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the
@@ -180,7 +180,7 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
     return 0.5 * (a + b)
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
     """Sensors after the accepted step (t, h) from y to ynew: each sign change of a sensor's value since the
     last accepted step is located on the step's dense output (F, computed here unless have_F); a crossing
@@ -225,7 +225,7 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
     return t_stop, have_F
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _stages(cm, wk, co, t, h, y, K, ys, ynew):
     """The 12 stages of a DOP853 step from y (K[0] = f(t, y) given), ynew and K[12] = f(t + h, ynew);
     False when an evaluation failed."""
@@ -247,7 +247,7 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
     return rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
 
 
-@kernel(_nrt=False)
+@kernel(_nrt=False, inline="always")
 def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
     """The 7th-order dense output coefficients F (7, n) of an accepted step (3 more evaluations)."""
     A, C, D = co[0], co[2], co[5]

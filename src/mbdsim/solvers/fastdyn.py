@@ -1,9 +1,12 @@
 """Compiled equations of motion: right-hand side, projections and accelerations at one state (numba).
 
 State y = [q, v] (system layout, docs/theory.md section 1). Every kernel takes the immutable compiled
-model `cm` (a tuple of arrays, `system.compiled.CompiledModel.arrays()`) and a per-run work tuple `wk`
-(`system.compiled.Work.arrays()`); see those for the field order. Loads and solves use six slots per
-frame: CM translation in ground axes [N, m/s^2], rotation in body axes [N m, rad/s^2].
+model `cm` (`system.compiled.CompiledModel.arrays()`) and the per-run work arrays `wk`
+(`system.compiled.Work.arrays()`), each a `mbdsim._slots.Slots`: one pointer, read as a tuple (``cm[9]``,
+``wk[44][2]``, constant indices); see those for the slot order. Loads and solves use six slots per
+frame: CM translation in ground axes [N, m/s^2], rotation in body axes [N m, rad/s^2]. `rhs`,
+`accelerations` and `project` are wrapperless kernels (mbdsim._jit): a call from Python goes to their
+Python-callable twins.
 """
 from __future__ import annotations
 
@@ -217,7 +220,7 @@ def rows_dropped(cm, wk):
     return wk[41][0] < wk[46].shape[0]
 
 
-@entry(_nrt=False)
+@kernel(_nrt=False)
 def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     """vd (nv) and lam (nc, zero at inactive rows) from the equations of motion at (q, v, t); status.
     y: the state the loads read (`loads_into`): q itself on the absolute path, the joint-coordinate state
@@ -296,7 +299,7 @@ def qdot_kernel(r_idx, p_idx, rd_idx, w_idx, q, v, qd):
         qd[p_idx[k, 3]] = 0.5 * (e0 * z + e1 * y - e2 * x)
 
 
-@entry(_nrt=False)
+@kernel(_nrt=False)
 def rhs(cm, wk, t, y, ydot, refactor=True):
     """ydot = [qdot, vd] at (t, y); returns a status code (OK when the solve succeeded). refactor=False:
     as in `accelerations`. Kernels pass their flags as `bool(True)` / `bool(False)`, never a bare constant
@@ -469,7 +472,7 @@ def newton_positions(cm, wk, t, q, v, tol):
     return PROJECTION, size, nfactor
 
 
-@entry(_nrt=False)
+@kernel(_nrt=False)
 def project(cm, wk, t, q, v, tol, exact_factor=True):
     """Project q onto phi(q, t) = 0 (`newton_positions`) and v onto phi_q v = nu.
     Leaves in wk the factorisation at the projected q (see `accelerations(refactor=False)`); with

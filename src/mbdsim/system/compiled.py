@@ -38,7 +38,8 @@ class NotCompiled(Exception):
 
 @dataclass(frozen=True)
 class CompiledModel:
-    """Arrays of one model for the compiled kernels; `arrays()` gives the tuple they take (order fixed)."""
+    """Arrays of one model for the compiled kernels; `arrays()` gives the slots they take (order fixed:
+    `tuple_`), as one `mbdsim._slots.Slots`."""
 
     r_idx: np.ndarray
     p_idx: np.ndarray
@@ -101,7 +102,18 @@ class CompiledModel:
     #                           user constraints: system.jointtree.coord_arrays, solvers.treecoord)
     coord_stack: int = 4      # stack size of their programs
 
-    def arrays(self) -> tuple:
+    def arrays(self):
+        """The slots cm[0..] the kernels take (`tuple_`'s order), as one `mbdsim._slots.Slots` (made once per
+        model: the kernels receive it as one pointer; Python indexes it as the tuple)."""
+        s = self.__dict__.get("_slots")
+        if s is None:
+            from .._slots import Slots
+            s = Slots(self.tuple_())
+            object.__setattr__(self, "_slots", s)   # (frozen dataclass: a cache, not a field)
+        return s
+
+    def tuple_(self) -> tuple:
+        """The kernels' slots as a plain tuple (order fixed; append new slots at the end)."""
         t = self.topo
         topo = (t.order, t.pblk, t.blk_child, t.blk_parent, t.blk_ptr, t.blk_rows, t.ch_ptr, t.ch_blk,
                 t.loop_rows)
@@ -153,10 +165,20 @@ class Work:
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
              (z((nf, 6)), np.zeros(3, np.int64)),
              _coord_work(cm, nf))   # 49: coordinate constraints on the tree (solvers.treecoord)
-        return cls(a)
+        work = cls(a)
+        work.__dict__["model"] = cm   # (for the slot types, `arrays`)
+        return work
 
-    def arrays(self) -> tuple:
-        return self.arrays_
+    def arrays(self):
+        """The slots wk[0..] as one `mbdsim._slots.Slots` (made once per Work; the same arrays as arrays_)."""
+        s = self.__dict__.get("_slots")
+        if s is None:
+            from .._slots import Slots
+            cm = self.__dict__.get("model")   # every Work of a model has the same slot types: typed once
+            s = self.__dict__["_slots"] = Slots(self.arrays_, None if cm is None else cm.__dict__.get("_work_type"))
+            if cm is not None:
+                object.__setattr__(cm, "_work_type", s._numba_type_)
+        return s
 
 
 def _coord_work(cm, nf) -> tuple:
