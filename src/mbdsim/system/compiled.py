@@ -15,7 +15,7 @@ import numpy as np
 from ..model.contacts import ShapeContact
 from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
-from . import exprloads_pack, jointtree, loopcoords, packing
+from . import exprloads_pack, jointtree, loopcoords, packing, pathcoords
 from .measures import locate
 from .topology import Topology, system_topology
 
@@ -104,6 +104,8 @@ class CompiledModel:
     #                           system.loopcoords, solvers.loopcoord); 48, 49 are kept for joint friction
     #                           and point-on-curve parameters
     loop_stack: int = 4       # stack size of their programs
+    paths: tuple = ()         # arrays()[49]: point-on-curve constraints (system.pathcoords, solvers.pathcoord)
+    path_stack: int = 4
 
     def arrays(self) -> tuple:
         t = self.topo
@@ -118,7 +120,7 @@ class CompiledModel:
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
                 self.shape_contacts or _shape_contacts(None, ()), self.coords or jointtree.empty_coords(),
-                np.zeros(0), np.zeros(0), self.loop_coords or loopcoords.empty())
+                np.zeros(0), self.paths or pathcoords.empty(), self.loop_coords or loopcoords.empty())
 
 
 @dataclass
@@ -158,7 +160,8 @@ class Work:
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
              (z((nf, 6)), np.zeros(3, np.int64)),
              _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
-             z(0), z(0),            # 50, 51: kept for joint friction and point-on-curve parameters
+             z(0),                  # 50: kept for joint friction
+             pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
              loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack))   # 52: solvers.loopcoord
         return cls(a)
 
@@ -339,7 +342,8 @@ def compile_system(sys, rows, state=None) -> CompiledModel:
 def _compile_system(sys, rows, state) -> CompiledModel:
     nf = sys.nbody + 1
     rows = np.asarray(rows, dtype=np.int64)
-    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
+    paths = len(getattr(sys.model, "path_constraints", {})) > 0   # (absolute coordinates: solvers.pathcoord)
+    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE or paths else \
         jointtree.tree_arrays(sys, rows, *state)
     coords, cstack = jointtree.coord_arrays(sys, tree, *state) if mode == 1 else (jointtree.empty_coords(), 4)
     tree_coords = mode == 1 and len(coords[3]) > 1
@@ -347,8 +351,6 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         rows = rows[~np.isin(rows, jointtree.coord_rows(sys))]   # the absolute solve of the outputs skips them
     elif getattr(sys, "not_compiled", None):   # issue 11: rows the kernels do not evaluate, callable sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
-    elif len(getattr(sys.model, "path_constraints", {})):
-        raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
     if len(sys.lock_rows):
         names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: see docs/theory.md 12c
         raise NotCompiled(f"joint friction (stick/slip) is not compiled yet: {names} run on the event-driven "
@@ -366,6 +368,9 @@ def _compile_system(sys, rows, state) -> CompiledModel:
     lc, lstack = (loopcoords.empty(), 4) if tree_coords else loopcoords.pack(sys, bi, bj)
     if len(lc[0]):   # couplers in absolute coordinates (issue 29): the link rows are not solved for
         rows = rows[~np.isin(rows, loopcoords.link_rows(sys))]
+    pc, pstack = pathcoords.pack(sys) if paths else (pathcoords.empty(), 4)
+    if paths:        # point-on-curve: the tangential rows are residuals only
+        rows = rows[~np.isin(rows, pathcoords.tangent_rows(sys))]
     code, consts, tables, start, end, stack, pyd, dslots = _driver_programs(fns)
     dense = int(_singular_masses(M6[1:]))
     if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
@@ -386,7 +391,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack)
+                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack, pc, pstack)
 
 
 def _candidates(sys, topo) -> np.ndarray:
@@ -398,4 +403,5 @@ def _candidates(sys, topo) -> np.ndarray:
     if full is None or not np.array_equal(np.sort(full.blk_rows), np.sort(topo.blk_rows)):
         return np.asarray(topo.loop_rows, dtype=np.int64).copy()
     loop = np.asarray(full.loop_rows, dtype=np.int64)
-    return loop[~np.isin(loop, loopcoords.link_rows(sys))].copy()   # (couplers' link rows: never solved for)
+    skip = np.concatenate([loopcoords.link_rows(sys), pathcoords.tangent_rows(sys)])   # never solved for
+    return loop[~np.isin(loop, skip)].copy()
