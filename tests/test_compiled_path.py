@@ -95,3 +95,20 @@ def test_straight_spline_uniform_acceleration_compiled():
     x = res.position("bead") @ u
     ref = 0.5 * res.time + 0.5 * (G * 0.8) * res.time ** 2
     assert np.max(np.abs(x - ref)) < 1e-6 * abs(ref[-1])
+
+
+def test_helix_compiled_parameter_and_constraint_force():
+    """Compiled expression helix at a tight tolerance: the curve parameter s (an auxiliary coordinate of the
+    state, synced to the foot point) follows the closed form, and the path's multipliers are the ground-axes
+    constraint force on the bead, lambda = m (g - a) (M vd + phi_q^T lambda = F, phi = P - C(s))."""
+    res = mb.simulate(bead_on(mb.Curve(HELIX, (-4, 3))), T_END, output_step=0.05, rtol=1e-10, atol=1e-12)
+    assert "(compiled)" in res.stats["method"]
+    sys_ = res.system
+    s = np.asarray(res.q)[:, sys_.aux_q_idx[0]]
+    assert np.max(np.abs(s - (0.5 + SD0 * res.time + 0.5 * SDD * res.time ** 2))) < 1e-9
+    lam = np.asarray(res.lambda_)[:, sys_.owner_rows["path"]]
+    a = np.asarray(res.vd)[:, sys_.rd_idx[0]]
+    F = 0.2 * (np.array([0.0, 0.0, -G]) - a)
+    assert np.max(np.abs(lam - F)) < 1e-9 * np.max(np.abs(F))
+    T = np.stack([-R * np.sin(s), R * np.cos(s), np.full_like(s, C)], -1)
+    assert np.max(np.abs(np.sum(lam * T, -1))) < 1e-9   # frictionless: no force along the curve
