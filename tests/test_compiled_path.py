@@ -112,3 +112,33 @@ def test_helix_compiled_parameter_and_constraint_force():
     assert np.max(np.abs(lam - F)) < 1e-9 * np.max(np.abs(F))
     T = np.stack([-R * np.sin(s), R * np.cos(s), np.full_like(s, C)], -1)
     assert np.max(np.abs(np.sum(lam * T, -1))) < 1e-9   # frictionless: no force along the curve
+
+
+def _bead_on_a_spinning_drum():
+    """A helix fixed on a drum that turns freely about z (body i moves: the curve's w_i terms), the bead
+    starting with the drum's rate; conservative."""
+    m = mb.Model("drum", gravity=(0, 0, -G))
+    drum = m.add_body("drum", 2.0, inertia=(0.05, 0.05, 0.08), position=(0, 0, 0))
+    m.add_revolute("z", m.ground, drum, (0, 0, 0), (0, 0, 1), initial_velocity=3.0)
+    P = np.array([R * np.cos(0.5), R * np.sin(0.5), C * 0.5])
+    bead = m.add_particle("bead", 0.2, position=P, velocity=np.cross([0, 0, 3.0], P))
+    m.add_point_on_curve("path", bead.add_marker("c"), drum, mb.Curve(HELIX, (-20, 5)))
+    return m
+
+
+def test_helix_on_a_spinning_drum_compiled_conserves_energy_and_matches_the_reference_rows(monkeypatch):
+    import mbdsim.solvers.dynamic as dynamic
+    kw = dict(output_step=0.05, rtol=1e-10, atol=1e-12)
+    a = mb.simulate(_bead_on_a_spinning_drum(), T_END, **kw)
+    assert "(compiled)" in a.stats["method"]
+    E = a.kinetic_energy() + a.potential_energy()
+    assert np.ptp(E) < 1e-9 * np.max(np.abs(E))
+    s = np.asarray(a.q)[:, a.system.aux_q_idx[0]]
+    assert s.min() < -np.pi                               # the bead runs down more than half a turn
+    monkeypatch.setattr(dynamic, "USE_COMPILED", False)   # the reference rows (three rows and an s column)
+    b = mb.simulate(_bead_on_a_spinning_drum(), T_END, method="dop853", **kw)
+    assert "compiled" not in b.stats["method"]
+    assert np.max(np.abs(a.position("bead") - b.position("bead"))) < 1e-9
+    assert np.max(np.abs(a.joint_coordinate("z") - b.joint_coordinate("z"))) < 1e-9
+    rows = a.system.owner_rows["path"]
+    assert np.max(np.abs(np.asarray(a.lambda_)[:, rows] - np.asarray(b.lambda_)[:, rows])) < 1e-8
