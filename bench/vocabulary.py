@@ -165,6 +165,12 @@ def line_bead():
     return bead(mb.Spline([k * u for k in np.linspace(-1.0, 20.0, 7)]), 1.0 / 6.0, 0.5 * u)
 
 
+def line_expr_bead():
+    """Bead on the same straight line written as expression strings in s (compiled, as the helix)."""
+    u = np.array([0.6, 0.0, -0.8])
+    return bead(mb.Curve(("0.6*s", "0*s", "-0.8*s"), (-1.0, 20.0)), 1.0, 0.5 * u)
+
+
 def timed(fn):
     fn()
     ts = []
@@ -205,6 +211,8 @@ CASES = [
      lambda: geared_four_bar(True), lambda: geared_four_bar(False), "simulate", ("O", "C")),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
+    ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,
+     line_expr_bead, "simulate", ()),
 ]
 
 
