@@ -74,8 +74,7 @@ def test_python_callable_agrees_with_expression_curve():
     assert np.allclose(a.position("bead"), b.position("bead"), atol=1e-8)
 
 
-@pytest.mark.parametrize("kind", ["expression", pytest.param("callable", marks=pending_compiled),
-                                  pytest.param("spline", marks=pending_compiled)])
+@pytest.mark.parametrize("kind", ["expression", pytest.param("callable", marks=pending_compiled), "spline"])
 def test_helix_default_settings_compiled(kind):
     curve = {"expression": lambda: mb.Curve(HELIX, (-4, 3)), "callable": lambda: mb.Curve(helix, (-4, 3)),
              "spline": lambda: mb.Spline([helix(s) for s in np.linspace(-4, 3, 141)])}[kind]()
@@ -84,7 +83,6 @@ def test_helix_default_settings_compiled(kind):
     assert angle_error(res) < 1e-6   # spline of 141 knots: 2.6e-8 (h^4, 1.4e-9 at 281)
 
 
-@pending_compiled
 def test_straight_spline_uniform_acceleration_compiled():
     u = np.array([0.6, 0.0, -0.8])
     m = mb.Model("slide", gravity=(0, 0, -G))

@@ -17,12 +17,14 @@ from ..system.kernels import _put, _sph_row, row_rate
 def _curve(pc, pw, p, s):
     """c, c', c'' of constraint p at parameter s in body-i axes into pw[8][p] (rows 0, 1, 2)."""
     x, stack, out = pw[0], pw[1], pw[8]
-    x[0] = s
-    for m in range(3):
-        for k in range(3):
-            b = 9 * p + 3 * m + k
-            u = eval_program(pc[8], pc[9], pc[10], pc[11][b], pc[12][b], x, stack)
-            out[p, m, k] = u
+    if pc[13][p] == 1:
+        _spline(pc, p, s, out)
+    else:
+        x[0] = s
+        for m in range(3):
+            for k in range(3):
+                b = 9 * p + 3 * m + k
+                out[p, m, k] = eval_program(pc[8], pc[9], pc[10], pc[11][b], pc[12][b], x, stack)
     A0T, r0 = pc[4], pc[5]
     for m in range(3):
         v0, v1, v2 = out[p, m, 0], out[p, m, 1], out[p, m, 2]
@@ -30,6 +32,33 @@ def _curve(pc, pw, p, s):
             v0, v1, v2 = v0 - r0[p, 0], v1 - r0[p, 1], v2 - r0[p, 2]
         for k in range(3):
             out[p, m, k] = A0T[p, k, 0] * v0 + A0T[p, k, 1] * v1 + A0T[p, k, 2] * v2
+
+
+@kernel(_nrt=False)
+def _spline(pc, p, s, out):
+    """C, C', C'' [m, ground axes at t = 0] of constraint p's cubic spline at s into out[p] (rows 0, 1, 2): the
+    segment found by bisection, the end segments extrapolated (a closed spline: s taken modulo its length)."""
+    c0, c1 = pc[14][p], pc[14][p + 1]
+    b0 = c0 + p
+    br, cf = pc[15], pc[16]
+    nseg = c1 - c0
+    x0, xe = br[b0], br[b0 + nseg]
+    if pc[17][p] == 1:
+        s = x0 + (s - x0) % (xe - x0)
+    lo, hi = 0, nseg - 1
+    while lo < hi:
+        mid = (lo + hi + 1) // 2
+        if br[b0 + mid] <= s:
+            lo = mid
+        else:
+            hi = mid - 1
+    i = c0 + lo
+    u = s - br[b0 + lo]
+    for k in range(3):
+        a3, a2, a1, a0 = cf[i, 0, k], cf[i, 1, k], cf[i, 2, k], cf[i, 3, k]
+        out[p, 0, k] = ((a3 * u + a2) * u + a1) * u + a0
+        out[p, 1, k] = (3.0 * a3 * u + 2.0 * a2) * u + a1
+        out[p, 2, k] = 6.0 * a3 * u + 2.0 * a2
 
 
 @kernel(_nrt=False)

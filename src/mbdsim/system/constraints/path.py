@@ -10,7 +10,7 @@ s_dot after the body coordinates, see System.aux_q_idx / aux_v_idx).  Rows (3, g
     (phi_dd = J vd + quad, gamma = -quad).
 
 These rows serve the reference path; the compiled core solves their two normal components at the foot
-point instead (system.pathcoords, solvers.pathcoord; expression curves).
+point instead (system.pathcoords, solvers.pathcoord; expression curves and splines).
 """
 from __future__ import annotations
 
