@@ -7,8 +7,9 @@ sdd = -g c / (R^2 + c^2) (uniform angular acceleration) and z(t) = z0 + c (sd0 t
 A straight line C = u s (|u| = 1): sdd = g_along = -g u_z.
 
 The tests marked `pending_compiled` state the issue's contract (default settings, 'compiled' in
-res.stats["method"], 1e-6 relative); they are strict xfails until the kernel rows land, so they
-fail loudly (XPASS) once it works and the marker must then be removed.
+res.stats["method"], 1e-6 relative). Expression curves and splines run compiled (solvers.pathcoord); the
+Python-callable curve is a strict xfail until it does, so it fails loudly (XPASS) once it works and the
+marker must then be removed.
 """
 from __future__ import annotations
 
@@ -20,7 +21,7 @@ import mbdsim as mb
 G, R, C, SD0, T_END = 9.81, 0.3, 0.1, 2.0, 1.0
 SDD = -G * C / (R ** 2 + C ** 2)
 HELIX = ("0.3*cos(s)", "0.3*sin(s)", "0.1*s")
-pending_compiled = pytest.mark.xfail(strict=True, reason="issue 29: point-on-curve rows are not compiled yet")
+pending_compiled = pytest.mark.xfail(strict=True, reason="issue 29: Python-callable curves are not compiled yet")
 
 
 def helix(s):
@@ -140,3 +141,21 @@ def test_helix_on_a_spinning_drum_compiled_conserves_energy_and_matches_the_refe
     assert np.max(np.abs(a.joint_coordinate("z") - b.joint_coordinate("z"))) < 1e-9
     rows = a.system.owner_rows["path"]
     assert np.max(np.abs(np.asarray(a.lambda_)[:, rows] - np.asarray(b.lambda_)[:, rows])) < 1e-8
+
+
+def test_closed_spline_bead_runs_round_compiled_at_constant_speed():
+    """A bead on a closed spline circle (r = 0.3 m, horizontal, gravity normal to it) at 2 m/s runs round
+    more than once (the parameter continues past the spline's length; the kernel takes it modulo the length):
+    constant speed and radius (a frictionless curve does no work)."""
+    pts = [(R * np.cos(a), R * np.sin(a), 0.0) for a in np.linspace(0, 2 * np.pi, 73)[:-1]]
+    m = mb.Model("ring", gravity=(0, 0, -G))
+    bead = m.add_particle("bead", 0.2, position=pts[0], velocity=(0.0, 2.0, 0.0))
+    m.add_point_on_curve("ring", bead.add_marker("c"), m.ground, mb.Spline(pts, closed=True))
+    res = mb.simulate(m, 1.5, output_step=0.01, rtol=1e-10, atol=1e-12)
+    assert "(compiled)" in res.stats["method"]
+    p, v = res.position("bead"), res.velocity("bead")
+    assert np.max(np.abs(np.linalg.norm(v, axis=1) - 2.0)) < 1e-7
+    assert np.max(np.abs(np.linalg.norm(p[:, :2], axis=1) - R)) < 1e-6   # the spline's own radius error
+    assert np.max(np.abs(p[:, 2])) < 1e-12
+    s = np.asarray(res.q)[:, res.system.aux_q_idx[0]]
+    assert s[-1] > 1.2 * m.path_constraints["ring"].curve.s_range[1]   # more than one lap
