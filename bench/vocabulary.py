@@ -112,6 +112,39 @@ def gear_train(geared):
     return m
 
 
+def geared_four_bar(geared):
+    """Four-bar of 3D revolutes (crank 0.1, coupler 0.3, rocker 0.25, ground link 0.3 m; a closed loop: absolute
+    coordinates) falling under gravity -y with the crank geared (ratio -2) to a flywheel of axial inertia Jf;
+    baseline: the same four-bar with the flywheel's reflected inertia r^2 Jf added to the crank (same motion)."""
+    from scipy.spatial.transform import Rotation
+    A_, B_, C_, D_, th1, r, Jf = 0.1, 0.3, 0.25, 0.3, np.radians(60.0), -2.0, 2e-4
+    e = lambda a: np.array([np.cos(a), np.sin(a)])  # noqa: E731
+    Ap, Cp = A_ * e(th1), np.array([D_, 0.0])
+    d = np.linalg.norm(Cp - Ap)
+    x = (B_**2 - C_**2 + d**2) / (2 * d)
+    u = (Cp - Ap) / d
+    Bp = Ap + x * u + np.sqrt(B_**2 - x**2) * np.array([-u[1], u[0]])
+    th2, th3 = np.arctan2(*(Bp - Ap)[::-1]), np.arctan2(*(Bp - Cp)[::-1])
+    m = mb.Model("four_bar", gravity=(0.0, -9.81, 0.0))
+    p3 = lambda v: (v[0], v[1], 0.0)  # noqa: E731
+    extra = 0.0 if geared else r * r * Jf
+    for name, mass, L, cm, th in (("crank", 0.5, A_, Ap / 2, th1), ("coupler", 1.2, B_, (Ap + Bp) / 2, th2),
+                                  ("rocker", 0.9, C_, (Bp + Cp) / 2, th3)):
+        izz = mass * L * L / 12 + (extra if name == "crank" else 0.0)
+        m.add_body(name, mass, inertia=(izz / 20 + (extra if name == "crank" else 0.0), izz, izz),
+                   position=p3(cm), orientation=Rotation.from_rotvec([0, 0, th]))
+    z = (0, 0, 1)
+    m.add_revolute("O", m.ground, "crank", (0, 0, 0), z)
+    m.add_revolute("A", "crank", "coupler", p3(Ap), z)
+    m.add_revolute("B", "coupler", "rocker", p3(Bp), z)
+    m.add_revolute("C", m.ground, "rocker", p3(Cp), z)
+    if geared:
+        m.add_body("fly", 1.0, inertia=(Jf, Jf, Jf), position=(0.0, 0.0, 0.1))
+        m.add_revolute("F", m.ground, "fly", (0, 0, 0.1), z)
+        m.add_gear("g", "O", "F", r)
+    return m
+
+
 def bead(curve, s0, velocity):
     """A 0.2 kg bead on a fixed curve, gravity -z (2 s: a helix in s runs to s = -15 rad, a line 17 m)."""
     m = mb.Model("bead", gravity=(0.0, 0.0, -9.81))
@@ -130,6 +163,12 @@ def line_bead():
     """Bead on a straight 7-point Spline along (0.6, 0, -0.8)."""
     u = np.array([0.6, 0.0, -0.8])
     return bead(mb.Spline([k * u for k in np.linspace(-1.0, 20.0, 7)]), 1.0 / 6.0, 0.5 * u)
+
+
+def line_expr_bead():
+    """Bead on the same straight line written as expression strings in s (compiled, as the helix)."""
+    u = np.array([0.6, 0.0, -0.8])
+    return bead(mb.Curve(("0.6*s", "0*s", "-0.8*s"), (-1.0, 20.0)), 1.0, 0.5 * u)
 
 
 def timed(fn):
@@ -168,8 +207,12 @@ CASES = [
      lambda: gears(False), "simulate", ("p1",)),
     ("two-stage gear train + torsion spring vs the equivalent shaft", lambda: gear_train(True),
      lambda: gear_train(False), "simulate", ("p3",)),
+    ("four-bar crank geared to a flywheel (closed loop) vs the four-bar with its reflected inertia",
+     lambda: geared_four_bar(True), lambda: geared_four_bar(False), "simulate", ("O", "C")),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
+    ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,
+     line_expr_bead, "simulate", ()),
 ]
 
 

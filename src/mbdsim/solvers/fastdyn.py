@@ -31,7 +31,7 @@ from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
-from . import fasttree, treecoord
+from . import fasttree, loopcoord, pathcoord, treecoord
 from .pycall import call_address
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
@@ -107,6 +107,10 @@ def _constraints(cm, wk, t, q, v):
         drivers_at(cm, wk, t)
     rows_kernel(r, A, rd, w, cm[11], cm[12], cm[13], cm[33], cm[34], cm[15],
                 wk[34], wk[35], wk[36], rigid, phi, Jc, nu, gamma)
+    if cm[50][0].shape[0]:   # coordinate constraints in closed loops (solvers.loopcoord)
+        loopcoord.coord_rows(cm[50], wk[52], t, q, r, A, rd, w, rigid, phi, Jc, nu, gamma)
+    if cm[49][0].shape[0]:   # point-on-curve constraints (solvers.pathcoord)
+        pathcoord.path_rows(cm[49], wk[51], q, r, A, rd, w, rigid, phi, Jc, nu, gamma)
 
 
 @entry(_nrt=False)
@@ -247,6 +251,10 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
         lam[i] = 0.0
     _solve(cm, wk, F, wk[7], x6, lam)
     _from6(cm, x6, vd)
+    if cm[50][0].shape[0]:   # loop couplers: the auxiliary angles' accelerations, the link rows' multipliers
+        loopcoord.aux_rates(cm[50], wk[52], x6, vd, lam)
+    if cm[49][0].shape[0]:   # paths: the curve parameters' accelerations, the rows' ground-axes multipliers
+        pathcoord.aux_rates(cm[49], wk[51], x6, vd, lam)
     if coupled:
         treecoord.fill_outputs(cm[47], wk[49], y.shape[0] // 2, wk[49][12], vd, lam)
     for i in range(vd.shape[0]):
@@ -314,6 +322,10 @@ def rhs(cm, wk, t, y, ydot, refactor=True):
     v = y[nq:]
     st = accelerations(cm, wk, t, q, v, q, ydot[nq:], wk[26], refactor)
     qdot_into(cm, q, v, ydot[:nq])
+    if cm[50][0].shape[0]:
+        loopcoord.aux_qdot(cm[50], wk[52], ydot)
+    if cm[49][0].shape[0]:
+        pathcoord.aux_qdot(cm[49], wk[51], ydot)
     return st
 
 
@@ -456,6 +468,10 @@ def newton_positions(cm, wk, t, q, v, tol):
                 return NONFINITE, size, nfactor
             res = max(res, r)
         if res <= tol:
+            if cm[50][0].shape[0]:   # loop couplers: psi <- the continued angles at the converged q
+                loopcoord.sync_q(cm[50], wk[52], q)
+            if cm[49][0].shape[0]:   # paths: s <- the foot points at the converged q
+                pathcoord.sync_q(cm[49], wk[51], q)
             return OK, size, nfactor
         if not _factor(cm, wk):
             return SINGULAR, size, nfactor
@@ -514,4 +530,12 @@ def project_velocities(cm, wk, v, refactor=True):
         n = 6 if rigid[f] else 3
         for k in range(n):
             v[vadr[f] + k] += x6[f, k]
+    if cm[50][0].shape[0] or cm[49][0].shape[0]:   # psi', s' <- their rates at the projected velocities
+        for f in range(1, x6.shape[0]):
+            for k in range(6):
+                v6[f, k] += x6[f, k]
+        if cm[50][0].shape[0]:
+            loopcoord.sync_v(cm[50], wk[52], v6, v)
+        if cm[49][0].shape[0]:
+            pathcoord.sync_v(cm[49], wk[51], v6, v)
     return OK

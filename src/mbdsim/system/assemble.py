@@ -186,7 +186,7 @@ def _assemble_system(model) -> System:
     specs += pspecs + cspecs + locks
     groups, owners, owner_rows = _groups(specs, fid)
     not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
-                    for g in groups if g.kind not in KERNEL_KINDS + ("curve",)]
+                    for g in groups if g.kind not in KERNEL_KINDS + ("curve", "coord")]
     not_compiled += [f"sensor '{n}'" for n, sn in getattr(model, "sensors", {}).items() if sn.text is None]
     as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
     sys = System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),

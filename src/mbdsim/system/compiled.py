@@ -15,7 +15,7 @@ import numpy as np
 from ..model.contacts import ShapeContact
 from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
-from . import exprloads_pack, jointtree, packing
+from . import exprloads_pack, jointtree, loopcoords, packing, pathcoords
 from .measures import locate
 from .topology import Topology, system_topology
 
@@ -101,6 +101,12 @@ class CompiledModel:
     coords: tuple = ()        # arrays()[47]: coordinate constraints of a joint-coordinate tree (couplers, gears,
     #                           user constraints: system.jointtree.coord_arrays, solvers.treecoord)
     coord_stack: int = 4      # stack size of their programs
+    loop_coords: tuple = ()   # arrays()[50]: coordinate constraints in absolute coordinates (closed loops:
+    #                           system.loopcoords, solvers.loopcoord); 48, 49 are kept for joint friction
+    #                           and point-on-curve parameters
+    loop_stack: int = 4       # stack size of their programs
+    paths: tuple = ()         # arrays()[49]: point-on-curve constraints (system.pathcoords, solvers.pathcoord)
+    path_stack: int = 4
 
     def arrays(self):
         """The slots cm[0..] the kernels take (`tuple_`'s order), as one `mbdsim._slots.Slots` (made once per
@@ -125,7 +131,8 @@ class CompiledModel:
                 # again); 35: unused, kept empty so that the later slots keep their numbers
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
-                self.shape_contacts or _shape_contacts(None, ()), self.coords or jointtree.empty_coords())
+                self.shape_contacts or _shape_contacts(None, ()), self.coords or jointtree.empty_coords(),
+                np.zeros(0), self.paths or pathcoords.empty(), self.loop_coords or loopcoords.empty())
 
 
 @dataclass
@@ -164,7 +171,10 @@ class Work:
              # 48: loads and drivers written as Python callables (solvers.pyloads): the loads (nf, 6) and
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
              (z((nf, 6)), np.zeros(3, np.int64)),
-             _coord_work(cm, nf))   # 49: coordinate constraints on the tree (solvers.treecoord)
+             _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
+             z(0),                  # 50: kept for joint friction
+             pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
+             loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack))   # 52: solvers.loopcoord
         work = cls(a)
         work.__dict__["model"] = cm   # (for the slot types, `arrays`)
         return work
@@ -354,15 +364,15 @@ def compile_system(sys, rows, state=None) -> CompiledModel:
 def _compile_system(sys, rows, state) -> CompiledModel:
     nf = sys.nbody + 1
     rows = np.asarray(rows, dtype=np.int64)
-    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE else \
+    paths = len(getattr(sys.model, "path_constraints", {})) > 0   # (absolute coordinates: solvers.pathcoord)
+    mode, tree = (0, jointtree.empty_arrays(nf)) if state is None or not USE_TREE or paths else \
         jointtree.tree_arrays(sys, rows, *state)
     coords, cstack = jointtree.coord_arrays(sys, tree, *state) if mode == 1 else (jointtree.empty_coords(), 4)
-    if mode == 1 and len(coords[3]) > 1:   # couplers on a tree: solved in joint coordinates (solvers.treecoord);
+    tree_coords = mode == 1 and len(coords[3]) > 1
+    if tree_coords:   # couplers on a tree: solved in joint coordinates (solvers.treecoord);
         rows = rows[~np.isin(rows, jointtree.coord_rows(sys))]   # the absolute solve of the outputs skips them
-    elif getattr(sys, "not_compiled", None):   # issue 11: screw/CV/coupler/user-constraint rows (in loops), sensors
+    elif getattr(sys, "not_compiled", None):   # issue 11: rows the kernels do not evaluate, callable sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
-    elif len(sys.aux_q_idx):
-        raise NotCompiled("path (point-on-curve) constraints are not compiled yet")
     if len(sys.lock_rows):
         names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: see docs/theory.md 12c
         raise NotCompiled(f"joint friction (stick/slip) is not compiled yet: {names} run on the event-driven "
@@ -377,6 +387,12 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         packed = sys.derived["packed"] = packing.pack_rows(sys)
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
+    lc, lstack = (loopcoords.empty(), 4) if tree_coords else loopcoords.pack(sys, bi, bj)
+    if len(lc[0]):   # couplers in absolute coordinates (issue 29): the link rows are not solved for
+        rows = rows[~np.isin(rows, loopcoords.link_rows(sys))]
+    pc, pstack = pathcoords.pack(sys) if paths else (pathcoords.empty(), 4)
+    if paths:        # point-on-curve: the tangential rows are residuals only
+        rows = rows[~np.isin(rows, pathcoords.tangent_rows(sys))]
     code, consts, tables, start, end, stack, pyd, dslots = _driver_programs(fns)
     dense = int(_singular_masses(M6[1:]))
     if not dense and mode == 0 and len(rows) == sys.nv <= SQUARE_MAX:
@@ -397,7 +413,7 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack)
+                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack, pc, pstack)
 
 
 def _candidates(sys, topo) -> np.ndarray:
@@ -408,4 +424,6 @@ def _candidates(sys, topo) -> np.ndarray:
     full = _full_topology(sys)
     if full is None or not np.array_equal(np.sort(full.blk_rows), np.sort(topo.blk_rows)):
         return np.asarray(topo.loop_rows, dtype=np.int64).copy()
-    return np.asarray(full.loop_rows, dtype=np.int64).copy()
+    loop = np.asarray(full.loop_rows, dtype=np.int64)
+    skip = np.concatenate([loopcoords.link_rows(sys), pathcoords.tangent_rows(sys)])   # never solved for
+    return loop[~np.isin(loop, skip)].copy()

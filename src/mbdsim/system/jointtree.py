@@ -178,6 +178,7 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
     evaluated by the compiled drivers); and the programs' stack size."""
     from . import exprvm
     from .frames import body_frames
+    from .loopcoords import programs
     groups = [g for g in sys.groups if g.kind == "coord"]
     motions = list(sys.model.motions.values())
     if not groups and not motions:
@@ -195,10 +196,8 @@ def coord_arrays(sys, arrays, q, v) -> tuple[tuple, int]:
                 link += dof == "rotation"
             names = c.variables[1:]
             slots = {name: k for k, name in enumerate(c.variables)}
-            exprs = [c.expr, c.derivs["t"], c.derivs[("t", "t")], *(c.derivs[n] for n in names),
-                     *(c.derivs[(n, "t")] for n in names), *(c.derivs[(a_, b_)] for a_ in names for b_ in names)]
             pbase.append(len(progs))
-            progs.extend(exprvm.compile_expr(e, slots) for e in exprs)
+            progs.extend(exprvm.compile_expr(e, slots) for e in programs(c))
             ptr.append(ptr[-1] + len(names))
             mrow.append(link)
             drv.append(-1)

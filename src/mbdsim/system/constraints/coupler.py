@@ -12,8 +12,9 @@ translations) and every row is single-valued: no state, any number of turns.  Th
     phi = f(X, t),  phi_q = sum_k f_k J_Xk,  nu = -f_t,
     gamma = -(sum_k f_k quad_Xk + sum_kl f_kl X'_k X'_l + 2 sum_k f_kt X'_k + f_tt)
 
-with exact symbolic derivatives f_k, f_kl (mbdsim.expressions).  Rows are evaluated by numpy only (the
-compiled core does not carry them: the System lists them in not_compiled).  The load the constraint
+with exact symbolic derivatives f_k, f_kl (mbdsim.expressions).  Rows are evaluated here by numpy for the
+reference path; the compiled core evaluates them on a joint-coordinate tree (solvers.treecoord) and in
+closed loops (solvers.loopcoord, where psi only picks the angle's branch).  The load the constraint
 transmits along joint coordinate k is -f_k lambda (lambda: the main row's multiplier).
 """
 from __future__ import annotations

@@ -8,6 +8,9 @@ s_dot after the body coordinates, see System.aux_q_idx / aux_v_idx).  Rows (3, g
               rotations), -A_i c'(s) for s
     quad = w_j x (w_j x s_j) - w_i x (w_i x A_i c) - 2 s_dot w_i x (A_i c') - s_dot^2 A_i c''
     (phi_dd = J vd + quad, gamma = -quad).
+
+These rows serve the reference path; the compiled core solves their two normal components at the foot
+point instead (system.pathcoords, solvers.pathcoord; expression curves and splines).
 """
 from __future__ import annotations
 
