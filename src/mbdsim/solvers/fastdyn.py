@@ -28,11 +28,12 @@ from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
-from . import fasttree, treecoord
+from . import fastfriction, fasttree, treecoord
 from .pycall import call_address
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
 CALLBACK_FAILED = 11   # a Python-callable load raised (solvers.pyloads keeps the error); 8-10: fastdop
+FRICTION_FAILED = 12   # the coupled joint-friction solve did not converge (element in wk[50][15]); 13: fastdop
 
 
 @kernel(_nrt=False)
@@ -243,6 +244,8 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     for i in range(lam.shape[0]):
         lam[i] = 0.0
     _solve(cm, wk, F, wk[7], x6, lam)
+    if cm[48][0].shape[0] and not _friction(cm, wk, x6, lam):
+        return FRICTION_FAILED
     _from6(cm, x6, vd)
     if coupled:
         treecoord.fill_outputs(cm[47], wk[49], y.shape[0] // 2, wk[49][12], vd, lam)
@@ -250,6 +253,39 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
         if not np.isfinite(vd[i]):
             return NONFINITE
     return OK
+
+
+@kernel(_nrt=False)
+def _friction(cm, wk, x6, lam):
+    """Joint friction (solvers.fastfriction): the unit solutions of the loads -J_lock^T of the elements with a
+    mode (the factorisation in wk, zero row right-hand side), then the coupled loads, into x6 and lam;
+    False when their iteration fails."""
+    fc, fw = cm[48], wk[50]
+    mode, E6, EL, F6, zc = fw[0], fw[3], fw[4], fw[5], fw[6]
+    Jc, bi, bj = wk[5], cm[12], cm[13]
+    lock = fc[0]
+    n = 0
+    for e in range(mode.shape[0]):
+        if mode[e] == 0:
+            continue
+        n += 1
+        r = lock[e]
+        for f in range(F6.shape[0]):
+            for c in range(6):
+                F6[f, c] = 0.0
+        for side in range(2):
+            b = bi[r] if side == 0 else bj[r]
+            if b != 0:
+                for c in range(6):
+                    F6[b, c] -= Jc[r, side, c]
+        for i in range(EL.shape[1]):
+            EL[e, i] = 0.0
+        _solve(cm, wk, F6, zc, E6[e], EL[e])
+    if n == 0:
+        for e in range(mode.shape[0]):
+            lam[lock[e]] = 0.0
+        return True
+    return fastfriction.couple(fc, fw, Jc, bi, bj, wk[1], wk[7], x6, lam)
 
 
 @kernel(_nrt=False)

@@ -50,8 +50,7 @@ from . import register
 from .friction_kkt import load_maps, normal_load
 from .friction_lcp import decide_all, stuck_margin
 
-V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
-STICK_TOL = 1e-10   # relative tolerance on the static friction limit
+from ...solvers.fastfriction import STICK_TOL, V_TOL   # noqa: F401  (one definition, shared with the kernels)
 
 
 class StickSlip:
