@@ -54,7 +54,6 @@ def test_spring_pulled_block_breaks_away_at_k_x_equal_mu_s_m_g_and_stops_again()
     assert np.allclose(res.friction_force("friction")[before], -200.0 * 0.5 * res.time[before], atol=1e-8)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 29: joint friction is not compiled yet (NotCompiled for lock rows)")
 def test_friction_runs_compiled():
     model, _ = spring_pulled_block()
     res = mb.simulate(model, 0.1, output_step=0.01)

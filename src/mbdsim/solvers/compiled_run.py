@@ -46,7 +46,7 @@ class CompiledRun:
         self.sys, self.rows = sys, rows
         self.cm = compile_system(sys, rows, state, friction)
         self.work = Work.for_model(self.cm)
-        self.friction = friction_run.FrictionModes(sys, self.work) if len(self.cm.friction[0]) else None
+        self.friction = friction_run.FrictionModes(sys, self.cm, self.work) if len(self.cm.friction[0]) else None
         self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.rtol, self.atol = float(rtol), float(atol)
         self.max_step = np.inf if not max_step else float(max_step)
@@ -399,22 +399,17 @@ def residual_check(run, t_out, Y):
 MULTIPLIER_BYTES = 512 * 2 ** 20
 
 
-def _full_multipliers(sys, rows, times, Y, VD, LAM, locks=True):
+def _full_multipliers(sys, rows, times, Y, VD, LAM):
     """Multipliers of every row: as solved when all rows are independent, else the minimum-norm
     lambda_ with phi_q^T lambda_ = phi_q,rows^T lambda_rows (the constraint load the solve found) over all
     rows, so that the determinate components are exact. All samples in one compiled call with r x r and
     d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm), the SVD pseudo-inverse where
     the rows are dependent at the sample's configuration too (a change point) or where the kernel solved
-    for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`)."""
-    keep = np.asarray(getattr(sys, "lock_rows", ()) if locks else (), dtype=np.int64)   # friction locks: as solved
+    for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`).
+    The lock rows of joint friction keep their multipliers as solved (the friction loads) and take no share."""
+    keep = np.asarray(getattr(sys, "lock_rows", ()), dtype=np.int64)
     if len(rows) + len(keep) == sys.nc or not len(times):
         return LAM
-    if len(keep):
-        LAM = np.array(LAM, dtype=float)
-        kept, LAM[:, keep] = LAM[:, keep].copy(), 0.0
-        out = _full_multipliers(sys, np.union1d(rows, keep), times, Y, VD, LAM, False)
-        out[:, keep] = kept
-        return out
     per_sample = 8 * sys.nc * sys.nv   # bytes of one sample's dense Jacobian
     if per_sample > MULTIPLIER_BYTES:
         names = sorted({sys.row_owner[r] for r in np.setdiff1d(np.arange(sys.nc), rows)})
@@ -427,25 +422,29 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM, locks=True):
             "positions, velocities and accelerations are not affected")
     step = max(1, MULTIPLIER_BYTES // per_sample)
     if len(times) > step:   # in chunks of samples, so that the Jacobians in memory stay within the budget
-        parts = [_full_multipliers(sys, rows, times[k:k + step], Y[k:k + step], None, LAM[k:k + step], locks)
+        parts = [_full_multipliers(sys, rows, times[k:k + step], Y[k:k + step], None, LAM[k:k + step])
                  for k in range(0, len(times), step)]
         return np.concatenate(parts)
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows` unless re-selected
-    rows = np.asarray(rows, dtype=np.int64)
-    key = ("dependent rows", rows.tobytes())
+    cols = np.setdiff1d(np.arange(sys.nc), keep)   # the rows that share the constraint load (all but locks)
+    Js = J if not len(keep) else np.ascontiguousarray(J[:, cols])
+    rows = np.searchsorted(cols, np.asarray(rows, dtype=np.int64)).astype(np.int64)
+    key = ("dependent rows", rows.tobytes(), keep.tobytes())
     dep = sys.derived.get(key)
     if dep is None:   # the same rows at every call of a run: computed once (the rows not in `rows`, sorted)
-        free = np.ones(sys.nc, dtype=bool)
+        free = np.ones(len(cols), dtype=bool)
         free[rows] = False
         dep = sys.derived[key] = np.flatnonzero(free).astype(np.int64)
-    LAM = np.ascontiguousarray(LAM, dtype=float)
-    out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
-    minnorm.min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
-    bad |= np.any(LAM[:, dep] != 0.0, axis=1)   # the kernel re-selected its loop rows (fastdyn._reselect)
+    LAMs = np.ascontiguousarray(LAM[:, cols], dtype=float)
+    outs, bad = np.zeros_like(LAMs), np.zeros(len(LAMs), dtype=np.bool_)
+    minnorm.min_norm_multipliers(Js, LAMs, rows, dep, outs, bad)
+    bad |= np.any(LAMs[:, dep] != 0.0, axis=1)   # the kernel re-selected its loop rows (fastdyn._reselect)
     if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
-        load = np.einsum("nri,nr->ni", J[bad], LAM[bad])
+        load = np.einsum("nri,nr->ni", Js[bad], LAMs[bad])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
-        out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
+        outs[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(Js[bad], (0, 2, 1)), rcond=rcond), load)
+    out = np.array(LAM, dtype=float)   # (the locks' columns as solved)
+    out[:, cols] = outs
     keep_jacobians(sys, out, J)   # the reactions read from these multipliers reuse their Jacobians
     return out
 

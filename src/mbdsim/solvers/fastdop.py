@@ -339,7 +339,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     With `watch`, the model's expression sensors (cm[43] slots 18-21) are evaluated after every accepted
     step (`_watch`): events go to the buffer wk[44][4] (EVENTS_FULL when it may not hold the next step's:
     hand them over, reset the count wk[44][5] and call again), and a "stop" event ends the run with
-    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time."""
+    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time. With `watch` and
+    joint friction (cm[48]), its switching functions are watched the same way (`_watch_friction`; their values
+    at the start computed here, with the modes the caller set in wk[50]): the first zero ends the run with
+    FRICTION_EVENT, the outputs up to its time written and y the projected state at st[0] = that time (the
+    caller decides the modes there and restarts with h = 0)."""
     E3, E5 = co[3], co[4]
     nq = cm[31][0]
     n = y.shape[0]

@@ -261,9 +261,21 @@ def _friction(cm, wk, x6, lam):
     mode (the factorisation in wk, zero row right-hand side), then the coupled loads, into x6 and lam;
     False when their iteration fails."""
     fc, fw = cm[48], wk[50]
+    if _unit_solutions(cm, wk) == 0:
+        for e in range(fw[0].shape[0]):
+            lam[fc[0][e]] = 0.0
+        return True
+    return fastfriction.couple(fc, fw, wk[5], cm[12], cm[13], wk[1], wk[7], x6, lam)
+
+
+@kernel(_nrt=False)
+def _unit_solutions(cm, wk):
+    """Accelerations and multipliers (wk[50][3], [4]) of the unit loads -J_lock^T of the friction elements
+    with a mode, with the factorisation in wk and a zero row right-hand side; their number."""
+    fw = wk[50]
     mode, E6, EL, F6, zc = fw[0], fw[3], fw[4], fw[5], fw[6]
     Jc, bi, bj = wk[5], cm[12], cm[13]
-    lock = fc[0]
+    lock = cm[48][0]
     n = 0
     for e in range(mode.shape[0]):
         if mode[e] == 0:
@@ -281,11 +293,26 @@ def _friction(cm, wk, x6, lam):
         for i in range(EL.shape[1]):
             EL[e, i] = 0.0
         _solve(cm, wk, F6, zc, E6[e], EL[e])
-    if n == 0:
-        for e in range(mode.shape[0]):
-            lam[lock[e]] = 0.0
-        return True
-    return fastfriction.couple(fc, fw, Jc, bi, bj, wk[1], wk[7], x6, lam)
+    return n
+
+
+@entry(_nrt=False)
+def stick_velocities(cm, wk, t, y):
+    """The velocities of the state y = [q, v] at t [s] (absolute coordinates) corrected in place so that
+    the joints of the sticking friction elements (wk[50]) are at rest: the mass-weighted minimum-norm
+    correction that keeps the other constraints' rates (`fastfriction.stick_rates`); status."""
+    nq = cm[31][0]
+    q, v = y[:nq], y[nq:]
+    _constraints(cm, wk, t, q, v)
+    if not _factor(cm, wk):
+        return SINGULAR
+    _unit_solutions(cm, wk)
+    v6 = wk[50][14]
+    _to6(cm, v, v6)
+    if not fastfriction.stick_rates(cm[48], wk[50], wk[5], cm[12], cm[13], v6):
+        return SINGULAR
+    _from6(cm, v6, v)
+    return OK
 
 
 @kernel(_nrt=False)

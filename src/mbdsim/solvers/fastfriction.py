@@ -244,3 +244,32 @@ def switching(fc, fw, Jc, bi, bj, A, lam, v6, g):
             g[e] = cap - abs(lam[lock[e]]) + STICK_TOL * (1.0 + cap)
         else:
             g[e] = 1.0
+
+
+@kernel(_nrt=False)
+def stick_rates(fc, fw, Jc, bi, bj, v6):
+    """v6 (nf, 6) plus the combination sum f_m vd_m of the sticking elements' unit solutions (fw[3]) that
+    brings their joint rates J_lock v to zero (the other rows' rates are kept: the unit solutions have a
+    zero row right-hand side); False if their k x k system is singular."""
+    mode, E6, S, rhs, f = fw[0], fw[3], fw[7], fw[8], fw[9]
+    lock = fc[0]
+    k = mode.shape[0]
+    for e in range(k):
+        for m in range(k):
+            S[e, m] = 0.0
+        rhs[e] = 0.0
+        if mode[e] != 2:
+            S[e, e] = 1.0
+            continue
+        for m in range(k):
+            if mode[m] == 2:
+                S[e, m] = _row_dot(Jc, bi, bj, lock[e], E6[m])
+        rhs[e] = -_row_dot(Jc, bi, bj, lock[e], v6)
+    if not _small_solve(S, rhs, f):
+        return False
+    for m in range(k):
+        if mode[m] == 2:
+            for fr in range(v6.shape[0]):
+                for c in range(6):
+                    v6[fr, c] += f[m] * E6[m, fr, c]
+    return True

@@ -25,13 +25,14 @@ CODES = {"slip": 1, "stick": 2}   # wk[50][0]; anything else (undecided) carries
 class FrictionModes:
     """The stick/slip modes of one compiled run: the System's histories and the kernel's mode arrays."""
 
-    def __init__(self, sys, work):
-        self.sys = sys
+    def __init__(self, sys, cm, work):
+        self.sys, self.cm, self.work = sys, cm, work
         self.names = list(sys.switched)
         self.fw = work.arrays()[50]
 
     def decide(self, t, y):
-        """Decide the modes at the state y = [q, v] at t [s] (an event or the start), write them to wk[50]."""
+        """Decide the modes at the state y = [q, v] at t [s] (an event or the start), write them to wk[50];
+        the velocities of y are corrected in place so that the sticking joints are at rest."""
         from ..system.force_elements.friction_lcp import decide_all
         sys = self.sys
         nq = sys.nq
@@ -47,6 +48,10 @@ class FrictionModes:
                               "path does not carry yet): the event-driven reference DOP853 runs it")
             raise NotCompiled(msg)
         self.set_modes(t)
+        if np.any(self.fw[0] == 2):   # sticking joints start exactly at rest (no creep at the event's V_TOL)
+            from . import fastdyn
+            if fastdyn.stick_velocities(self.cm.arrays(), self.work.arrays(), float(t), y) != fastdyn.OK:
+                raise SolverError("singular equations of motion at a stick decision of joint friction", time=float(t))
 
     def set_modes(self, t):
         """Write the modes in force at t [s] into wk[50]."""
