@@ -16,7 +16,7 @@ import numpy as np
 from ..._blas import scipy_linalg
 from ...math.rotation import skew
 
-from ...solvers.fastfriction import MAXIT   # noqa: E402,F401  (iterations of the coupled friction KKT solve)
+from ...solvers.fastfriction import MAXIT   # iterations of the coupled friction KKT solve (one definition)
 
 
 def load_maps(sys, fr, J, elem):
