@@ -171,6 +171,32 @@ def line_expr_bead():
     return bead(mb.Curve(("0.6*s", "0*s", "-0.8*s"), (-1.0, 20.0)), 1.0, 0.5 * u)
 
 
+def coasting_slider_crank(bore=0.0, pins=0.0):
+    """Vertical-plane slider-crank (crank 0.1 m, rod 0.35 m) released spinning at 2 rev/s, Coulomb friction
+    mu = `bore` in the slider's guide and mu = `pins` in the crank and rod pins (pin radius 5 mm); no
+    friction element where mu = 0 (the baseline: the same machine without friction)."""
+    R_, L_, th0 = 0.1, 0.35, np.pi / 3
+    m = mb.Model("coast", gravity=(0.0, -9.81, 0.0))
+    A = R_ * np.array([np.cos(th0), np.sin(th0), 0.0])
+    B = np.array([R_ * np.cos(th0) + np.sqrt(L_**2 - (R_ * np.sin(th0)) ** 2), 0.0, 0.0])
+    from scipy.spatial.transform import Rotation
+    rz = lambda a: Rotation.from_rotvec([0.0, 0.0, a])  # noqa: E731
+    crank = m.add_body("crank", 1.5, (1e-3, 1.25e-3, 1.25e-3), position=A / 2, orientation=rz(th0))
+    rod = m.add_body("rod", 2.0, (2e-3, 0.02, 0.02), position=(A + B) / 2,
+                     orientation=rz(-np.arcsin(R_ * np.sin(th0) / L_)))
+    slider = m.add_body("slider", 0.8, (0.01, 0.01, 0.01), position=B)
+    z = (0, 0, 1)
+    o = m.add_revolute("O", m.ground, crank, (0, 0, 0), z, initial_velocity=[4 * np.pi])
+    a = m.add_revolute("A", crank, rod, A, z)
+    m.add_revolute("B", rod, slider, B, z)
+    guide = m.add_translational("guide", m.ground, slider, B, (1, 0, 0))
+    if bore:
+        m.add_friction("bore", guide, bore, bore)
+    for jt in (o, a) if pins else ():
+        m.add_friction("f_" + jt.name, jt, pins, pins, pin_radius=0.005)
+    return m
+
+
 def timed(fn):
     fn()
     ts = []
@@ -209,6 +235,10 @@ CASES = [
      lambda: gear_train(False), "simulate", ("p3",)),
     ("four-bar crank geared to a flywheel (closed loop) vs the four-bar with its reflected inertia",
      lambda: geared_four_bar(True), lambda: geared_four_bar(False), "simulate", ("O", "C")),
+    ("joint friction, bore + two pins (coasting slider-crank, slipping through dead centres) vs none",
+     lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", ()),   # different motions
+    ("joint friction, bore (coasting slider-crank comes to rest and sticks) vs none",
+     lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
     ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,

@@ -1,8 +1,12 @@
-"""Joint friction stick/slip against closed forms, and the issue-29 contract that it runs compiled.
+"""Joint friction stick/slip on the compiled core (issue 29) against closed forms and conservation laws.
 
-The physics checks run on whatever path `simulate` picks; `test_friction_runs_compiled` states the
-issue-29 contract (res.stats["method"] says "(compiled)") and is a strict xfail until the compiled
-step loop carries friction (system/compiled.py still raises NotCompiled for lock rows).
+The spring-pulled block: breakaway and stop against the closed form; the coasting slider-crank (a
+closed loop, friction in the bore) comes to rest with the energy balance kinetic +
+potential + dissipated = initial energy to 1e-6 of it, and stops when the event-driven reference
+(force_elements.friction, Python) says; the torque-driven crank-rocker with friction in every pin
+passes its rocker's extremes (reversals carried by the loop) where the closed form puts them, with
+the drive's work = change of energy + dissipation. Each states the issue-29 contract: "(compiled)" in
+res.stats["method"].
 """
 from __future__ import annotations
 
@@ -11,6 +15,7 @@ import pytest
 from scipy.optimize import brentq
 
 import mbdsim as mb
+from test_friction_loops import four_bar, rocker_extreme_crank_angles, slider_crank
 
 G = 9.81
 
@@ -54,9 +59,46 @@ def test_spring_pulled_block_breaks_away_at_k_x_equal_mu_s_m_g_and_stops_again()
     assert np.allclose(res.friction_force("friction")[before], -200.0 * 0.5 * res.time[before], atol=1e-8)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 29: joint friction is not compiled yet (NotCompiled for lock rows)")
 def test_friction_runs_compiled():
     model, _ = spring_pulled_block()
     res = mb.simulate(model, 0.1, output_step=0.01)
     assert res.success, res.message
     assert "(compiled)" in res.stats["method"], res.stats["method"]   # "not compiled" must not count
+
+
+def test_coasting_slider_crank_comes_to_rest_compiled_with_energy_balance(monkeypatch):
+    model = slider_crank("coast", mu=0.4)
+    res = mb.simulate(model, 3.5, output_step=0.01)
+    assert res.success, res.message
+    assert "(compiled)" in res.stats["method"], res.stats["method"]
+    ev = res.friction_events("friction")
+    assert ev[-1][1] == "stick" and ev[-1][0] < 3.0
+    after = res.time > ev[-1][0]
+    assert np.max(np.abs(res.joint_velocity("O")[after])) < 1e-10   # at rest, and staying there
+    E = res.kinetic_energy() + res.potential_energy()
+    D = res.dissipated_energy()
+    assert D[-1] > 0.5 * E[0]
+    assert np.max(np.abs(E + D - E[0])) < 1e-6 * E[0]
+    # the same stop as the event-driven reference path (Python, scipy's DOP853)
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", False)
+    ref = mb.simulate(slider_crank("coast", mu=0.4), ev[-1][0] + 0.05, output_step=0.05)
+    assert "(compiled)" not in ref.stats["method"]
+    ev_ref = ref.friction_events("friction")
+    assert [(m, d) for _, m, d in ev_ref] == [(m, d) for _, m, d in ev]
+    assert np.allclose([e[0] for e in ev_ref], [e[0] for e in ev], rtol=1e-6, atol=0)
+
+
+def test_crank_rocker_with_friction_in_every_pin_compiled_through_rocker_extremes():
+    res = mb.simulate(four_bar("torque"), 0.3, output_step=0.01)
+    assert res.success, res.message
+    assert "(compiled)" in res.stats["method"], res.stats["method"]
+    ev = res.friction_events("f_O4")[1:]          # rocker pivot reversals: the rocker's extremes
+    assert len(ev) >= 2 and all(m == "slip" for _, m, _ in ev)
+    crank = (res.at([e[0] for e in ev]).joint_coordinate("O2") + 0.3) % (2 * np.pi)
+    ext = rocker_extreme_crank_angles()
+    assert np.max(np.min(np.abs(crank[:, None] - ext[None]), axis=1)) < 1e-7
+    th = res.joint_coordinate("O2") + 0.3
+    E = res.kinetic_energy() + res.potential_energy()
+    W = 0.3 * (th - th[0])
+    assert np.max(np.abs(W - (E - E[0] + res.dissipated_energy()))) < 1e-6 * W[-1]

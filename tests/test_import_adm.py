@@ -311,7 +311,9 @@ def test_springdamper_friction_motion_closed_forms(tmp_path):
     assert any("FIELD" in n for n in m.import_notes) and any("STICTION" in n for n in m.import_notes)
     res = mb.simulate(m, 1.0, output_step=0.01)
     w = np.sqrt(8.0 / 2e-3)                                     # KT 8000 N mm/rad, Izz 2000 kg mm^2
-    assert np.abs(res.joint_coordinate("JOINT_1") - np.radians(10) * (1 - np.cos(w * res.time))).max() < 1e-9
+    # the default method's target: 1e-7 of the amplitude (the model runs compiled since issue 29, in absolute
+    # coordinates because of the friction; the reference path it took before happened to reach 5e-10)
+    assert np.abs(res.joint_coordinate("JOINT_1") - np.radians(10) * (1 - np.cos(w * res.time))).max() < 1e-7 * np.radians(20)
     assert np.abs(res.position("PART_4")[:, 0]).max() < 1e-12
     assert res.friction_force("FRICTION_1")[-1] == pytest.approx(-5.0)
     assert res.joint_coordinate("JOINT_3")[-1] == pytest.approx(0.1, abs=1e-9)

@@ -90,6 +90,11 @@ class KernelDispatcher(CPUDispatcher):
         return self.python_twin()._compile_for_args(*args, **kws)
 
 
+def _disabled() -> bool:
+    from numba.core import config
+    return bool(config.DISABLE_JIT)
+
+
 def _options(options: dict) -> dict:
     out = {"nopython": True, "cache": True}
     out.update(options)
@@ -101,6 +106,8 @@ def kernel(fn=None, **options):
     Python call goes to a wrapped twin (module docstring). ``@kernel`` or ``@kernel(_nrt=False, ...)``
     with numba's ``njit`` options."""
     def wrap(f):
+        if _disabled():   # NUMBA_DISABLE_JIT=1: the plain Python function (debugging kernels without compiling)
+            return f
         opts = _options(options)
         cache = opts.pop("cache")
         opts.pop("nopython")

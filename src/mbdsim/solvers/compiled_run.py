@@ -15,12 +15,14 @@ import numpy as np
 from ..errors import AnalysisInterrupted, MbdsimError, SolverError
 from ..results.result import Result
 from ..results.stream import ProgressError, notify
-from ..system.compiled import Work, compile_system
+from ..system.compiled import NotCompiled, Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
 from . import fastdop, fastdyn, minnorm, pyloads
 from .sensors import SensorEvent
-from .fastdyn import CALLBACK_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR, STIFF, TINY_STEP
+from .fastdyn import (CALLBACK_FAILED, FRICTION_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR,
+                      STIFF, TINY_STEP)
+from . import friction_run
 
 _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular configuration)",
              PROJECTION: "projection onto the constraints does not converge",
@@ -29,7 +31,8 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
                         "or a discontinuity)",
              MAX_STEPS: "step budget exhausted (max_steps)",
              STIFF: "the model is stiff for an explicit method",
-             INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load or driver written as a Python callable failed"}
+             INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load or driver written as a Python callable failed",
+             FRICTION_FAILED: "the coupled joint-friction solve does not converge"}
 PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.run_error)
 CHUNK = 256
 CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand
@@ -38,10 +41,12 @@ CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for de
 class CompiledRun:
     """A compiled model and its work arrays for one analysis (immutable model, per-run state)."""
 
-    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False, state=None):
+    def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False, state=None,
+                 friction=False):
         self.sys, self.rows = sys, rows
-        self.cm = compile_system(sys, rows, state)
+        self.cm = compile_system(sys, rows, state, friction)
         self.work = Work.for_model(self.cm)
+        self.friction = friction_run.FrictionModes(sys, self.cm, self.work) if len(self.cm.friction[0]) else None
         self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.rtol, self.atol = float(rtol), float(atol)
         self.max_step = np.inf if not max_step else float(max_step)
@@ -73,9 +78,14 @@ class CompiledRun:
         K, F, sc = np.zeros((16, n)), np.zeros((7, n)), np.zeros((4, n))
         keep = checkpoints and n * 8 * 64 <= CHECKPOINT_BUDGET
         SY, ST, ns = np.zeros((64 if keep else 0, n)), np.zeros((64 if keep else 0, 2)), np.zeros(1, np.int64)
-        watch = bool(self.sensors)
+        watch = bool(self.sensors) or self.friction is not None
+        if self.friction is not None:   # the initial modes (all joints at rest decided together)
+            self.friction.decide(t0, y)
         try:
-            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL) and iout < nout:
+            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL, fastdop.FRICTION_EVENT) and iout < nout:
+                if status == fastdop.FRICTION_EVENT:   # a stick/slip event at st[0]: decide, restart there
+                    self.friction.decide(st[0], y)
+                    st[1] = 0.0
                 if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
                     if 2 * SY.size * 8 <= CHECKPOINT_BUDGET:
                         SY = np.concatenate([SY, np.zeros_like(SY)])
@@ -87,7 +97,8 @@ class CompiledRun:
                                            self.rtol, self.atol, self.max_step, self.max_steps, CHUNK,
                                            1e-12, self.stats, K, F, sc, self.stiff_check, SY, ST, ns, watch)
                 if st[1] == 0.0:   # the start failed: not even the initial state is an output
-                    iout = 0
+                    if st[0] == t0:   # (a restart after a friction event keeps the outputs before it)
+                        iout = 0
                     break
                 notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:   # arrives between chunks; every output written so far is kept
@@ -142,10 +153,15 @@ class CompiledRun:
         sys = self.sys
         VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
         YJ = self.joint_states(times, Y)
-        done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y,
-                                  np.zeros((len(times), 0)) if YJ is None else YJ, VD, LAM)
-        if done < len(times):
-            raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[done]))
+        times = np.asarray(times, float)
+        for sel in ([slice(None)] if self.friction is None else self.friction.groups(times)):   # the modes then
+            YJs = np.zeros((len(times), 0)) if YJ is None else YJ
+            VDs, LAMs = np.zeros_like(VD[sel]), np.zeros_like(LAM[sel])
+            done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), times[sel], np.ascontiguousarray(Y[sel]),
+                                      np.ascontiguousarray(YJs[sel]), VDs, LAMs)
+            if done < len(VDs):
+                raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[sel][done]))
+            VD[sel], LAM[sel] = VDs, LAMs
         return VD, LAM
 
     def joint_states(self, times, Y):
@@ -201,6 +217,8 @@ class CompiledRun:
             tout = np.array([t]) if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)) else np.array([times[k], t])
             Yk, VDk, LAMk = np.zeros((len(tout), n)), np.zeros((len(tout), self.sys.nv)), np.zeros((len(tout), self.sys.nc))
             y0 = self.state_of(Y[k]) if YJ0 is None else YJ0[k].copy()
+            if self.friction is not None:   # the modes at the restart sample (the run's steps are not kept)
+                self.friction.set_modes(float(times[k]))
             YJk = np.zeros((len(tout), 0 if YJ0 is None else ns))
             status, m = fastdop.span(a, w, fastdop.COEFFS, np.array([times[k], 0.0]), y0, f, tout, Yk, YJk, VDk, LAMk,
                                      self.rtol, self.atol, self.max_step, self.max_steps, self.stats, K, F, sc)
@@ -242,6 +260,8 @@ class CompiledRun:
         for j in np.unique(step):
             sel = np.flatnonzero(step == j)
             t0, h = ST[j]
+            if self.friction is not None:   # the modes in force during that step
+                self.friction.set_modes(float(t0))
             tq = np.clip(ts[sel], t0, t0 + h)
             Yk, VDk, LAMk = np.zeros((len(sel), n)), np.zeros((len(sel), sys.nv)), np.zeros((len(sel), sys.nc))
             status = fastdop.from_checkpoint(a, w, fastdop.COEFFS, float(t0), float(h), SY[j].copy(), f, tq, Yk,
@@ -272,12 +292,18 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     with the compiled DOP853 (raises NotCompiled when the model needs the reference path, and Stiff
     when stiff_check is set and the model is stiff). progress(t) is called with the time reached [s]
     every chunk of outputs; Ctrl-C ends the run with success=False and every output before it."""
-    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check, state=(rep.q, rep.v))
+    friction = len(sys.lock_rows) > 0   # joint friction: absolute coordinates, no stiffness hand-over
+    if sys.derived.get("friction not compiled"):   # a held group met by an earlier try (solvers.friction_run)
+        raise NotCompiled(sys.derived["friction not compiled"])
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check and not friction,
+                      state=(rep.q, rep.v), friction=friction)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
     times = np.asarray(times, float)
     partial = lambda Y, n: _result(sys, rep, run, times[:n], Y[:n], stats={"assembly": rep})  # noqa: E731
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial)
+    if status == FRICTION_FAILED:   # name the element whose coupled solve failed
+        run.run_error = run.friction.failure(t_fail, y_fail)
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
     if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the last sample
@@ -379,8 +405,10 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
     rows, so that the determinate components are exact. All samples in one compiled call with r x r and
     d x d Cholesky solves only (d dependent rows; mbdsim.solvers.minnorm), the SVD pseudo-inverse where
     the rows are dependent at the sample's configuration too (a change point) or where the kernel solved
-    for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`)."""
-    if len(rows) == sys.nc or not len(times):
+    for other loop rows than `rows` (re-selected as the configuration changed: LAM nonzero off `rows`).
+    The lock rows of joint friction keep their multipliers as solved (the friction loads) and take no share."""
+    keep = np.asarray(getattr(sys, "lock_rows", ()), dtype=np.int64)
+    if len(rows) + len(keep) == sys.nc or not len(times):
         return LAM
     per_sample = 8 * sys.nc * sys.nv   # bytes of one sample's dense Jacobian
     if per_sample > MULTIPLIER_BYTES:
@@ -398,21 +426,25 @@ def _full_multipliers(sys, rows, times, Y, VD, LAM):
                  for k in range(0, len(times), step)]
         return np.concatenate(parts)
     J = jacobians(sys, Y[:, :sys.nq])                       # (N, nc, nv); LAM is zero off `rows` unless re-selected
-    rows = np.asarray(rows, dtype=np.int64)
-    key = ("dependent rows", rows.tobytes())
+    cols = np.setdiff1d(np.arange(sys.nc), keep)   # the rows that share the constraint load (all but locks)
+    Js = J if not len(keep) else np.ascontiguousarray(J[:, cols])
+    rows = np.searchsorted(cols, np.asarray(rows, dtype=np.int64)).astype(np.int64)
+    key = ("dependent rows", rows.tobytes(), keep.tobytes())
     dep = sys.derived.get(key)
     if dep is None:   # the same rows at every call of a run: computed once (the rows not in `rows`, sorted)
-        free = np.ones(sys.nc, dtype=bool)
+        free = np.ones(len(cols), dtype=bool)
         free[rows] = False
         dep = sys.derived[key] = np.flatnonzero(free).astype(np.int64)
-    LAM = np.ascontiguousarray(LAM, dtype=float)
-    out, bad = np.zeros_like(LAM), np.zeros(len(LAM), dtype=np.bool_)
-    minnorm.min_norm_multipliers(np.ascontiguousarray(J), LAM, rows, dep, out, bad)
-    bad |= np.any(LAM[:, dep] != 0.0, axis=1)   # the kernel re-selected its loop rows (fastdyn._reselect)
+    LAMs = np.ascontiguousarray(LAM[:, cols], dtype=float)
+    outs, bad = np.zeros_like(LAMs), np.zeros(len(LAMs), dtype=np.bool_)
+    minnorm.min_norm_multipliers(Js, LAMs, rows, dep, outs, bad)
+    bad |= np.any(LAMs[:, dep] != 0.0, axis=1)   # the kernel re-selected its loop rows (fastdyn._reselect)
     if np.any(bad):   # rows dependent at this configuration too (a change point): SVD pseudo-inverse
-        load = np.einsum("nri,nr->ni", J[bad], LAM[bad])
+        load = np.einsum("nri,nr->ni", Js[bad], LAMs[bad])
         rcond = np.finfo(float).eps * max(sys.nc, sys.nv)
-        out[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(J[bad], (0, 2, 1)), rcond=rcond), load)
+        outs[bad] = np.einsum("nij,nj->ni", np.linalg.pinv(np.transpose(Js[bad], (0, 2, 1)), rcond=rcond), load)
+    out = np.array(LAM, dtype=float)   # (the locks' columns as solved)
+    out[:, cols] = outs
     keep_jacobians(sys, out, J)   # the reactions read from these multipliers reuse their Jacobians
     return out
 

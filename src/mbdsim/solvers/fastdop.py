@@ -25,14 +25,15 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
-from . import fasttree
-from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows, normalize_into, project,
-                      read_state, rhs, tree_project, write_state)
+from . import fastfriction, fasttree
+from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, _to6, accelerations, joint_rows,
+                      normalize_into, project, read_state, rhs, tree_project, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
 EVENTS_FULL = 10       # run status: the sensor event buffer is full (hand the events over and call again)
 SENSOR_XTOL = 1e-13    # [s]: sensor times are located on the dense output to this
+FRICTION_EVENT = 13    # run status: a joint-friction switching function crossed zero; y is the state at st[0]
 
 N_STAGES = _c.N_STAGES
 # Hairer's stiffness test flags h |df|/|dy| above this; dop853.f uses 6.1, but stability-limited steps of an
@@ -138,18 +139,45 @@ def _sensor_g(cm, wk, t, y, yo, g):
     sensor_values(cm[43], wk[44], t, yo, r, A, rd, w, g)
 
 
+@kernel(_nrt=False)
+def _friction_g(cm, wk, t, y, yo, g):
+    """Each joint-friction element's switching function (solvers.fastfriction.switching) at the
+    integrator's state y at t [s] into g, from the coupled solve there (Euler parameters normalised in
+    the copy yo); status of that solve."""
+    fw = wk[50]
+    nq = cm[31][0]
+    for i in range(y.shape[0]):
+        yo[i] = y[i]
+    normalize_into(cm, yo[:nq])
+    s_ = accelerations(cm, wk, t, yo[:nq], yo[nq:], yo[:nq], fw[12], fw[13], bool(True))
+    _to6(cm, yo[nq:], fw[14])
+    fastfriction.switching(cm[48], fw, wk[5], cm[12], cm[13], wk[1], fw[13], fw[14], g)
+    return s_
+
+
+@kernel(_nrt=False)
+def _signal(cm, wk, t, y, yo, g, which):
+    """The watched signals at state y and t [s] into g: the sensors (which = 0, `_sensor_g`) or the
+    joint-friction switching functions (1, `_friction_g`)."""
+    if which == 0:
+        _sensor_g(cm, wk, t, y, yo, g)
+    else:
+        _friction_g(cm, wk, t, y, yo, g)
+
+
 @kernel(_nrt=False, inline="always")
-def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
-    """The time [s] in (t0, t0 + h] at which sensor k's value changes sign on the dense output (F, y0) of
-    the step from t0, by the Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the
-    step's ends do not bracket a sign change (the crossing is then not an event, as a failed bracket of
-    the reference path's brentq)."""
+def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which):
+    """The time [s] in (t0, t0 + h] at which signal k (`_signal` `which`: a sensor's value, a friction
+    element's switching function) changes sign on the dense output (F, y0) of the step from t0, by the
+    Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the step's ends do not
+    bracket a sign change (the crossing is then not an event, as a failed bracket of the reference
+    path's brentq)."""
     a, b = t0, t0 + h
     _dense(F, y0, t0, h, a, yd)
-    _sensor_g(cm, wk, a, yd, yo, g)
+    _signal(cm, wk, a, yd, yo, g, which)
     fa = g[k]
     _dense(F, y0, t0, h, b, yd)
-    _sensor_g(cm, wk, b, yd, yo, g)
+    _signal(cm, wk, b, yd, yo, g, which)
     fb = g[k]
     if fb == 0.0:
         return b
@@ -163,7 +191,7 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g):
         if not a < c < b:
             c = 0.5 * (a + b)
         _dense(F, y0, t0, h, c, yd)
-        _sensor_g(cm, wk, c, yd, yo, g)
+        _signal(cm, wk, c, yd, yo, g, which)
         fc = g[k]
         if fc == 0.0:
             return c
@@ -201,7 +229,7 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
         if not have_F:
             _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
             have_F = True
-        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp)
+        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0)
         rising = gn > gp
         if tk <= t or (ex[19][k] != 0 and (ex[19][k] > 0) != rising):
             continue
@@ -223,6 +251,29 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
         elif g_prev[k] != 0.0:   # exactly at the threshold: the sign after the crossing
             g_prev[k] = -g_prev[k]
     return t_stop, have_F
+
+
+@kernel(_nrt=False)
+def _watch_friction(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
+    """Joint friction after the accepted step (t, h) from y to ynew: the first time a switching function
+    that was positive at the last accepted step reaches zero, located on the step's dense output (F,
+    computed here unless have_F), or np.inf when none did (the values at ynew then become the last
+    accepted ones); and whether F holds the step's dense output."""
+    fw = wk[50]
+    gp, gn = fw[2], fw[16]
+    _friction_g(cm, wk, t + h, ynew, scale, gn)
+    t_ev = np.inf
+    for e in range(gn.shape[0]):
+        if gp[e] > 0.0 and not gn[e] > 0.0:
+            if not have_F:
+                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+                have_F = True
+            te = _sensor_time(cm, wk, F, y, t, h, e, ys, scale, fw[18], 1)
+            t_ev = min(t_ev, te if te > t else t + h)
+    if t_ev == np.inf:
+        for e in range(gn.shape[0]):
+            gp[e] = gn[e]
+    return t_ev, have_F
 
 
 @kernel(_nrt=False, inline="always")
@@ -288,7 +339,11 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     With `watch`, the model's expression sensors (cm[43] slots 18-21) are evaluated after every accepted
     step (`_watch`): events go to the buffer wk[44][4] (EVENTS_FULL when it may not hold the next step's:
     hand them over, reset the count wk[44][5] and call again), and a "stop" event ends the run with
-    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time."""
+    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time. With `watch` and
+    joint friction (cm[48]), its switching functions are watched the same way (`_watch_friction`; their values
+    at the start computed here, with the modes the caller set in wk[50]): the first zero ends the run with
+    FRICTION_EVENT, the outputs up to its time written and y the projected state at st[0] = that time (the
+    caller decides the modes there and restarts with h = 0)."""
     E3, E5 = co[3], co[4]
     nq = cm[31][0]
     n = y.shape[0]
@@ -304,7 +359,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         st[1] = h
         if watch:   # the sensors' values at the start: a sign change from them is an event
             _sensor_g(cm, wk, t, y, sc[3], wk[44][2])
+            if cm[48][0].shape[0]:   # and the friction switching functions (the modes set by the caller)
+                _friction_g(cm, wk, t, y, sc[3], wk[50][2])
     n_sensors = wk[44][2].shape[0] if watch else 0
+    n_friction = cm[48][0].shape[0] if watch else 0
     written = 0
     steps0, nfev0 = stats[0], stats[2]
     failed = 0   # consecutive steps a Python-callable load failed in (solvers.pyloads)
@@ -408,6 +466,21 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 write_state(cm, wk, yo, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
                 iout += 1
                 written += 1
+        if n_friction > 0:   # a stick/slip event: the outputs up to its time, the state there, and back to
+            computed = have_F   # the caller, which decides the modes from it and restarts
+            t_ev, have_F = _watch_friction(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale)
+            if have_F and not computed:
+                stats[2] += 3
+            if t_ev < np.inf:
+                while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
+                    iout -= 1
+                _dense(F, y, t, h, t_ev, yo)
+                s_ = _project(cm, wk, t_ev, yo, proj_tol, bool(True))
+                stats[3] += 1
+                for i in range(n):
+                    y[i] = yo[i]
+                st[0], st[1] = t_ev, h
+                return (FRICTION_EVENT if s_ == OK else s_), iout
         if n_sensors > 0:
             computed = have_F
             t_stop, have_F = _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale)

@@ -31,11 +31,12 @@ from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_square import square_factor, square_solve
 from .kkt_tree import _row_dot, dense_factor, dense_solve, kkt_factor, kkt_solve
-from . import fasttree, loopcoord, pathcoord, treecoord
+from . import fastfriction, fasttree, loopcoord, pathcoord, treecoord
 from .pycall import call_address
 
 OK, SINGULAR, PROJECTION, NONFINITE, TINY_STEP, MAX_STEPS, STIFF, INTERRUPTED = 0, 1, 2, 3, 4, 5, 6, 7
 CALLBACK_FAILED = 11   # a Python-callable load raised (solvers.pyloads keeps the error); 8-10: fastdop
+FRICTION_FAILED = 12   # the coupled joint-friction solve did not converge (element in wk[50][15]); 13: fastdop
 
 
 @kernel(_nrt=False)
@@ -250,6 +251,8 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     for i in range(lam.shape[0]):
         lam[i] = 0.0
     _solve(cm, wk, F, wk[7], x6, lam)
+    if cm[48][0].shape[0] and not _friction(cm, wk, x6, lam):
+        return FRICTION_FAILED
     _from6(cm, x6, vd)
     if cm[50][0].shape[0]:   # loop couplers: the auxiliary angles' accelerations, the link rows' multipliers
         loopcoord.aux_rates(cm[50], wk[52], x6, vd, lam)
@@ -260,6 +263,66 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     for i in range(vd.shape[0]):
         if not np.isfinite(vd[i]):
             return NONFINITE
+    return OK
+
+
+@kernel(_nrt=False)
+def _friction(cm, wk, x6, lam):
+    """Joint friction (solvers.fastfriction): the unit solutions of the loads -J_lock^T of the elements with a
+    mode (the factorisation in wk, zero row right-hand side), then the coupled loads, into x6 and lam;
+    False when their iteration fails."""
+    fc, fw = cm[48], wk[50]
+    if _unit_solutions(cm, wk) == 0:
+        for e in range(fw[0].shape[0]):
+            lam[fc[0][e]] = 0.0
+        return True
+    return fastfriction.couple(fc, fw, wk[5], cm[12], cm[13], wk[1], wk[7], x6, lam)
+
+
+@kernel(_nrt=False)
+def _unit_solutions(cm, wk):
+    """Accelerations and multipliers (wk[50][3], [4]) of the unit loads -J_lock^T of the friction elements
+    with a mode, with the factorisation in wk and a zero row right-hand side; their number."""
+    fw = wk[50]
+    mode, E6, EL, F6, zc = fw[0], fw[3], fw[4], fw[5], fw[6]
+    Jc, bi, bj = wk[5], cm[12], cm[13]
+    lock = cm[48][0]
+    n = 0
+    for e in range(mode.shape[0]):
+        if mode[e] == 0:
+            continue
+        n += 1
+        r = lock[e]
+        for f in range(F6.shape[0]):
+            for c in range(6):
+                F6[f, c] = 0.0
+        for side in range(2):
+            b = bi[r] if side == 0 else bj[r]
+            if b != 0:
+                for c in range(6):
+                    F6[b, c] -= Jc[r, side, c]
+        for i in range(EL.shape[1]):
+            EL[e, i] = 0.0
+        _solve(cm, wk, F6, zc, E6[e], EL[e])
+    return n
+
+
+@entry(_nrt=False)
+def stick_velocities(cm, wk, t, y):
+    """The velocities of the state y = [q, v] at t [s] (absolute coordinates) corrected in place so that
+    the joints of the sticking friction elements (wk[50]) are at rest: the mass-weighted minimum-norm
+    correction that keeps the other constraints' rates (`fastfriction.stick_rates`); status."""
+    nq = cm[31][0]
+    q, v = y[:nq], y[nq:]
+    _constraints(cm, wk, t, q, v)
+    if not _factor(cm, wk):
+        return SINGULAR
+    _unit_solutions(cm, wk)
+    v6 = wk[50][14]
+    _to6(cm, v, v6)
+    if not fastfriction.stick_rates(cm[48], wk[50], wk[5], cm[12], cm[13], v6):
+        return SINGULAR
+    _from6(cm, v6, v)
     return OK
 
 

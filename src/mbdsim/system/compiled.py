@@ -15,6 +15,7 @@ import numpy as np
 from ..model.contacts import ShapeContact
 from ..model.element_specs import Bushing, Contact
 from ..model.forces import Force, SpringDamper, Torque
+from ..model.friction_path import JointFriction
 from . import exprloads_pack, jointtree, loopcoords, packing, pathcoords
 from .measures import locate
 from .topology import Topology, system_topology
@@ -102,11 +103,12 @@ class CompiledModel:
     #                           user constraints: system.jointtree.coord_arrays, solvers.treecoord)
     coord_stack: int = 4      # stack size of their programs
     loop_coords: tuple = ()   # arrays()[50]: coordinate constraints in absolute coordinates (closed loops:
-    #                           system.loopcoords, solvers.loopcoord); 48, 49 are kept for joint friction
-    #                           and point-on-curve parameters
+    #                           system.loopcoords, solvers.loopcoord); 48: joint friction, 49: point-on-curve
+    #                           parameters
     loop_stack: int = 4       # stack size of their programs
     paths: tuple = ()         # arrays()[49]: point-on-curve constraints (system.pathcoords, solvers.pathcoord)
     path_stack: int = 4
+    friction: tuple = ()      # arrays()[48]: joint friction elements (`_friction`, solvers.fastfriction; issue 29)
 
     def arrays(self):
         """The slots cm[0..] the kernels take (`tuple_`'s order), as one `mbdsim._slots.Slots` (made once per
@@ -132,7 +134,8 @@ class CompiledModel:
                 self.dims, self.active, self.vecs, self.par, np.zeros(0),
                 *self.bushings, self.tree, self.exprloads, self.contacts, self.cand,
                 self.shape_contacts or _shape_contacts(None, ()), self.coords or jointtree.empty_coords(),
-                np.zeros(0), self.paths or pathcoords.empty(), self.loop_coords or loopcoords.empty())
+                self.friction or _friction(None), self.paths or pathcoords.empty(),
+                self.loop_coords or loopcoords.empty())
 
 
 @dataclass
@@ -172,7 +175,7 @@ class Work:
              # [load callback address (0: none), failed flag, driver callback address (0: none)]
              (z((nf, 6)), np.zeros(3, np.int64)),
              _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
-             z(0),                  # 50: kept for joint friction
+             _friction_work(cm.friction or _friction(None), nf, nc, nv),   # 50: joint friction (solvers.fastfriction)
              pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
              loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack))   # 52: solvers.loopcoord
         work = cls(a)
@@ -201,6 +204,34 @@ def _coord_work(cm, nf) -> tuple:
     z = np.zeros
     return (z(1 + width), z(cm.coord_stack), z(nt), z(nt), z(nt), z(m), z(m), z(m), z((m, nj)), z((m, m)), z(m),
             z(m), z(2 * nj), z(nj), z((nf, 6)), z((m, 3)))
+
+
+def _friction(sys) -> tuple:
+    """The joint friction elements of `sys` (its lock rows' owners, in the order of sys.switched) for
+    solvers.fastfriction (layout there): lock rows, joint rows, frames, axis and joint point, parameters."""
+    from .force_elements.friction_kkt import term_weights
+    els = [] if sys is None else [sys.model.forces[n] for n in sys.switched]
+    k = len(els)
+    width = max([len(sys.owner_rows[e.joint.name]) for e in els], default=1)
+    lock, jrows = np.zeros(k, np.int64), -np.ones((k, width), np.int64)
+    fid, vec, par = np.zeros((k, 2), np.int64), np.zeros((k, 2, 3)), np.zeros((k, 8))
+    for i, e in enumerate(els):
+        g, jr = sys.geoms[e.joint.name], sys.owner_rows[e.joint.name]
+        b, s_b = (g.bj, g.s_j) if g.bj != 0 else (g.bi, g.s_i)
+        lock[i] = sys.owner_rows[e.name][0]
+        jrows[i, :len(jr)] = jr
+        fid[i] = (b, g.bi)
+        vec[i] = (g.h_i, s_b)
+        par[i] = (e.mu_static, e.mu_dynamic, e.preload, *term_weights(e), float(bool(sys.frame_rigid[b])))
+    return lock, jrows, fid, vec, par
+
+
+def _friction_work(fc, nf, nc, nv) -> tuple:
+    """Work of solvers.fastfriction (layout there) for the packed elements fc."""
+    k = len(fc[0])
+    z = np.zeros
+    return (np.zeros(k, np.int64), z(k), z(k), z((k, nf, 6)), z((k, nc)), z((nf, 6)), z(nc), z((k, k)), z(k), z(k),
+            z(k), z((k, 4, 3)), z(nv), z(nc), z((nf, 6)), np.zeros(2, np.int64), z(k), z((3, 3)), z(k), z(nc))
 
 
 def _contacts(sys) -> tuple:
@@ -255,9 +286,13 @@ def _driver_programs(fns):
         from . import exprvm
     except ImportError:
         raise NotCompiled("the expression compiler (system.exprvm) is not available") from None
+    from .force_elements.friction import StickSlip
     progs, called, slots = [], [], []
     for d, fn in enumerate(fns):
         sym = getattr(fn, "symbolic", None)
+        if isinstance(fn, StickSlip):   # a friction lock row: target 0, phi is the joint coordinate itself
+            progs.extend((exprvm.constant_program(0.0),) * 3)
+            continue
         if sym is not None:   # a driver reading model inputs: inputs and anchors as constants (written later)
             p = []
             for node in (sym.value, sym.d1, sym.d2):
@@ -327,8 +362,8 @@ def _loads(sys, skip=()):
             mi, mj = e.marker_i, e.marker_j
             bu.append(((sys.fid[mi.body], sys.fid[mj.body]), (mi.s_B, mj.s_B), (mi.R_BM, mj.R_BM),
                        e.stiffness, e.damping, e.preload))
-        elif type(e) is Contact or type(e) is ShapeContact:
-            continue   # packed by _contacts / _shape_contacts
+        elif type(e) is Contact or type(e) is ShapeContact or type(e) is JointFriction:
+            continue   # packed by _contacts / _shape_contacts / _friction
         elif type(e) is SpringDamper:
             sp.append(((sys.fid[e.marker_i.body], sys.fid[e.marker_j.body]),
                        (e.marker_i.s_B, e.marker_j.s_B), (e.stiffness, e.damping, e.free_length, e.preload)))
@@ -346,22 +381,25 @@ def _loads(sys, skip=()):
             arr([p[2] for p in sp], (m, 4)))
 
 
-def compile_system(sys, rows, state=None) -> CompiledModel:
+def compile_system(sys, rows, state=None, friction=False) -> CompiledModel:
     """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported.
     With the assembled state=(q, v) a tree of one-degree-of-freedom joints gets its joint-coordinate
-    model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm).  Kept in
-    sys.derived for the same rows and state (a System reused for an unchanged Model compiles once)."""
+    model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm).  Joint friction
+    (lock rows) only with `friction` (the caller runs its stick/slip events: solvers.compiled_run), in
+    absolute coordinates.  Kept in sys.derived for the same rows, state and flag (a System reused for an
+    unchanged Model compiles once)."""
     rows = np.asarray(rows, dtype=np.int64)
-    key = (rows.tobytes(), None if state is None else tuple(np.asarray(x, float).tobytes() for x in state))
+    key = (rows.tobytes(), None if state is None else tuple(np.asarray(x, float).tobytes() for x in state),
+           bool(friction))
     kept = sys.derived.get("compiled")
     if kept is not None and kept[0] == key:
         return kept[1]
-    cm = _compile_system(sys, rows, state)
+    cm = _compile_system(sys, rows, None if friction and len(sys.lock_rows) else state, friction)
     sys.derived["compiled"] = (key, cm)
     return cm
 
 
-def _compile_system(sys, rows, state) -> CompiledModel:
+def _compile_system(sys, rows, state, friction=False) -> CompiledModel:
     nf = sys.nbody + 1
     rows = np.asarray(rows, dtype=np.int64)
     paths = len(getattr(sys.model, "path_constraints", {})) > 0   # (absolute coordinates: solvers.pathcoord)
@@ -373,10 +411,10 @@ def _compile_system(sys, rows, state) -> CompiledModel:
         rows = rows[~np.isin(rows, jointtree.coord_rows(sys))]   # the absolute solve of the outputs skips them
     elif getattr(sys, "not_compiled", None):   # issue 11: rows the kernels do not evaluate, callable sensors
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
-    if len(sys.lock_rows):
-        names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: see docs/theory.md 12c
-        raise NotCompiled(f"joint friction (stick/slip) is not compiled yet: {names} run on the event-driven "
-                          "reference DOP853 (force_elements/friction.py)")
+    if len(sys.lock_rows) and not friction:
+        names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: docs/theory.md 12c
+        raise NotCompiled(f"joint friction (stick/slip) is compiled for the DOP853 step loop only: {names} "
+                          "run on the event-driven reference (force_elements/friction.py)")
     M6 = np.zeros((nf, 6, 6))
     M6[:, range(6), range(6)] = 1.0
     M6[1:, range(3), range(3)] = sys.mass[1:, None]
@@ -413,7 +451,8 @@ def _compile_system(sys, rows, state) -> CompiledModel:
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
                          np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
-                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack, pc, pstack)
+                         tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack, pc, pstack,
+                         _friction(sys if len(sys.lock_rows) else None))
 
 
 def _candidates(sys, topo) -> np.ndarray:

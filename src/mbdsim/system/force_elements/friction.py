@@ -32,9 +32,10 @@ any time - dense output, Result.at - uses the mode in force then):
   carried by the loop through zero velocity (slips on in the direction of its kinematic acceleration);
   the others by the complementarity conditions of Coulomb friction, solved over all their
   stick/slip assignments with the coupled normal loads.
-Only the "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic (through the
-EventTracker hooks on_start / on_event / switch); other analyses raise a ModelError naming the
-element.  One friction element per joint; a joint driven by a motion cannot have friction.  The
+The "dop853"/"rk45"/"radau"/"bdf" methods of mb.simulate run this logic on the reference path
+(through the EventTracker hooks on_start / on_event / switch); "auto" and "dop853" run it on the
+compiled core (solvers.fastfriction, solvers.friction_run: the same decisions, docs/theory.md 12c);
+other analyses raise a ModelError naming the element.  One friction element per joint; a joint driven by a motion cannot have friction.  The
 joint's `reaction_force` does not include the friction force (`res.friction_force(name)` gives it;
 `res.friction_events(name)` the stick/slip history).  Energy: `dissipation` = lambda_f xd >= 0 [W].
 """
@@ -50,8 +51,7 @@ from . import register
 from .friction_kkt import load_maps, normal_load
 from .friction_lcp import decide_all, stuck_margin
 
-V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
-STICK_TOL = 1e-10   # relative tolerance on the static friction limit
+from ...solvers.fastfriction import STICK_TOL, V_TOL   # noqa: F401  (one definition, shared with the kernels)
 
 
 class StickSlip:

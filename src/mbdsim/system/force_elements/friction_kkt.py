@@ -16,7 +16,7 @@ import numpy as np
 from ..._blas import scipy_linalg
 from ...math.rotation import skew
 
-MAXIT = 50          # iterations of the coupled friction KKT solve
+from ...solvers.fastfriction import MAXIT   # iterations of the coupled friction KKT solve (one definition)
 
 
 def load_maps(sys, fr, J, elem):
@@ -32,15 +32,20 @@ def load_maps(sys, fr, J, elem):
     if sys.frame_rigid[b]:
         A = fr.A[b]
         LT = A @ (-J[jr, a + 3:a + 6].T) - skew(A @ s_b) @ LF
-    e = elem
     TP, TA = (None, None) if LT is None else (P @ LT, h[None] @ LT)   # bending / torsional moment maps
-    inv = lambda x: 1.0 / x if x else None  # noqa: E731
-    if e.joint.kind == "revolute":
-        terms = [(e.pin_radius, P @ LF), (e.friction_arm, h[None] @ LF),
-                 (e.pin_radius * inv(e.bending_arm) if e.bending_arm else None, TP)]
-    else:
-        terms = [(1.0, P @ LF), (inv(e.effective_length), TP), (inv(e.reaction_arm), TA)]
+    terms = zip(term_weights(elem), (P @ LF, h[None] @ LF, TP, TA))
     return jr, [(w, L) for w, L in terms if w and L is not None]
+
+
+def term_weights(elem):
+    """Weights (w_PF, w_hF, w_PT, w_hT) of the normal-load terms |P F|, |h.F|, |P T|, |h.T| (0: omitted), see
+    force_elements.friction: revolute (pin_radius, friction_arm, pin_radius / bending_arm, 0), translational
+    (1, 0, 1 / effective_length, 1 / reaction_arm)."""
+    e = elem
+    inv = lambda x: 1.0 / x if x else 0.0  # noqa: E731
+    if e.joint.kind == "revolute":
+        return (e.pin_radius, e.friction_arm or 0.0, e.pin_radius * inv(e.bending_arm), 0.0)
+    return (1.0, 0.0, inv(e.effective_length), inv(e.reaction_arm))
 
 
 def normal_load(elem, maps, lam_j):
