@@ -64,7 +64,7 @@ def test_progress_partial_results_and_final_result(method):
     last = partial[-1]
     n = len(last.time)
     assert np.array_equal(last.time, res.time[:n]) and np.allclose(last.q, res.q[:n], rtol=0, atol=1e-14)
-    assert res.stats["steps"] >= 1 and res.stats["method"] in ("HHT", "RK45")
+    assert res.stats["steps"] >= 1 and res.stats["method"].split(" (")[0] in ("HHT", "RK45")
     # energy of the rigid pendulum: conserved to the method's accuracy (HHT dissipates slightly)
     E = res.kinetic_energy() + res.potential_energy()
     assert np.max(np.abs(E - E[0])) < (1e-3 if method == "hht" else 1e-6)
