@@ -140,3 +140,24 @@ def test_pendulum_half_period_at_rtol_1e7():
     assert abs(t_min - half_period) < 1e-4
     assert abs(th_min + np.pi) < 1e-5
     assert 1 <= res.stats["njev"] < res.stats["steps"] / 5   # tangents reused across steps
+
+
+def test_compiled_hht_steps_never_turn_a_spinning_body_past_its_branch():
+    """A shaft in a closed loop (revolute + coaxial cylindrical: absolute coordinates) spun up by a constant
+    torque from -1 rad/s to ~74 rad/s: theta = w0 t + T t^2 / (2 J). Constant accelerations leave HHT's
+    error estimate near zero; without a bound on the rotation per step it took 0.1 s steps (7 rad each)
+    and ended 3 rad off."""
+    import warnings
+    J, T, w0 = 0.004, 0.2, -1.0
+    m = mb.Model("shaft_loop", gravity=(0.0, 0.0, 0.0))
+    s1 = m.add_body("s1", 1.0, inertia=(J, J, J))
+    m.add_revolute("R1", m.ground, s1, (0, 0, 0), (0, 0, 1), initial_velocity=w0)
+    m.add_cylindrical("C1", m.ground, s1, (0, 0, 0), (0, 0, 1))
+    m.add_torque("T", "s1", (0.0, 0.0, T))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        res = mb.simulate(m, 1.5, 0.01, method="hht")
+    assert res.success and res.stats["method"] == "HHT (compiled)"
+    th = res.joint_coordinate("R1")
+    assert th.max() > 50.0
+    assert np.max(np.abs(th - (w0 * res.time + 0.5 * T / J * res.time**2))) < 1e-3
