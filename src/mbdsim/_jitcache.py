@@ -38,7 +38,8 @@ KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.p
                   "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
                   "solvers/pycall.py", "cosim/_stepper.py", "solvers/fastnarrow.py", "solvers/fastcontact.py",
                   "solvers/treecoord.py", "solvers/fastradau.py", "solvers/fastbroad.py", "solvers/fastgjk.py",
-                  "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py")
+                  "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py",
+                  "solvers/fastridge.py", "solvers/fastmeshpair.py")
 
 
 # numba's flags of mbdsim's two kinds of kernels (mbdsim._jit: @kernel, @entry); numba's index does not record
