@@ -98,3 +98,51 @@ def test_mesh_box_dropped_tilted_on_a_mesh_floor_comes_to_rest_flat(tmp_path):
     # at rest (e = 1) the points' forces k delta_i add up to the weight, whatever their share
     assert abs(last.penetration.mean() - mass * G / (len(last) * k)) < 1e-3 * mass * G / (len(last) * k)
     assert abs(last.normal_force.sum() - mass * G) < 1e-3 * mass * G
+
+
+def _below(V, T, cap):
+    """Per vertex of V (n, 3) the largest depth below the triangles T (m, 3, 3) whose plane it is less than
+    cap under and whose foot is on the triangle (0 where none): the brute-force count over all pairs."""
+    a, b, c = T[:, 0], T[:, 1], T[:, 2]
+    m = np.cross(b - a, c - a)
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    d = np.einsum("mk,nmk->nm", m, a[None] - V[:, None])
+    foot = V[:, None] + d[..., None] * m[None]
+    ab, ac, ap = b - a, c - a, foot - a[None]
+    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
+    d20, d21 = (ap * ab[None]).sum(2), (ap * ac[None]).sum(2)
+    den = d00 * d11 - d01 * d01
+    v = (d11 * d20 - d01 * d21) / den
+    w = (d00 * d21 - d01 * d20) / den
+    ok = (d > 0) & (d < cap) & (v >= -1e-9) & (w >= -1e-9) & (v + w <= 1 + 1e-9)
+    return np.where(ok, d, 0.0).max(axis=1)
+
+
+def test_mesh_pair_walk_finds_every_vertex_a_brute_force_count_finds():
+    """Two fine spheres (icosphere meshes, one turned) pressed 3 mm into each other: the points of the walk
+    of both hierarchies are those of every vertex against every triangle of the other mesh (3 mm is deeper
+    than the leaves' boxes are thick: the walk must grow them by the depth cap)."""
+    from mbdsim.solvers.fastcontact import REC_FIELDS
+    from mbdsim.solvers.fastmeshpair import SKIN
+    from mbdsim.system.assemble import assemble_system
+    from mbdsim.system.force_elements.shape_contact import loads
+    from mbdsim.system.frames import body_frames
+    s = trimesh.creation.icosphere(3, 0.1)
+    Rb = Rotation.from_rotvec((0.3, -0.2, 0.5)).as_matrix()
+    pb = np.array([0.01, 0.005, 0.197])
+    m = mb.Model()
+    lo = m.add_body("a", 1.0, (1e-3,) * 3)
+    m.add_fixed("fix", m.ground, lo)
+    up = m.add_body("b", 1.0, (1e-3,) * 3, position=pb, orientation=Rb)
+    c = m.add_contact("c", lo.add_shape("g", mb.Mesh(s.vertices, s.faces)),
+                      up.add_shape("g", mb.Mesh(s.vertices, s.faces)), 1e6, 1.0, 0.0, 1e-5)
+    sys_ = assemble_system(m)
+    fr = body_frames(sys_, sys_.q0, sys_.v0)
+    _, rec = loads(sys_, (fr.r, fr.A, fr.rd, fr.w), c, np.zeros((4096, len(REC_FIELDS))))
+    Va, Vb = s.vertices, s.vertices @ Rb.T + pb
+    cap = SKIN * 0.1
+    ref = np.concatenate([_below(Vb, Va[s.faces], cap), _below(Va, Vb[s.faces], cap)])
+    ref = np.sort(ref[ref > 0])
+    got = np.sort(rec[:, REC_FIELDS.index("penetration")])
+    assert len(ref) > 20 and ref.max() > 2e-3
+    assert len(got) == len(ref) and np.allclose(got, ref, rtol=1e-9, atol=1e-15), (len(got), len(ref))

@@ -6,7 +6,9 @@ bounding radii below a triangle (a vertex outside a closed mesh is behind its fa
 that); solvers.fastcontact keeps, per vertex, the direction of least depth (the nearest face).
 
 `mesh_mesh_points` walks the two bounding-volume hierarchies (geometry.bvh) together: pairs of nodes whose
-boxes overlap (x's node box, in x's axes, taken into msh's axes as the box around it), splitting the larger
+boxes overlap (x's node box, in x's axes, taken into msh's axes as the box around it, against msh's node box
+swept by its triangles moved SKIN x its bounding radius along their inward normals, sc[34], so that a vertex
+up to the depth cap below a triangle is met however thin the leaves), splitting the larger
 node of a pair first, down to pairs of leaves, whose triangles' vertices (of x) are tested against the
 triangles (of msh).  The cost grows with the size of the touching region, not with the product of the
 meshes' sizes.  Edge-edge crossings of two coarse meshes are not seen: only vertices push.
@@ -33,9 +35,9 @@ def _relative(Pm, Px):
 
 
 @kernel(_nrt=False)
-def _disjoint(nodes, na, nb, R, o0, o1, o2):
-    """Whether node na (msh's axes) and the box around node nb (x's axes; R, o: x's axes and origin in msh's)
-    do not overlap."""
+def _disjoint(swept, nodes, na, nb, R, o0, o1, o2):
+    """Whether node na's swept box (msh's axes) and the box around node nb (x's axes; R, o: x's axes and
+    origin in msh's) do not overlap."""
     c0, c1, c2 = 0.5 * (nodes[nb, 0] + nodes[nb, 3]), 0.5 * (nodes[nb, 1] + nodes[nb, 4]), \
         0.5 * (nodes[nb, 2] + nodes[nb, 5])
     h0, h1, h2 = 0.5 * (nodes[nb, 3] - nodes[nb, 0]), 0.5 * (nodes[nb, 4] - nodes[nb, 1]), \
@@ -46,8 +48,8 @@ def _disjoint(nodes, na, nb, R, o0, o1, o2):
     e0 = abs(R[0]) * h0 + abs(R[1]) * h1 + abs(R[2]) * h2
     e1 = abs(R[3]) * h0 + abs(R[4]) * h1 + abs(R[5]) * h2
     e2 = abs(R[6]) * h0 + abs(R[7]) * h1 + abs(R[8]) * h2
-    return l0 + e0 < nodes[na, 0] or l0 - e0 > nodes[na, 3] or l1 + e1 < nodes[na, 1] or \
-        l1 - e1 > nodes[na, 4] or l2 + e2 < nodes[na, 2] or l2 - e2 > nodes[na, 5]
+    return l0 + e0 < swept[na, 0] or l0 - e0 > swept[na, 3] or l1 + e1 < swept[na, 1] or \
+        l1 - e1 > swept[na, 4] or l2 + e2 < swept[na, 2] or l2 - e2 > swept[na, 5]
 
 
 @kernel(_nrt=False)
@@ -74,7 +76,7 @@ def _leaves(sc, x, Px, Pm, ta, na_, tb, nb_, S, cap):
 def mesh_mesh_points(sc, x, msh, Px, Pm):
     """The vertices of mesh x (pose Px) below the triangles of mesh msh (pose Pm) into the slot rows of
     sc[29], NSLOT per vertex of x (module docstring); returns how many slot rows to read."""
-    sv, rad, meta, nodes, links, S, stack = sc[6], sc[5], sc[21], sc[27], sc[28], sc[29], sc[30]
+    sv, rad, meta, nodes, links, S, stack, swept = sc[6], sc[5], sc[21], sc[27], sc[28], sc[29], sc[30], sc[34]
     nrow = (sv[x, 1] - sv[x, 0]) * NSLOT
     if nrow > S.shape[0] or meta[msh, 3] <= meta[msh, 2] or meta[x, 3] <= meta[x, 2]:
         return 0
@@ -87,7 +89,7 @@ def mesh_mesh_points(sc, x, msh, Px, Pm):
     while top > 0:
         top -= 2
         na, nb = stack[top], stack[top + 1]
-        if _disjoint(nodes, na, nb, R, o0, o1, o2):
+        if _disjoint(swept, nodes, na, nb, R, o0, o1, o2):
             continue
         la, lb = links[na, 0] < 0, links[nb, 0] < 0
         if la and lb:
