@@ -98,3 +98,54 @@ def test_mesh_box_dropped_tilted_on_a_mesh_floor_comes_to_rest_flat(tmp_path):
     # at rest (e = 1) the points' forces k delta_i add up to the weight, whatever their share
     assert abs(last.penetration.mean() - mass * G / (len(last) * k)) < 1e-3 * mass * G / (len(last) * k)
     assert abs(last.normal_force.sum() - mass * G) < 1e-3 * mass * G
+
+
+
+def _below(V, T, cap):
+    """Per vertex of V (n, 3) the least depth below the triangles T (m, 3, 3) whose plane it is less than
+    cap under and whose foot is on the triangle (0 where none): the brute-force count over all pairs (the
+    nearest face; the faces here are planar, so the triangles of one face agree)."""
+    a, b, c = T[:, 0], T[:, 1], T[:, 2]
+    m = np.cross(b - a, c - a)
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    d = np.einsum("mk,nmk->nm", m, a[None] - V[:, None])
+    foot = V[:, None] + d[..., None] * m[None]
+    ab, ac, ap = b - a, c - a, foot - a[None]
+    d00, d01, d11 = (ab * ab).sum(1), (ab * ac).sum(1), (ac * ac).sum(1)
+    d20, d21 = (ap * ab[None]).sum(2), (ap * ac[None]).sum(2)
+    den = d00 * d11 - d01 * d01
+    v = (d11 * d20 - d01 * d21) / den
+    w = (d00 * d21 - d01 * d20) / den
+    ok = (d > 0) & (d < cap) & (v >= -1e-9) & (w >= -1e-9) & (v + w <= 1 + 1e-9)
+    best = np.where(ok, d, np.inf).min(axis=1)
+    return np.where(np.isfinite(best), best, 0.0)
+
+
+def test_mesh_pair_walk_finds_every_vertex_a_brute_force_count_finds():
+    """A finely meshed box pressed 0.3-1.7 mm (slightly turned) into a fine mesh floor: the points of the
+    walk of both hierarchies are those of every vertex against every triangle of the other mesh.  The flat
+    leaves have no thickness: only their boxes swept along the inward normals meet the vertices below them."""
+    from mbdsim.solvers.fastcontact import REC_FIELDS
+    from mbdsim.solvers.fastmeshpair import SKIN
+    from mbdsim.system.assemble import assemble_system
+    from mbdsim.system.force_elements.shape_contact import loads
+    from mbdsim.system.frames import body_frames
+    vf, ff = grid_surface(-0.2, -0.2, 20, 0.02)
+    cube = trimesh.creation.box(extents=(0.1, 0.1, 0.1))
+    vb, fb = trimesh.remesh.subdivide(*trimesh.remesh.subdivide(cube.vertices, cube.faces))
+    Rb = Rotation.from_rotvec((0.01, -0.015, 0.3)).as_matrix()
+    pb = np.array([0.003, -0.002, 0.05 - 0.001])
+    m = mb.Model()
+    box = m.add_body("b", 1.0, (1e-3,) * 3, position=pb, orientation=Rb)
+    c = m.add_contact("c", m.ground.add_shape("floor", mb.Mesh(vf, ff)), box.add_shape("g", mb.Mesh(vb, fb)),
+                      1e6, 1.0, 0.0, 1e-5)
+    sys_ = assemble_system(m)
+    fr = body_frames(sys_, sys_.q0, sys_.v0)
+    _, rec = loads(sys_, (fr.r, fr.A, fr.rd, fr.w), c, np.zeros((4096, len(REC_FIELDS))))
+    Vb = vb @ Rb.T + pb
+    cap = SKIN * min(np.linalg.norm(vb, axis=1).max(), np.linalg.norm(vf, axis=1).max())
+    ref = np.concatenate([_below(Vb, vf[ff], cap), _below(vf, Vb[fb], cap)])
+    ref = np.sort(ref[ref > 0])
+    got = np.sort(rec[:, REC_FIELDS.index("penetration")])
+    assert len(ref) >= 20 and ref.max() > 1.5e-3 and ref.min() < 5e-4
+    assert len(got) == len(ref) and np.allclose(got, ref, rtol=1e-9, atol=1e-15), (len(got), len(ref))

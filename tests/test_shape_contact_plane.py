@@ -60,9 +60,10 @@ def test_box_slides_down_an_incline_at_g_sin_minus_mu_cos(kind, tmp_path):
     assert abs(a / ref - 1) < 1e-3, (a, ref)
 
 
-def test_box_stays_on_an_incline_steeper_friction_than_tan(tmp_path):
+@pytest.mark.parametrize("kind", ["box", "convex", "stl"])
+def test_box_stays_on_an_incline_steeper_friction_than_tan(kind, tmp_path):
     theta = np.radians(20)
-    m, t = box_on_incline(theta, "box", tmp_path, mu_static=0.6, mu_dynamic=0.5, stiction_velocity=1e-3,
+    m, t = box_on_incline(theta, kind, tmp_path, mu_static=0.6, mu_dynamic=0.5, stiction_velocity=1e-3,
                           transition_velocity=1e-2)
     res = mb.simulate(m, 0.5, 0.01)
     assert res.success

@@ -35,3 +35,23 @@ def build(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
     node(np.arange(len(tv)))
     return np.array(order, np.int64), np.array(boxes, float).reshape(-1, 6), np.array(links, np.int64).reshape(-1, 4)
+
+
+def swept(vertices: np.ndarray, faces: np.ndarray, boxes: np.ndarray, links: np.ndarray, depth: float) -> np.ndarray:
+    """Node boxes (nn, 6: lower and upper corner [m]) grown to hold each of their triangles moved by up to depth
+    [m] along its inward normal (-n, n by the right-hand rule): a point up to depth below a triangle lies in
+    its leaf's swept box.  faces in the hierarchy's order (`build`'s order applied), links as `build` returns."""
+    tv = np.asarray(vertices, float)[np.asarray(faces, np.int64)]
+    n = np.cross(tv[:, 1] - tv[:, 0], tv[:, 2] - tv[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    lo, hi = tv.min(axis=1), tv.max(axis=1)
+    lo, hi = np.minimum(lo, lo - depth * n), np.maximum(hi, hi - depth * n)
+    out = np.array(boxes, float).reshape(-1, 6).copy()
+    for nd in range(len(links) - 1, -1, -1):   # children come after their parent
+        if links[nd, 0] < 0:
+            s, c = links[nd, 2], links[nd, 3]
+            out[nd] = np.concatenate([lo[s:s + c].min(axis=0), hi[s:s + c].max(axis=0)])
+        else:
+            a, b = out[links[nd, 0]], out[links[nd, 1]]
+            out[nd] = np.concatenate([np.minimum(a[:3], b[:3]), np.maximum(a[3:], b[3:])])
+    return out

@@ -78,7 +78,7 @@ def _local(shape):
 
 
 # sizes of the narrow phase's scratch arrays (solvers.fastgjk, solvers.fastmesh)
-_EPA_FACES, _EPA_EDGES, _STACK = 3000, 128, 128
+_EPA_FACES, _EPA_EDGES, _STACK = 3000, 128, 256
 
 
 def pack_contacts(sys, elems) -> tuple:
@@ -93,13 +93,17 @@ def pack_contacts(sys, elems) -> tuple:
     (21) per shape: triangle range and node range of its mesh (ns, 4), (22) triangles (nt, 3: rows of (7)),
     (23-26) EPA scratch (solvers.fastgjk), (27) hierarchy node boxes (nn, 6), (28) node links (nn, 4)
     (geometry.bvh), (29) mesh contact slots (solvers.fastmesh), (30) the hierarchy walk's stack, (31) edge
-    ranges (ns, 2) into (32) the edges of boxes and hulls (ne, 2: rows of (7); solvers.fastedges)."""
+    ranges (ns, 2) into (32) the edges of boxes and hulls (ne, 2: rows of (7); solvers.fastedges), (33) per
+    triangle of (22) its ridge and peak bits (nt,: geometry.ridges, solvers.fastridge), (34) the node boxes of
+    (27) swept along their triangles' inward normals (nn, 6: geometry.bvh.swept, solvers.fastmeshpair)."""
     from ..solvers.fastcontact import NREC
     from ..solvers.fastgjk import MAX_ITER
-    from ..solvers.fastmesh import NSLOT
-    from .bvh import build
+    from ..solvers.fastmesh import NSLOT, RIDGE_ROWS
+    from ..solvers.fastmeshpair import SKIN
+    from .bvh import build, swept
+    from .ridges import ridge_masks
     index, rows, verts, planes, pairs, par = {}, [], [], [], [], []
-    lbox, meta, tris, nodes, links, eran, edges = [], [], [], [], [], [], []
+    lbox, meta, tris, nodes, links, eran, edges, rmask, sweep = [], [], [], [], [], [], [], [], []
     nv = npl = nt = nn = ne = 0
     for ei, e in enumerate(elems):
         for a, b in e.pairs:
@@ -118,7 +122,9 @@ def pack_contacts(sys, elems) -> tuple:
                         f = np.asarray(s.geometry.faces, np.int64)
                         order, nb, nl = build(v, f)
                         tris.append(f[order] + nv)
+                        rmask.append(ridge_masks(v, f[order]))
                         nodes.append(nb)
+                        sweep.append(swept(v, f[order], nb, nl, SKIN * rad))
                         nl = nl.copy()
                         inner = nl[:, 0] >= 0
                         nl[inner, :2] += nn
@@ -158,8 +164,11 @@ def pack_contacts(sys, elems) -> tuple:
             np.zeros((_EPA_EDGES, 2), np.int64),
             np.concatenate(nodes).reshape(-1, 6) if nodes else np.zeros((0, 6)),
             np.concatenate(links).reshape(-1, 4) if links else np.zeros((0, 4), np.int64),
-            np.zeros((ncand * NSLOT, 9)), np.zeros(_STACK, np.int64), np.array(eran, np.int64).reshape(ns, 2),
-            np.concatenate(edges).reshape(-1, 2) if edges else np.zeros((0, 2), np.int64))
+            np.zeros((ncand * NSLOT + RIDGE_ROWS, 9)), np.zeros(_STACK, np.int64),
+            np.array(eran, np.int64).reshape(ns, 2),
+            np.concatenate(edges).reshape(-1, 2) if edges else np.zeros((0, 2), np.int64),
+            np.concatenate(rmask) if rmask else np.zeros(0, np.int64),
+            np.concatenate(sweep).reshape(-1, 6) if sweep else np.zeros((0, 6)))
 
 
 def empty_contacts() -> tuple:
@@ -169,4 +178,5 @@ def empty_contacts() -> tuple:
     return (z(0, i), z(0, i), z((0, 3)), z((0, 3, 3)), z((0, 3)), z(0), z((0, 2), i), z((0, 3)), z((0, 2), i),
             z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
             z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
-            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i), z((0, 2), i), z((0, 2), i))
+            z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i), z((0, 2), i), z((0, 2), i),
+            z(0, i), z((0, 6)))

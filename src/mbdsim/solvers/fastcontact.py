@@ -14,9 +14,11 @@ polyhedra's face normals picks the reference face of least penetration, whose no
 of every point: the incident shape's candidate points below it and inside the reference (vertices, rim
 points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
 line contacts get several points and the right moments; a convex shape against a triangle mesh through
-its bounding-volume hierarchy (solvers.fastmesh; a mesh no larger than a box or hull it meets puts its
-vertices on the polyhedron's faces instead); two triangle meshes by the vertices of each against the
-other's triangles (`_mesh_pair`, a penalty approximation for finely tessellated meshes); two cylinders, or a
+its bounding-volume hierarchy (solvers.fastmesh; with a box or hull also the mesh's ridges and peaks
+inside it, solvers.fastridge; a mesh no larger than a box or hull it meets puts its vertices on the
+polyhedron's faces instead); two triangle meshes by the vertices of each against the other's triangles
+(`_mesh_pair`, the two hierarchies walked together, solvers.fastmeshpair; a penalty approximation for
+finely tessellated meshes); two cylinders, or a
 capsule and a cylinder, with axes within LINE_SIN of parallel along their line (`_line_pair`: a point at
 each end of the overlap of the axes); the other convex pairs (cylinders and ellipsoids against
 curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
@@ -43,6 +45,7 @@ from .fastedges import hull_edges
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
 from .fastmesh import NSLOT, mesh_points
+from .fastmeshpair import mesh_mesh_points
 from .fastnarrow import (BOX, CAPSULE, CYLINDER, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
                          n_candidates, segments_closest, support_depth, to_ground, to_local)
 
@@ -347,12 +350,13 @@ def _line_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
 @kernel(_nrt=False)
 def _mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     """Two triangle meshes (a penalty approximation for finely tessellated meshes): the vertices of each
-    below the other's triangles (fastmesh.mesh_points, depth capped at a skin), per vertex the direction
-    of least depth (the nearest face of a closed mesh), each a point of the contact law."""
+    below the other's triangles (fastmeshpair.mesh_mesh_points: the two hierarchies walked together, depth
+    capped at a skin), per vertex the direction of least depth (the nearest face of a closed mesh), each a
+    point of the contact law."""
     S = sc[29]
     for side in range(2):
         x, msh, Px, Pm, sign = (b, a, Pb, Pa, 1.0) if side == 0 else (a, b, Pa, Pb, -1.0)
-        nrow = mesh_points(sc, x, msh, Px, Pm)
+        nrow = mesh_mesh_points(sc, x, msh, Px, Pm)
         for k in range(nrow // NSLOT):
             best, bd = -1, np.inf
             for s in range(k * NSLOT, (k + 1) * NSLOT):

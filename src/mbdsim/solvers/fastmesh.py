@@ -20,11 +20,8 @@ continuously from one triangle to the next (a ball rolling over the facets of a 
 the normal).  They are left in the slot rows of sc[29] (used, depth [m], point [m], normal m, weight),
 which solvers.fastcontact applies.
 
-Two triangle meshes (a penalty approximation, fine for finely tessellated meshes): the vertices of each
-are the candidate points against the other's triangles, counted only when less than SKIN times the smaller
-of the two bounding radii below a triangle (a vertex outside a closed mesh is behind its far faces, but
-deeper than that); solvers.fastcontact keeps, per vertex, the direction of least depth (the nearest face).
-Edge-edge crossings of two coarse meshes are not seen: only vertices push.
+For a box or hull the walk also collects the mesh's ridges and peaks inside it (solvers.fastridge), in
+the RIDGE_ROWS rows after the candidates' slots.  Two triangle meshes: solvers.fastmeshpair.
 """
 from __future__ import annotations
 
@@ -32,11 +29,12 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import CAPSULE, MESH, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastnarrow import BOX, CAPSULE, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastridge import ridge_points
 
 NSLOT = 4          # contact directions kept per candidate point
 COS_SAME = 0.95    # normals closer than this (cosine) are one direction
-SKIN = 0.5         # a mesh's vertex counts below another mesh's triangle to SKIN x the smaller bounding radius
+RIDGE_ROWS = 64    # slot rows after the candidates' for a polyhedron's ridge and peak points (solvers.fastridge)
 
 
 @kernel(_nrt=False)
@@ -122,10 +120,10 @@ def _keep(S, k, depth, x0, x1, x2, n0, n1, n2):
 
 
 @kernel(_nrt=False)
-def _triangle(sc, x, Px, Pm, t, S, cap):
-    """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points no deeper than cap [m] into
-    the slots S."""
-    kind, prm, sv, verts, rad, tri = sc[1], sc[4], sc[6], sc[7], sc[5], sc[22]
+def triangle(sc, Pm, t):
+    """Triangle t of a mesh (pose Pm) in ground: its corners a, b, c [m], outward unit normal m (the right-hand
+    rule) and whether it has an area."""
+    verts, tri = sc[7], sc[22]
     a0, a1, a2 = to_ground(Pm, verts[tri[t, 0], 0], verts[tri[t, 0], 1], verts[tri[t, 0], 2])
     b0, b1, b2 = to_ground(Pm, verts[tri[t, 1], 0], verts[tri[t, 1], 1], verts[tri[t, 1], 2])
     c0, c1, c2 = to_ground(Pm, verts[tri[t, 2], 0], verts[tri[t, 2], 1], verts[tri[t, 2], 2])
@@ -134,8 +132,31 @@ def _triangle(sc, x, Px, Pm, t, S, cap):
     m2 = (b0 - a0) * (c1 - a1) - (b1 - a1) * (c0 - a0)
     L = np.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
     if not L > 0.0:
+        return a0, a1, a2, b0, b1, b2, c0, c1, c2, 0.0, 0.0, 1.0, False
+    return a0, a1, a2, b0, b1, b2, c0, c1, c2, m0 / L, m1 / L, m2 / L, True
+
+
+@kernel(_nrt=False)
+def point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2, cap):
+    """Candidate k at the ground point y into its slots when it lies below the triangle a, b, c (outward
+    normal m) by less than cap [m] and its foot lies on the triangle."""
+    d = m0 * (a0 - y0) + m1 * (a1 - y1) + m2 * (a2 - y2)
+    if not (d > 0.0 and d < cap):
         return
-    m0, m1, m2 = m0 / L, m1 / L, m2 / L
+    if not _on_triangle(y0 + d * m0, y1 + d * m1, y2 + d * m2, a0, a1, a2, b0, b1, b2, c0, c1, c2, 1e-9):
+        return
+    h = 0.5 * d
+    _keep(S, k, d, y0 + h * m0, y1 + h * m1, y2 + h * m2, m0, m1, m2)
+
+
+@kernel(_nrt=False)
+def _triangle(sc, x, Px, Pm, t, S, cap):
+    """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points no deeper than cap [m] into
+    the slots S."""
+    kind, prm, sv, verts = sc[1], sc[4], sc[6], sc[7]
+    a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2, ok = triangle(sc, Pm, t)
+    if not ok:
+        return
     kd, p = kind[x], prm[x]
     if kd == SPHERE or kd == CAPSULE:
         for k in range(2 if kd == CAPSULE else 1):
@@ -153,29 +174,42 @@ def _triangle(sc, x, Px, Pm, t, S, cap):
             h = 0.5 * (p[0] - dist)
             _keep(S, k, p[0] - dist, q0 - h * n0, q1 - h * n1, q2 - h * n2, n0, n1, n2)
         return
-    tol = 1e-9
     for k in range(n_candidates(kd, sv[x, 1] - sv[x, 0])):
         y0, y1, y2 = candidate(kd, Px, p, verts, sv[x, 0], m0, m1, m2, k)
-        d = m0 * (a0 - y0) + m1 * (a1 - y1) + m2 * (a2 - y2)
-        if not (d > 0.0 and d < cap):
-            continue
-        if not _on_triangle(y0 + d * m0, y1 + d * m1, y2 + d * m2, a0, a1, a2, b0, b1, b2, c0, c1, c2, tol):
-            continue
-        h = 0.5 * d
-        _keep(S, k, d, y0 + h * m0, y1 + h * m1, y2 + h * m2, m0, m1, m2)
+        point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2, cap)
+
+
+@kernel(_nrt=False)
+def clear_slots(S, nrow):
+    for s in range(nrow):
+        S[s, 0] = 0.0
+
+
+@kernel(_nrt=False)
+def slot_means(S, nrow):
+    """The depth^2 weighted means of the slots: a contact that moves continuously over the triangles."""
+    for s in range(nrow):
+        if S[s, 0] > 0.0 and S[s, 8] > 0.0:
+            L = np.sqrt(S[s, 5] * S[s, 5] + S[s, 6] * S[s, 6] + S[s, 7] * S[s, 7])
+            S[s, 2], S[s, 3], S[s, 4] = S[s, 2] / S[s, 8], S[s, 3] / S[s, 8], S[s, 4] / S[s, 8]
+            S[s, 5], S[s, 6], S[s, 7] = S[s, 5] / L, S[s, 6] / L, S[s, 7] / L
+        else:
+            S[s, 0] = 0.0
 
 
 @kernel(_nrt=False)
 def mesh_points(sc, x, msh, Px, Pm):
     """Points of convex shape x (pose Px) on mesh msh (pose Pm) into the slot rows of sc[29] (module
-    docstring); returns how many slot rows to read."""
+    docstring), and after them, for a box or hull, the mesh's ridges and peaks inside it (solvers.fastridge);
+    returns how many slot rows to read."""
     kind, sv, BB, meta, nodes, links, S, stack = sc[1], sc[6], sc[18], sc[21], sc[27], sc[28], sc[29], sc[30]
     kd = kind[x]
-    cap = sc[5][x] if kd != MESH else SKIN * min(sc[5][x], sc[5][msh])
+    cap = sc[5][x]
     nc = 2 if kd == CAPSULE else (1 if kd == SPHERE else n_candidates(kd, sv[x, 1] - sv[x, 0]))
     nrow = min(nc * NSLOT, S.shape[0])
-    for s in range(nrow):
-        S[s, 0] = 0.0
+    clear_slots(S, nrow)
+    ridges = kd == BOX or kd == HULL
+    nxt = nrow
     # x's ground box, as a box in the mesh's axes
     g0, g1, g2 = 0.5 * (BB[x, 0] + BB[x, 3]) - Pm[0], 0.5 * (BB[x, 1] + BB[x, 4]) - Pm[1], \
         0.5 * (BB[x, 2] + BB[x, 5]) - Pm[2]
@@ -198,15 +232,11 @@ def mesh_points(sc, x, msh, Px, Pm):
             for t in range(links[nd, 2], links[nd, 2] + links[nd, 3]):
                 if nc * NSLOT <= S.shape[0]:
                     _triangle(sc, x, Px, Pm, t, S, cap)
+                    if ridges:
+                        nxt = ridge_points(sc, x, Px, Pm, t, S, nxt)
         elif top + 2 <= stack.shape[0]:
             stack[top] = links[nd, 0]
             stack[top + 1] = links[nd, 1]
             top += 2
-    for s in range(nrow):   # the weighted means: a contact that moves continuously over the triangles
-        if S[s, 0] > 0.0 and S[s, 8] > 0.0:
-            L = np.sqrt(S[s, 5] * S[s, 5] + S[s, 6] * S[s, 6] + S[s, 7] * S[s, 7])
-            S[s, 2], S[s, 3], S[s, 4] = S[s, 2] / S[s, 8], S[s, 3] / S[s, 8], S[s, 4] / S[s, 8]
-            S[s, 5], S[s, 6], S[s, 7] = S[s, 5] / L, S[s, 6] / L, S[s, 7] / L
-        else:
-            S[s, 0] = 0.0
-    return nrow
+    slot_means(S, nrow)
+    return nxt
