@@ -14,7 +14,8 @@ file's content hash instead of numba's (modification time, size), which every cl
 changes (numba then ignored the whole index and compiled again). numba itself still checks each
 function's bytecode hash, its own version and the CPU (its index and data keys), so a changed kernel,
 another numba or another machine never loads a stale entry: the cache is keyed on the kernels' content
-and the machine, not the path. `mbdsim cache info` / `mbdsim cache clear` (mbdsim._cachedir).
+and the machine, not the path. `mbdsim cache info` / `mbdsim cache clear` (mbdsim._cachedir). A fresh cache directory is first filled from
+the compiled kernels shipped with the package (mbdsim._kernelpack: numba's generic CPU).
 
 Loading a cached kernel: numba's `FunctionCache.load_overload` first refreshes the whole CPU target
 context (imports and installs every typing and lowering registry, numba.np.linalg's check for scipy's
@@ -75,11 +76,21 @@ def base_dir() -> str:
 
 
 def configure() -> str:
-    """Point numba's cache at the directory of this kernel version; returns it."""
+    """Point numba's cache at the directory of this kernel version and, with numba's generic CPU in force,
+    unpack the package's compiled kernels there once (mbdsim._kernelpack); returns the directory."""
     import numba
-    path = os.path.join(base_dir(), _digest())
+    from . import _kernelpack
+    digest = _digest()
+    path = os.path.join(base_dir(), digest)
     numba.config.CACHE_DIR = path
+    global PORTABLE, UNPACKED
+    PORTABLE = _kernelpack.portable_cpu()
+    UNPACKED = _kernelpack.install(path, digest) if PORTABLE and not os.environ.get("MBDSIM_NO_PACK") else None
     return path
+
+
+PORTABLE = False        # numba compiles for its generic CPU (mbdsim._kernelpack.portable_cpu)
+UNPACKED = None         # the name of the shipped archive this process unpacked, if it did
 
 
 def _package_locator() -> bool:
