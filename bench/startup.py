@@ -5,8 +5,9 @@
     python3 bench/startup.py --cases 1-3     # the cold `mbdsim validate` on these cases only
 
 Cold (a fresh virtual environment, an empty HOME and an empty compiled-kernel cache):
-1. the README's first command, `python3 -m pip install -e . && mbdsim validate`: the install, the time to
-   the first case's line and to the end (with --cases, those cases only: say so when quoting it);
+1. the README's first command, `python3 -m pip install -e . && mbdsim validate` (its report written): the
+   install, the time to the first case's line and to the end (the package's compiled kernels unpacked into
+   the empty cache: mbdsim._kernelpack; MBDSIM_NO_PACK=1 in the environment measures a full compile instead) (with --cases, those cases only: say so when quoting it);
    the virtual environment sees this machine's packages (--system-site-packages: "the registries' wheels
    already downloaded") and the install is `pip install -e . --no-deps` (pip fetches its build tools);
 2. the README's first Python example in a fresh process on the then warm cache, and on an empty one.
@@ -100,7 +101,7 @@ def cold(cases, log):
         install, _, rc, out = _timed([py, "-m", "pip", "install", "-q", "-e", ".", "--no-deps"], env=env, cwd=ROOT)
         assert rc == 0, out[-3000:]
         log(f"install (pip install -e . --no-deps): {install:.1f} s")
-        cmd = [os.path.join(env_dir, "bin", "mbdsim"), "validate", "--no-report"] + (["--case", cases] if cases else [])
+        cmd = [os.path.join(env_dir, "bin", "mbdsim"), "validate"] + (["--case", cases] if cases else [])
         total, first, rc, out = _timed(cmd, env=env, cwd=tmp, first_line="case ")
         first_case = next((ln for ln in out.splitlines() if ln.strip().startswith("case ")), "")
         log(f"mbdsim validate{' --case ' + cases if cases else ''}: first case line after {first} s, "

@@ -97,3 +97,25 @@ print(userkernel.twice(1.5), sum(userkernel.twice.stats.cache_hits.values()), in
     value, hits, linalg = _run(code, cwd=tmp_path)[0].split()
     assert float(value) == 3.0 and int(hits) == 1
     assert int(linalg) == 1                          # loaded by numba's method: the refresh ran
+
+
+def test_entries_load_without_parsing_their_bitcode():
+    """An entry loaded from the cache (kind "mbdsim-object", mbdsim._jit) keeps its LLVM bitcode unparsed until
+    something links it; linking then gets the module with the entry's functions, and the run is the same."""
+    if not _jitcache.LINK_ONLY:
+        pytest.skip("MBDSIM_LINK_ONLY=0: numba's own cache format")
+    check = textwrap.dedent("""
+        lib = fastdop.run.overloads[fastdop.run.signatures[0]].library
+        pending = "_mbdsim_bitcode" in lib.__dict__
+        mod = lib._get_module_for_linking()
+        names = [f.name for f in mod.functions if not f.is_declaration]
+        print(int(pending), int(any("run" in n for n in names)), int("_mbdsim_bitcode" in lib.__dict__))
+    """)
+    code = _PENDULUM + check
+    out = subprocess.run([sys.executable, "-c", code.replace("{before}", "")], capture_output=True, text=True,
+                         timeout=900)
+    assert out.returncode == 0, out.stderr[-3000:]
+    lines = out.stdout.split("\n")
+    hits, misses = map(int, lines[0].split()[:2])
+    assert hits >= 1 and misses == 0
+    assert lines[2].split() == ["1", "1", "0"]

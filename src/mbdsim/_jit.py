@@ -181,10 +181,25 @@ def _link_only() -> bool:
     def patched_serialize(self):
         if getattr(self, "mbdsim_link_only", False):
             return (self.name, "mbdsim-link-only", self._get_module_for_linking().as_bitcode())
+        if _SAVING_MBDSIM[0]:   # an entry of mbdsim's: numba's object format, plus the defined symbols' names
+            self._ensure_finalized()
+            mod = self._get_module_for_linking()
+            names = tuple(g.name for gs in (mod.functions, mod.global_variables) for g in gs if not g.is_declaration)
+            return (self.name, "mbdsim-object", (self._get_compiled_object(), mod.as_bitcode(), names))
         return serialize(self)
 
     def patched_unserialize(cls, codegen, state):
         name, kind, data = state
+        if kind == "mbdsim-object":
+            object_code, bitcode, names = data
+            library = codegen.create_library(name)
+            library.__class__ = _lazy_class(type(library))
+            library.enable_object_caching()
+            library._set_compiled_object(object_code)
+            library.__dict__["_mbdsim_bitcode"] = bitcode
+            library._finalize_final_module()
+            library._codegen._engine._defined_symbols |= set(names)
+            return library
         if kind != "mbdsim-link-only":
             return unserialize(cls, codegen, state)
         library = codegen.create_library(name)
@@ -209,7 +224,59 @@ def _link_only() -> bool:
     return True
 
 
+# Loading an entry from the cache (issue 32, "every later process quick"). numba's object format stores the
+# machine code and the LLVM bitcode of the module (for linking into later compilations) and parses the bitcode
+# on every load, to list the symbols the module defines: ~0.09 s of a fresh process's first simulate for the
+# README pendulum's four entries. mbdsim's entries are saved as "mbdsim-object" (the same two plus the defined
+# symbols' names) and loaded without parsing: the bitcode is parsed only if something links it
+# (`_lazy_class`). Saving is told apart by `_SAVING_MBDSIM`, set while numba saves a function of mbdsim's
+# (`_jitcache`'s save hook), so a user's own numba functions keep numba's format.
+_SAVING_MBDSIM = [False]
+_LAZY: dict = {}
+
+
+def _lazy_class(base):
+    """`base` (numba's CPUCodeLibrary class) with its shared module parsed from the kept bitcode on first use."""
+    cls = _LAZY.get(base)
+    if cls is None:
+        from llvmlite import binding as ll
+
+        def get(self):
+            d = self.__dict__
+            if d.get("_mbdsim_shared") is None and d.get("_mbdsim_bitcode") is not None:
+                d["_mbdsim_shared"] = ll.parse_bitcode(d.pop("_mbdsim_bitcode"))
+            return d.get("_mbdsim_shared")
+
+        def put(self, mod):
+            self.__dict__["_mbdsim_shared"] = mod
+            self.__dict__.pop("_mbdsim_bitcode", None)
+
+        cls = _LAZY[base] = type(base.__name__, (base,), {"_shared_module": property(get, put),
+                                                           "__module__": base.__module__})
+    return cls
+
+
+def _saving_hook() -> None:
+    """Mark numba's saves of mbdsim's functions (see `_SAVING_MBDSIM`)."""
+    save = caching.Cache.save_overload
+    if getattr(save, "mbdsim", False):
+        return
+
+    def save_overload(self, sig, data):
+        module = getattr(getattr(self, "_py_func", None), "__module__", None) or ""
+        _SAVING_MBDSIM[0] = module.startswith("mbdsim.")
+        try:
+            return save(self, sig, data)
+        finally:
+            _SAVING_MBDSIM[0] = False
+
+    save_overload.mbdsim = True
+    caching.Cache.save_overload = save_overload
+
+
 LINKED_ONLY = _link_only()
+if LINKED_ONLY:
+    _saving_hook()
 
 from . import _compilenote  # noqa: E402 - after the decorators: the note on long compilations (issue 32)
 

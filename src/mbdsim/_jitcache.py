@@ -53,8 +53,14 @@ ENTRY_FLAGS = {"no_cfunc_wrapper": True}
 LINK_ONLY = os.environ.get("MBDSIM_LINK_ONLY", "1") != "0"
 
 
+# the layout of mbdsim's cache entries (mbdsim._jit: "mbdsim-link-only", "mbdsim-object"); a change starts a new
+# cache directory
+CACHE_FORMAT = 2
+
+
 def _digest() -> str:
-    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()), LINK_ONLY)).encode())
+    h = hashlib.sha1(repr((sorted(KERNEL_FLAGS.items()), sorted(ENTRY_FLAGS.items()), LINK_ONLY,
+                           CACHE_FORMAT)).encode())
     for rel in KERNEL_SOURCES:
         p = _HERE / rel
         if p.exists():
@@ -111,9 +117,16 @@ def _package_locator() -> bool:
         mbdsim = True
 
         def __init__(self, py_func, py_file):
-            super().__init__(py_func, py_file)
-            rel = Path(py_file).resolve().parent.relative_to(_HERE.resolve())
-            self._cache_path = os.path.join(numba_config().CACHE_DIR, "mbdsim", *rel.parts)
+            self._py_file = py_file
+            self._lineno = py_func.__code__.co_firstlineno
+            self._cache_path = os.path.join(numba_config().CACHE_DIR, "mbdsim", *_package_parts(py_file))
+
+        def ensure_cache_path(self):
+            """numba's check (create the directory, write a temporary file in it), once per directory and
+            process: numba makes it for every function (~0.1 s of a fresh process's start for ~240 kernels)."""
+            if self._cache_path not in _READY:
+                super().ensure_cache_path()
+                _READY.add(self._cache_path)
 
         def get_source_stamp(self):
             """The source file's content hash: numba's (modification time, size) changes with every clone
@@ -122,14 +135,24 @@ def _package_locator() -> bool:
 
         @classmethod
         def from_function(cls, py_func, py_file):
-            try:
-                Path(py_file).resolve().relative_to(_HERE.resolve())
-            except (ValueError, OSError):
+            if _package_parts(py_file) is None:
                 return None
             return super().from_function(py_func, py_file)
 
     impl._locator_classes.insert(0, _PackageCacheLocator)
     return True
+
+
+_READY: set = set()   # cache directories checked by this process (_PackageCacheLocator.ensure_cache_path)
+
+
+@functools.lru_cache(maxsize=None)
+def _package_parts(py_file: str) -> tuple | None:
+    """The directories from the package's root to `py_file` (a module of mbdsim), else None."""
+    try:
+        return Path(py_file).resolve().parent.relative_to(_HERE.resolve()).parts
+    except (ValueError, OSError):
+        return None
 
 
 def numba_config():

@@ -19,8 +19,9 @@ cache_app = typer.Typer(help="The on-disk cache of the compiled kernels: info, c
 
 @cache_app.command("info")
 def info_cmd() -> None:
-    """Print where the compiled kernels are cached, which kernel version this mbdsim uses, and how many
-    kernels and bytes each cached version holds (a version not current is left by another mbdsim).
+    """Print where the compiled kernels are cached, which kernel version this mbdsim uses, how many
+    kernels and bytes each cached version holds (a version not current is left by another mbdsim), and
+    whether the package's shipped kernels serve this numba and Python.
 
     Example: mbdsim cache info"""
     from mbdsim import _cachedir
@@ -31,6 +32,17 @@ def info_cmd() -> None:
         tag = "current" if v.current else "stale  "
         state = f"{v.kernels} kernels, {_cachedir.human(v.size)}" if v.kernels else "empty (compiles on first use)"
         typer.echo(f"  {tag} {v.digest}  {state}")
+    from mbdsim import _jitcache, _kernelpack
+    name = _kernelpack.pack_name(_jitcache._digest())
+    shipped = sorted(p.name for p in _kernelpack.PACK_DIR.glob("*.tar.xz"))
+    if name in shipped and _jitcache.PORTABLE:
+        typer.echo(f"shipped kernels: {name} (unpacked into the current version on first use)")
+    elif name in shipped:
+        typer.echo(f"shipped kernels: {name}, not used: numba compiles for this machine's CPU "
+                   "(MBDSIM_CPU=host or NUMBA_CPU_NAME set)")
+    else:
+        typer.echo(f"shipped kernels: {', '.join(shipped) or 'none'}; none for these kernel sources, numba and "
+                   f"Python ({name}): kernels compile on first use")
     stale = [v for v in vs if not v.current]
     if stale:
         typer.echo(f"{len(stale)} stale version(s), {_cachedir.human(sum(v.size for v in stale))}: "
