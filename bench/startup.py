@@ -88,6 +88,18 @@ def _best(cmd, env=None, n=5):
     return min(_timed(cmd, env=env)[0] for _ in range(n))
 
 
+def _best_cpu(cmd, env=None, n=5):
+    """Least CPU time (user + system, [s]) of the child over n runs: fair on a loaded machine."""
+    import resource
+    out = []
+    for _ in range(n):
+        r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        _timed(cmd, env=env)
+        r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
+        out.append(r1.ru_utime - r0.ru_utime + r1.ru_stime - r0.ru_stime)
+    return min(out)
+
+
 def cold(cases, log):
     """Steps 1-2 in a fresh virtual environment with an empty HOME and cache."""
     tmp = tempfile.mkdtemp(prefix="mbdsim-startup-")
@@ -131,11 +143,15 @@ def warm(log):
         _timed([sys.executable, "-c", MUJOCO], env=env)
         out["mujoco_s"] = _best([sys.executable, "-c", MUJOCO], env=env)
         out["ratio"] = out["mbdsim_first_simulate_s"] / out["mujoco_s"]
+        out["mbdsim_first_simulate_cpu_s"] = _best_cpu([sys.executable, "-c", FIRST_SIMULATE], env=env)
+        out["mujoco_cpu_s"] = _best_cpu([sys.executable, "-c", MUJOCO], env=env)
+        out["ratio_cpu"] = out["mbdsim_first_simulate_cpu_s"] / out["mujoco_cpu_s"]
     except ImportError:
         out["mujoco_s"] = None
     log(f"fresh process, cache warm: mbdsim import + pendulum + simulate {out['mbdsim_first_simulate_s']:.2f} s, "
         f"MuJoCo import + load + 2000 steps {out['mujoco_s'] or float('nan'):.2f} s "
-        f"(ratio {out.get('ratio', float('nan')):.2f}); python -c pass {out['python_s']:.3f} s; "
+        f"(ratio {out.get('ratio', float('nan')):.2f}; CPU time {out.get('mbdsim_first_simulate_cpu_s', float('nan')):.2f} s "
+        f"against {out.get('mujoco_cpu_s', float('nan')):.2f} s, ratio {out.get('ratio_cpu', float('nan')):.2f}); python -c pass {out['python_s']:.3f} s; "
         f"mbdsim --help {out['help_s']:.3f} s")
     return out
 

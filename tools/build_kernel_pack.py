@@ -87,9 +87,9 @@ def main() -> None:
     out_dir.mkdir(exist_ok=True)
     tmp = out_dir / (name + ".part")
     with tarfile.open(tmp, "w:xz", preset=9) as tar:
-        for f in sorted((src_dir / "mbdsim").rglob("*")):
-            if f.is_file() and f.suffix in (".nbi", ".nbc"):
-                tar.add(f, arcname=str(f.relative_to(src_dir)))
+        files = sorted(f for f in (src_dir / "mbdsim").rglob("*") if f.is_file() and f.suffix in (".nbi", ".nbc"))
+        for f in files + sorted(src_dir.glob("nrt-*.pickle")):   # + numba's runtime module (_jitcache._cached_nrt)
+            tar.add(f, arcname=str(f.relative_to(src_dir)))
     for old in out_dir.glob("*.tar.xz"):
         if old.name != name:
             old.unlink()

@@ -190,6 +190,54 @@ def _fast_cached_loads() -> bool:
     return True
 
 
+def _cached_nrt() -> bool:
+    """Cache numba's runtime module (NRT: its reference counting and allocation helpers), which numba
+    compiles with LLVM in every process before the first compiled call (30-40 ms of a fresh process's first
+    simulate): the machine code is kept in numba's object format in this kernel version's cache directory,
+    keyed on numba's version and the CPU; any failure compiles it as numba does."""
+    try:
+        import pickle
+        from numba.core.runtime import nrtdynmod
+        original = nrtdynmod.compile_nrt_functions
+        nrtdynmod.create_nrt_module   # noqa: B018 - the internal used below exists
+    except (ImportError, AttributeError):
+        return False
+    if getattr(original, "mbdsim", False):
+        return True
+
+    def compile_nrt_functions(ctx):
+        codegen = ctx.codegen()
+        try:
+            import numba
+            key = hashlib.sha1(repr((numba.__version__, codegen.magic_tuple())).encode()).hexdigest()[:16]
+            path = os.path.join(CACHE_DIR, f"nrt-{key}.pickle")
+        except Exception:  # noqa: BLE001
+            return original(ctx)
+        try:
+            with open(path, "rb") as f:
+                return codegen.unserialize_library(pickle.load(f))
+        except Exception:  # noqa: BLE001 - absent or unreadable: compile it
+            pass
+        ir_mod, library = nrtdynmod.create_nrt_module(ctx)
+        library.enable_object_caching()
+        library.add_ir_module(ir_mod)
+        library.finalize()
+        try:
+            os.makedirs(CACHE_DIR, exist_ok=True)
+            tmp = f"{path}.{os.getpid()}.tmp"
+            with open(tmp, "wb") as f:
+                pickle.dump(library.serialize_using_object_code(), f)
+            os.replace(tmp, path)
+        except Exception:  # noqa: BLE001 - not written: compiled again next time
+            pass
+        return library
+
+    compile_nrt_functions.mbdsim = True
+    nrtdynmod.compile_nrt_functions = compile_nrt_functions
+    return True
+
+
 CACHE_DIR = configure()
 PACKAGE_LOCATOR = _package_locator()
 FAST_LOADS = _fast_cached_loads()
+CACHED_NRT = _cached_nrt()
