@@ -256,3 +256,27 @@ def test_box_dropped_on_a_plane_balances_with_the_shape_contact_damping_and_fric
     assert abs(D_ind - loss) < 3e-3 * loss, (D_ind, loss)
     d = res.diagnostics
     assert abs(d.energy_error[-1]) < 3e-3 * loss and np.max(np.abs(d.energy_error)) < d.tolerances["energy_error"]
+
+
+def test_undamped_springs_skip_the_dissipation_quadrature_but_still_balance(monkeypatch):
+    """A spring chain with zero damping dissipates nothing: the monitor checks T + V without integrating
+    an identically zero dissipation power, and still catches a drift (a spring with damping does run it)."""
+    m = mb.Model("springs", gravity=(0, 0, 0))
+    a = m.add_body("a", 1.0, inertia=(1, 1, 1), position=(1, 0, 0), velocity=(0.3, 0, 0))
+    b = m.add_body("b", 2.0, inertia=(1, 1, 1), position=(2, 0, 0))
+    m.add_translational("sa", "ground", a, (1, 0, 0), (1, 0, 0))
+    m.add_translational("sb", "ground", b, (2, 0, 0), (1, 0, 0))
+    m.add_spring_damper("k1", m.ground.add_marker("o", (0, 0, 0)), a.add_marker("pa", (1, 0, 0)), 100.0, 0.0, 1.0)
+    m.add_spring_damper("k2", a.add_marker("qa", (1, 0, 0)), b.add_marker("pb", (2, 0, 0)), 1e4, 0.0, 1.0)
+    calls = []
+    original = Result.dissipated_energy
+    monkeypatch.setattr(Result, "dissipated_energy", lambda self: calls.append(1) or original(self))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", MonitorWarning)
+        res = mb.simulate(m, 1.0, 0.01)
+    assert not calls
+    d = res.diagnostics
+    assert d.energy_scale > 0.04 and np.max(np.abs(d.energy_error)) < 1e-6 * d.energy_scale
+    m.forces["k2"].damping = 1.0
+    mb.simulate(m, 0.2, 0.01)
+    assert calls

@@ -122,8 +122,7 @@ def _energy_terms(res):
     # the dissipated energy the Result reports: the dissipation power integrated on the run's own dense
     # output (step-wise, to 1e-10), not the trapezoidal rule on the output samples, which misses the
     # power of contact impacts and of modes ringing faster than the output step
-    D = res.dissipated_energy() if any(
-        hasattr(evaluator(e), "dissipation") for e in sys.model.forces.values()) else None
+    D = res.dissipated_energy() if any(_can_dissipate(e) for e in sys.model.forces.values()) else None
     P_w = None
     if applied:
         from .state import state_factory
@@ -139,6 +138,23 @@ def _energy_terms(res):
         except Exception as exc:  # noqa: BLE001 - a user load failing here: monitor skipped, run unaffected
             return None, f"energy balance not checked: applied load failed ({type(exc).__name__})"
     return (T, V, D, P_w), None
+
+
+def _can_dissipate(e) -> bool:
+    """Whether force element `e` can dissipate energy: an element with a dissipation power, except the
+    linear ones (spring-dampers, torsion springs, bushings) whose damping is zero, for which that power is
+    identically zero (the dissipated energy's quadrature then costs more than the run)."""
+    from ..model.element_specs import Bushing, TorsionSpring
+    from ..model.forces import SpringDamper
+    from ..system.force_elements import evaluator
+    if not hasattr(evaluator(e), "dissipation"):
+        return False
+    if type(e) in (SpringDamper, TorsionSpring, Bushing):
+        try:
+            return bool(np.any(np.asarray(e.damping, float)))
+        except (TypeError, ValueError):   # a damping that is not a number (an expression): it may dissipate
+            return True
+    return True
 
 
 def _trapz_cum(P, t, start=0.0):
