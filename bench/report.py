@@ -52,6 +52,29 @@ def _plot(key, summ, folder):
     return path
 
 
+def _kept_sections(path, md):
+    """The `## ` sections of the existing RESULTS.md that this run does not write (start-up and compile
+    notes, measurements by other scripts): kept, in their order, so that a bench run does not erase them.
+    A section of this run's heading replaces the old one (its hand-written `###` subsections are kept)."""
+    try:
+        text = open(path).read()
+    except OSError:
+        return []
+    written = {ln for ln in md if ln.startswith("## ")}
+    out = []
+    for part in text.split("\n## ")[1:]:
+        head, _, body = part.partition("\n")
+        if head.strip() == "Work-precision plots":
+            continue
+        if "## " + head in written:
+            sub = body[body.find("\n### ") + 1:] if "\n### " in body else ""
+            if sub:
+                out += ["", f"### (kept from the previous RESULTS.md: {head.strip()})", "", sub.rstrip()]
+            continue
+        out += ["", "## " + head, body.rstrip()]
+    return out
+
+
 def write(results, here, log):
     """Write RESULTS.md and the plots; returns the Markdown path."""
     folder = os.path.join(here, "plots")
@@ -108,6 +131,7 @@ def write(results, here, log):
         md += ["", "## Start-up", "", f"- `import mbdsim`: {st['import_s']:.3f} s",
                f"- first `simulate` of a new model in a fresh process (numba cache warm): {st['first_simulate_s']:.3f} s",
                f"- `mbdsim validate` (30 cases): {st['validate_s']:.1f} s"]
+    md += _kept_sections(os.path.join(here, "RESULTS.md"), md)
     md += ["", "## Work-precision plots", ""]
     for key, s in results["problems"].items():
         path = _plot(key, s, folder)
