@@ -17,6 +17,7 @@ import time
 import warnings
 from pathlib import Path
 
+import numba
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
@@ -71,6 +72,21 @@ def pendulum(torque):
 
 def callable_drag(rod):
     return lambda t, s: (0.0, 0.0, -0.3 * s.angular_velocity(rod)[2])
+
+
+@numba.njit
+def _drag(w):
+    return -0.3 * w
+
+
+def pendulum_njit():
+    """pendulum() with the drag torque -0.3 w_z computed by an njit function called from the kernel."""
+    m = mb.Model("p", gravity=(0.0, -9.81, 0.0))
+    rod = m.add_body("rod", 2.0, inertia=(0.01, 2 / 12, 2 / 12), position=(0.5, 0, 0))
+    m.add_revolute("pin", m.ground, rod, (0, 0, 0), (0, 0, 1))
+    m.add_function("drag", _drag)
+    m.add_torque("drag", rod, (0, 0, "drag(WZ(rod))"))
+    return m
 
 
 def gears(geared):
@@ -220,6 +236,8 @@ CASES = [
      lambda: slider_crank(displacement="18.85*t"), "kinematics", ("O", "slide")),
     ("slender rod, axial inertia 0 (torsion spring)", lambda: rod(0.0), lambda: rod(1e-6), "simulate", ("pin",)),
     ("Python-callable drag torque (pendulum)", lambda: pendulum(callable_drag),
+     lambda: pendulum(lambda rod: (0, 0, "-0.3*WZ(rod)")), "simulate", ("pin",)),
+    ("numba.njit drag torque via Model.add_function (pendulum)", pendulum_njit,
      lambda: pendulum(lambda rod: (0, 0, "-0.3*WZ(rod)")), "simulate", ("pin",)),
     ("Python-callable driver, exact derivatives (carousel)",
      lambda: carousel(displacement=mb.expressions.time_function(lambda t: 3 * t + 2 * np.sin(t),
