@@ -122,3 +122,8 @@ def test_non_finite_return_ends_the_run_naming_the_function():
     assert not res.success and isinstance(res.error, EvaluationError)
     assert "wall" in str(res.error) and "load 'drag'" in str(res.error) and "non-finite" in str(res.error)
     assert res.time[-1] < 1.5
+
+
+def test_model_file_refuses_a_user_function(tmp_path):
+    with pytest.raises(mb.ModelError, match=r"function 'drag'.*Model.add_function"):
+        mb.save_model(_pendulum("drag(WZ(rod))", drag=drag), tmp_path / "p.yaml")
