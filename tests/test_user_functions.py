@@ -127,3 +127,13 @@ def test_non_finite_return_ends_the_run_naming_the_function():
 def test_model_file_refuses_a_user_function(tmp_path):
     with pytest.raises(mb.ModelError, match=r"function 'drag'.*Model.add_function"):
         mb.save_model(_pendulum("drag(WZ(rod))", drag=drag), tmp_path / "p.yaml")
+
+
+def test_non_finite_driver_names_the_function_and_the_motion():
+    @numba.njit
+    def encoder(t):
+        return 3.0 * t if t < 0.3 else np.inf   # (also: no complex step on a numba function's reference path)
+    res = _run(_carousel(displacement=encoder))
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert "'encoder'" in str(res.error) and "motion 'spin'" in str(res.error)
+    assert 0.25 < res.time[-1] <= 0.3
