@@ -35,7 +35,7 @@ _D1_8 = (4.0 / 5.0, -1.0 / 5.0, 4.0 / 105.0, -1.0 / 280.0)
 _D2_8 = (8.0 / 5.0, -1.0 / 5.0, 8.0 / 315.0, -1.0 / 560.0)
 _D2_8_C0 = -205.0 / 72.0
 
-_CACHE: dict = {}                   # (id(fn), nargs) -> (fn, UserFunction): one cfunc per function and arity
+_CACHE: dict = {}                   # (id(fn), nargs, name) -> (fn, UserFunction): one cfunc per function and arity
 _BY_ADDRESS: dict = {}              # C address -> UserFunction (naming a failure)
 
 
@@ -95,8 +95,8 @@ class UserFunction:
             return np.vectorize(lambda *xs: call(*map(float, xs)), otypes=[float])(*args)
         return call(*map(float, args))
 
-    def __reduce__(self):          # (a copy or pickle compiles the cfunc again)
-        return UserFunction, (self.name, self.fn, self.nargs, self.entity)
+    def __reduce__(self):          # (a copy or pickle makes the cfunc again: once per function in a process)
+        return user_function, (self.fn, self.name, self.nargs, self.entity)
 
     def __repr__(self) -> str:
         return f"UserFunction({self.name!r}, {self.nargs} argument(s))"
@@ -126,9 +126,9 @@ def _cfunc(fn, nargs, entity):
 def user_function(fn, name: str | None = None, nargs: int | None = None, entity: str | None = None) -> UserFunction:
     """The UserFunction of a numba function (made once per function and arity)."""
     name = name or getattr(fn, "__name__", None) or getattr(getattr(fn, "_pyfunc", None), "__name__", "function")
-    key = (id(fn), nargs)
+    key = (id(fn), nargs, name)
     hit = _CACHE.get(key)
-    if hit is not None and hit[0] is fn and hit[1].name == name:
+    if hit is not None and hit[0] is fn:
         return hit[1]
     uf = UserFunction(name, fn, nargs, entity)
     _CACHE[key] = (fn, uf)

@@ -75,7 +75,7 @@ class SignalsMixin:
         kernels call it through its C address (no Python in the loop); declare it before the elements that
         read it. A plain Python callable is refused (ModelError): give a load callable (t, state) instead,
         or decorate it with numba.njit. Returns the mbdsim.userfunctions.UserFunction."""
-        from ..userfunctions import UserFunction
+        from ..userfunctions import user_function
         from .loadexpr import check_name
         entity = f"function '{name}'"
         check_name(entity, name, True)
@@ -86,7 +86,7 @@ class SignalsMixin:
             raise ModelError(entity, "name", f"the model has a table {name!r}: choose another name")
         if name in getattr(self, "functions", {}):
             raise ModelError(entity, "name", "a function of this name already exists in the model")
-        uf = UserFunction(name, function, entity=entity)   # (called by name: entities may share the name)
+        uf = user_function(function, name, entity=entity)   # (called by name: entities may share the name)
         self.__dict__.setdefault("functions", {})[name] = uf
         return uf
 
