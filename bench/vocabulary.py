@@ -17,6 +17,7 @@ import time
 import warnings
 from pathlib import Path
 
+import numba
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "src"))
@@ -71,6 +72,26 @@ def pendulum(torque):
 
 def callable_drag(rod):
     return lambda t, s: (0.0, 0.0, -0.3 * s.angular_velocity(rod)[2])
+
+
+@numba.njit
+def _drag(w):
+    return -0.3 * w
+
+
+@numba.njit
+def _spin(t):
+    return 3 * t + 2 * np.sin(t)
+
+
+def pendulum_njit():
+    """pendulum() with the drag torque -0.3 w_z computed by an njit function called from the kernel."""
+    m = mb.Model("p", gravity=(0.0, -9.81, 0.0))
+    rod = m.add_body("rod", 2.0, inertia=(0.01, 2 / 12, 2 / 12), position=(0.5, 0, 0))
+    m.add_revolute("pin", m.ground, rod, (0, 0, 0), (0, 0, 1))
+    m.add_function("drag", _drag)
+    m.add_torque("drag", rod, (0, 0, "drag(WZ(rod))"))
+    return m
 
 
 def gears(geared):
@@ -159,6 +180,12 @@ def helix_bead():
     return bead(c, 0.5, 2.0 * np.array([-0.3 * np.sin(0.5), 0.3 * np.cos(0.5), 0.1]))
 
 
+def helix_py_bead():
+    """The same helix as a Python function of s (tabulated as a spline to the run's tolerance: system.pathtable)."""
+    c = mb.Curve(lambda s: np.array([0.3 * np.cos(s), 0.3 * np.sin(s), 0.1 * s]), (-20.0, 3.0))
+    return bead(c, 0.5, 2.0 * np.array([-0.3 * np.sin(0.5), 0.3 * np.cos(0.5), 0.1]))
+
+
 def line_bead():
     """Bead on a straight 7-point Spline along (0.6, 0, -0.8)."""
     u = np.array([0.6, 0.0, -0.8])
@@ -221,6 +248,11 @@ CASES = [
     ("slender rod, axial inertia 0 (torsion spring)", lambda: rod(0.0), lambda: rod(1e-6), "simulate", ("pin",)),
     ("Python-callable drag torque (pendulum)", lambda: pendulum(callable_drag),
      lambda: pendulum(lambda rod: (0, 0, "-0.3*WZ(rod)")), "simulate", ("pin",)),
+    ("numba.njit drag torque via Model.add_function (pendulum)", pendulum_njit,
+     lambda: pendulum(lambda rod: (0, 0, "-0.3*WZ(rod)")), "simulate", ("pin",)),
+    ("numba.njit driver, derivatives by the kernel's central differences (carousel)",
+     lambda: carousel(displacement=_spin), lambda: carousel(displacement="3*t + 2*sin(t)"), "simulate",
+     ("hub", "tip")),
     ("Python-callable driver, exact derivatives (carousel)",
      lambda: carousel(displacement=mb.expressions.time_function(lambda t: 3 * t + 2 * np.sin(t),
                                                                 d1=lambda t: 3 + 2 * np.cos(t),
@@ -241,6 +273,8 @@ CASES = [
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
+    ("helix as a Python-callable curve (tabulated) vs straight spline (bead, point-on-curve)", helix_py_bead,
+     line_bead, "simulate", ()),
     ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,
      line_expr_bead, "simulate", ()),
 ]

@@ -6,10 +6,9 @@ C = (R cos s, R sin s, c s) (helix) has T = m (R^2 + c^2) sd^2 / 2, V = m g c s,
 sdd = -g c / (R^2 + c^2) (uniform angular acceleration) and z(t) = z0 + c (sd0 t + sdd t^2 / 2).
 A straight line C = u s (|u| = 1): sdd = g_along = -g u_z.
 
-The tests marked `pending_compiled` state the issue's contract (default settings, 'compiled' in
-res.stats["method"], 1e-6 relative). Expression curves and splines run compiled (solvers.pathcoord); the
-Python-callable curve is a strict xfail until it does, so it fails loudly (XPASS) once it works and the
-marker must then be removed.
+`test_helix_default_settings_compiled` states the issue's contract (default settings, 'compiled' in
+res.stats["method"], 1e-6 relative) for expression curves, splines and Python-callable curves (tabulated
+to the run's tolerance as splines: system.pathtable), all run by solvers.pathcoord.
 """
 from __future__ import annotations
 
@@ -21,7 +20,6 @@ import mbdsim as mb
 G, R, C, SD0, T_END = 9.81, 0.3, 0.1, 2.0, 1.0
 SDD = -G * C / (R ** 2 + C ** 2)
 HELIX = ("0.3*cos(s)", "0.3*sin(s)", "0.1*s")
-pending_compiled = pytest.mark.xfail(strict=True, reason="issue 29: Python-callable curves are not compiled yet")
 
 
 def helix(s):
@@ -75,7 +73,7 @@ def test_python_callable_agrees_with_expression_curve():
     assert np.allclose(a.position("bead"), b.position("bead"), atol=1e-8)
 
 
-@pytest.mark.parametrize("kind", ["expression", pytest.param("callable", marks=pending_compiled), "spline"])
+@pytest.mark.parametrize("kind", ["expression", "callable", "spline"])
 def test_helix_default_settings_compiled(kind):
     curve = {"expression": lambda: mb.Curve(HELIX, (-4, 3)), "callable": lambda: mb.Curve(helix, (-4, 3)),
              "spline": lambda: mb.Spline([helix(s) for s in np.linspace(-4, 3, 141)])}[kind]()

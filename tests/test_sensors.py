@@ -167,3 +167,32 @@ def test_more_sensors_than_the_event_buffer_holds():
     got = sorted((e.time, e.name) for e in res.sensor_events)
     assert [n for _, n in got] == [f"s{i}" for i in range(70)]
     assert np.max(np.abs(np.array([t for t, _ in got]) - levels)) < 1e-12
+
+
+def test_callable_sensor_runs_compiled_like_the_expression_sensor():
+    """A Python-callable sensor is called back from the compiled step loop (solvers.pyloads) and its
+    crossing located on the dense output like the expression sensor's: the falling ball reaches z = 0.5
+    at sqrt(2 (h - 0.5) / g), both to 1e-9 of the closed form and to 1e-8 of each other."""
+    res = {}
+    for kind, signal in (("callable", lambda t, s: s.position("ball")[2]), ("expression", "DZ(ball)")):
+        m = falling()
+        m.add_sensor("floor", signal, value=0.5, direction=-1, action="stop")
+        res[kind] = mb.simulate(m, 5.0, 0.01)
+        assert res[kind].success and "(compiled)" in res[kind].stats["method"], res[kind].stats["method"]
+        assert res[kind].sensor_events[0].time == pytest.approx(np.sqrt(2 * 1.5 / G), abs=1e-9)
+    assert abs(res["callable"].sensor_events[0].time - res["expression"].sensor_events[0].time) < 1e-8
+    assert abs(res["callable"].time[-1] - res["expression"].time[-1]) < 1e-8
+
+
+def test_failing_callable_sensor_ends_the_run_naming_it():
+    from mbdsim.errors import EvaluationError
+
+    def signal(t, s):
+        if t > 0.2:
+            raise RuntimeError("probe lost")
+        return s.position("ball")[2]
+    m = falling()
+    m.add_sensor("probe", signal, value=-1.0, action="stop")
+    res = mb.simulate(m, 1.0, 0.01)
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert "sensor 'probe'" in str(res.error) and "probe lost" in str(res.error)

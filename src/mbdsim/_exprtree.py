@@ -217,6 +217,8 @@ def _eval(n, env):
     if isinstance(n, Fn):
         return _NP[n.name](*(_eval(x, env) for x in n.args))
     args = [_eval(x, env) for x in n.args]
+    if getattr(n.table, "nargs", None) is not None:   # a user function (mbdsim.userfunctions)
+        return n.table(*args)
     if n.table is not None:
         return n.table(args[0], order=n.order)
     return _lib.LIBRARY[n.name].fn(*args, order=n.order)
@@ -277,6 +279,9 @@ def _diff(n, var):
             num = sub(mul(x, _diff(y, var)), mul(y, _diff(x, var)))
             return div(num, add(pw(x, Const(2.0)), pw(y, Const(2.0))))
         return mul(_DERIV[n.name](n.args[0]), _diff(n.args[0], var))
+    if getattr(n.table, "nargs", None) is not None:
+        raise ExpressionError(f"cannot differentiate the user function {n.name}(...) (mbdsim.userfunctions): "
+                              "it has no derivatives")
     for k, x in enumerate(n.args[1:], start=2):        # Call: only the first argument may vary
         if _depends(x, var):
             raise ExpressionError(f"cannot differentiate {n.name}(...) with respect to {var!r}: argument {k} "

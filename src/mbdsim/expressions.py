@@ -228,8 +228,10 @@ def parse(text: str, variables: Sequence[str] = ("t",), *, tables: dict[str, Any
                 fail(f"keyword argument not allowed (only order=<0..{MAX_ORDER}> for library functions and tables):", kw)
             order = kw.value.value
         args = [walk(a, depth + 1) for a in n.args]
-        if name in tables:
-            lo, hi = 1, 1
+        if name in tables:   # a table of x, or a user function of its arguments (mbdsim.userfunctions)
+            lo = hi = getattr(tables[name], "nargs", 1)
+            if order and hasattr(tables[name], "nargs"):
+                fail(f"{name} is a user function: it has no derivatives (order=), in", n)
         elif lib:
             lo, hi = _lib.LIBRARY[lib].min_args, _lib.LIBRARY[lib].max_args
         else:

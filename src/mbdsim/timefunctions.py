@@ -134,6 +134,9 @@ def _richardson(f, t, order):
 
 def _complex_step(f, t):
     """Im f(t + ih)/h if f accepts complex input and agrees with a central difference; else None."""
+    from .userfunctions import is_numba
+    if is_numba(f):   # a numba function of float64 (a complex argument would compile another one, or fail typing)
+        return None
     t = np.asarray(t, dtype=float)
     scale = np.maximum(1.0, np.abs(t))
     h = 1e-20 * scale

@@ -297,6 +297,9 @@ def model_to_dict(model, base_dir=None) -> dict:
     d["inputs"] = [{"name": i.name, "value": i.value} for i in getattr(model, "inputs", {}).values()]
     d["outputs"] = [{"name": o.name, "expression": o.text} for o in getattr(model, "outputs", {}).values()]
     d["tables"] = [_table(n, t) for n, t in getattr(model, "tables", {}).items()]
+    for name in getattr(model, "functions", {}):   # compiled Python code (Model.add_function): not stored
+        raise ModelError(f"function '{name}'", "function", "a numba function is Python code, which model files "
+                         "do not carry; store the model without it and add it after loading (Model.add_function)")
     for f in getattr(model, "fmus", {}).values():   # an FMU is code: model files never carry (and run) one
         raise ModelError(f"fmu '{f.name}'", "path", "an FMU runs its own code, so model files do not carry FMUs; "
                          "store the model without it and add it after loading (Model.add_fmu)")

@@ -15,6 +15,9 @@ carried by the body it is fixed on).  `derivatives(s)` returns (C, dC/ds, d2C/ds
   closed) through the points, parametrised by cumulative chord length [m] (s ~ arc length), with
   exact derivatives.
 
+On the compiled core an expression curve runs as compiled programs, a Spline as its cubics, and a callable
+curve as a spline table of it built to the run's tolerance (mbdsim.system.pathtable).
+
 s_range = (a, b): the parameter interval (used to find the initial parameter and the difference
 steps); a closed curve is periodic with period b - a.  Beyond the interval of an open curve the
 callable is evaluated as given and a spline is extrapolated by its end cubics: keep the motion of

@@ -18,6 +18,8 @@ Variables: t and TIME [s]; the coordinate of every revolute, screw (angle [rad],
 translational joint (slide [m]) by its name, and its rate as <joint>_dot [rad/s, m/s]; the model's
 inputs (Model.add_input) by name.  Tables: the model's `tables` {name: table} (the Adams SPLINEs that
 mb.from_adm reads, a model file's `tables:` section) are called as name(x) or name(x, order=n).
+Functions: the model's `functions` (Model.add_function: numba.njit / numba.cfunc functions, run inside the
+compiled kernels, mbdsim.userfunctions) are called as name(x, ...) with their number of arguments.
 """
 from __future__ import annotations
 
@@ -189,7 +191,8 @@ def parse_load(model, text, entity, field, allow_acc=False) -> LoadExpr:
     hook = _Hook(model, allow_acc)
     inputs = [v for v in getattr(model, "inputs", {}) if v not in reserved and v not in joints]
     try:
-        e = parse(text, (*TIME_NAMES, *joints, *inputs), measures=hook, tables=getattr(model, "tables", None))
+        tables = {**getattr(model, "tables", {}), **getattr(model, "functions", {})}   # (functions: add_function)
+        e = parse(text, (*TIME_NAMES, *joints, *inputs), measures=hook, tables=tables)
     except (ExpressionError, ValueError) as exc:
         raise ModelError(entity, field, f"{exc} (measures: {', '.join(MEASURE_KIND)} of bodies and "
                          f"body.marker; variables: t, TIME, the joints {', '.join(joints) or '(none)'}"

@@ -45,9 +45,10 @@ class SensorsMixin:
                    threshold: float | None = None) -> Sensor:
         """Sensor on `signal` reaching `value` (alias `threshold`) in `direction` (+1 rising, -1 falling,
         0 either); action "stop" ends the simulation at that instant (the Result's last sample), "record"
-        notes it.  The times are in `Result.sensor_events`.  An expression signal is watched inside the
-        compiled DOP853's step loop (method "auto" or "dop853"); a callable signal runs the reference
-        (scipy DOP853) path, which "auto" picks; HHT does not stop on sensors."""
+        notes it.  The times are in `Result.sensor_events`.  The signal is watched inside the compiled
+        DOP853's step loop (method "auto" or "dop853"): an expression as a compiled program, a callable
+        through a callback from that loop (solvers.pyloads; its crossing located on the dense output the
+        same way); a named scipy method runs the reference path; HHT does not stop on sensors."""
         entity = f"sensor '{name}'"
         self._claim(name, "sensor")
         try:

@@ -10,6 +10,8 @@ read as a torque is in N m, one read as an angle in rad).
 """
 from __future__ import annotations
 
+from typing import Any
+
 from dataclasses import dataclass
 
 from ..errors import ModelError
@@ -65,6 +67,28 @@ class SignalsMixin:
         inp = Input(name, v)
         self.__dict__.setdefault("inputs", {})[name] = inp
         return inp
+
+    def add_function(self, name: str, function) -> Any:
+        """Make the compiled function `function` callable as `name(x, ...)` in the model's load, sensor
+        and output expressions: a `numba.njit` function or a `numba.cfunc` of 1 to 6 float64 arguments
+        returning a float64, in the SI units of what it computes (mbdsim.userfunctions). The compiled
+        kernels call it through its C address (no Python in the loop); declare it before the elements that
+        read it. A plain Python callable is refused (ModelError): give a load callable (t, state) instead,
+        or decorate it with numba.njit. Returns the mbdsim.userfunctions.UserFunction."""
+        from ..userfunctions import user_function
+        from .loadexpr import check_name
+        entity = f"function '{name}'"
+        check_name(entity, name, True)
+        if not name.isidentifier():
+            raise ModelError(entity, "name", f"{name!r} must be an identifier (letters, digits, _), so that "
+                             "expressions can call it")
+        if name in getattr(self, "tables", {}):
+            raise ModelError(entity, "name", f"the model has a table {name!r}: choose another name")
+        if name in getattr(self, "functions", {}):
+            raise ModelError(entity, "name", "a function of this name already exists in the model")
+        uf = user_function(function, name, entity=entity)   # (called by name: entities may share the name)
+        self.__dict__.setdefault("functions", {})[name] = uf
+        return uf
 
     def add_output(self, name: str, expression: str) -> Output:
         """Declare the measured signal `name`: an expression string of the state, as load expressions use

@@ -44,7 +44,7 @@ class CompiledRun:
     def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False, state=None,
                  friction=False):
         self.sys, self.rows = sys, rows
-        self.cm = compile_system(sys, rows, state, friction)
+        self.cm = compile_system(sys, rows, state, friction, (rtol, atol))
         self.work = Work.for_model(self.cm)
         self.friction = friction_run.FrictionModes(sys, self.cm, self.work) if len(self.cm.friction[0]) else None
         self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back

@@ -16,6 +16,15 @@ Drivers whose function has no compiled program (a Python callable of t, or an in
 form) get a second callback (address in slot 48[1][2]): `drivers_at` calls it after the programs, and it
 writes value, d1, d2 of each such driver into the kernels' driver arrays (work slots 34-36).
 
+Sensors whose signal is a Python callable (t, state) are programs of the expression sensors (system.
+exprloads_pack) that call a ctypes callback `double f(double t)` (`sensor_callback`, one per sensor, its
+address a constant of the program: exprvm's USER op) wherever the step loop evaluates the sensors, at the
+accepted steps and at the probes of the event location on the dense output (solvers.fastdop, as for
+expression sensors): the callback hands the sensor's callable the light State of the frames the kernel has
+just computed for that time and returns the signal. User functions compiled with numba (mbdsim.userfunctions)
+need no callback; a run whose user function returned a non-finite value ends with the EvaluationError
+naming it (`settle`).
+
 A callable that raises, or returns a non-finite or malformed value, is caught here (a ctypes callback
 cannot raise into the kernel): the callback returns 1 and the step is rejected; shorter steps then reach
 up to the failure (the outputs before it are written), and after CALLBACK_RETRIES failed steps in a row the
@@ -37,6 +46,37 @@ from . import fasttree
 from .pydrive import triple
 
 _CALLBACK = ctypes.CFUNCTYPE(ctypes.c_int64, ctypes.c_double)
+_SIGNAL = ctypes.CFUNCTYPE(ctypes.c_double, ctypes.c_double)
+
+
+class SensorCallback:
+    """The ctypes callback `double f(double t)` of one Python-callable sensor: the signal at the kernel's
+    current frames (through `target`, the PythonLoads of the run; nan while no run is attached)."""
+
+    def __init__(self, sensor):
+        self.sensor, self.name, self.target = sensor, f"sensor '{sensor.name}'", None
+        self._cb = _SIGNAL(self._call)
+        self.address = ctypes.cast(self._cb, ctypes.c_void_p).value
+
+    def _call(self, t):
+        pyl = self.target
+        return math.nan if pyl is None else pyl.signal(self.sensor, t)
+
+
+_SENSOR_CALLBACKS: dict = {}   # id(sensor) -> SensorCallback (kept out of the sensor: the model's fingerprint)
+
+
+def sensor_callback(sensor) -> SensorCallback:
+    """The SensorCallback of a Python-callable sensor (made once per sensor object and signal, kept here: the
+    compiled model's programs hold its address)."""
+    from ..userfunctions import _BY_ADDRESS
+    cb = _SENSOR_CALLBACKS.get(id(sensor))
+    if cb is None or cb.sensor is not sensor or cb.signal is not sensor.signal:
+        cb = SensorCallback(sensor)
+        cb.signal = sensor.signal
+        _SENSOR_CALLBACKS[id(sensor)] = cb
+        _BY_ADDRESS[cb.address] = cb
+    return cb
 
 
 class PythonLoads:
@@ -50,8 +90,16 @@ class PythonLoads:
         self.y = np.zeros(sys.nq + sys.nv)
         self.calls, self.error, self.interrupted = 0, None, False
         self.last_failed = False   # whether the latest call of either callback failed
+        self.sensor_error = None   # the error of a Python-callable sensor (the run ends with it)
         self.ctl[:] = 0
         self._callbacks = []   # kept alive: the kernels hold their addresses
+        from ..userfunctions import reset, sites
+        self.user_sites = sites(cm)   # compiled user functions and sensor callbacks (exprvm's USER op)
+        reset(self.user_sites)
+        for sn in getattr(sys.model, "sensors", {}).values():
+            cb = _SENSOR_CALLBACKS.get(id(sn))
+            if sn.text is None and cb is not None and cb.sensor is sn:
+                cb.target = self
         if self.elems:
             self.ctl[0] = self._address(self._call)
         if cm.python_drivers:
@@ -125,6 +173,31 @@ class PythonLoads:
         angle = lambda jt: np.atleast_1d(state.joint_coordinate(jt))[:1]  # noqa: E731
         return state, Frames(r, A, rd, w, t=t, q=q, v=v, angle=angle)
 
+    def signal(self, sensor, t) -> float:
+        """The signal of a Python-callable sensor at t [s] and the kernel's current frames; nan when it
+        fails (the error kept: the run ends with it)."""
+        self.calls += 1
+        if self.interrupted or self.sensor_error is not None:
+            return math.nan
+        try:
+            state, _ = self.state(t)
+            v = sensor.signal(t, state)
+            try:
+                x = float(v)
+            except TypeError:
+                x = float(np.asarray(v, dtype=float).reshape(()))
+            if not math.isfinite(x):
+                raise EvaluationError(f"sensor '{sensor.name}'", "signal", f"is not finite ({x!r})", time=float(t))
+            return x
+        except KeyboardInterrupt:
+            self.interrupted = True
+        except MbdsimError as exc:
+            self.sensor_error = exc
+        except Exception as exc:  # noqa: BLE001 - user code: reported with the sensor's name
+            self.sensor_error = EvaluationError(f"sensor '{sensor.name}'", "signal", f"{type(exc).__name__}: {exc}",
+                                                time=float(t))
+        return math.nan
+
     def _call(self, t):
         """The load callback: generalized loads of the called-back elements at t [s] into slot 48[0]."""
         names = ", ".join(e.name for e in self.elems)
@@ -149,6 +222,13 @@ def settle(pyl, status, error):
     CALLBACK_FAILED, or another failure status, e.g. the step size collapsing onto the failure, right
     after a failed call)."""
     from .fastdyn import CALLBACK_FAILED, INTERRUPTED
+    if pyl is not None and error is None:   # a sensor callback, or a compiled user function, failed
+        if pyl.sensor_error is not None:
+            return CALLBACK_FAILED, pyl.sensor_error
+        from ..userfunctions import failures
+        failed = failures(pyl.user_sites, pyl.sys.model)
+        if failed is not None:
+            return CALLBACK_FAILED, failed
     if pyl is None or status == 0 or error is not None:
         return status, error
     if pyl.interrupted:
@@ -159,5 +239,9 @@ def settle(pyl, status, error):
 
 
 def attach(sys, cm, work) -> PythonLoads | None:
-    """The callbacks of the model's Python-callable loads and drivers set into `work` (None without)."""
-    return PythonLoads(sys, cm, work) if cm.python_loads or cm.python_drivers else None
+    """The callbacks of the model's Python-callable loads, drivers and sensors set into `work`, with the
+    compiled user functions' failure counters reset (None without any)."""
+    if cm.python_loads or cm.python_drivers:
+        return PythonLoads(sys, cm, work)
+    from ..userfunctions import sites
+    return PythonLoads(sys, cm, work) if sites(cm) else None

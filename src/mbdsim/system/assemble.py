@@ -77,7 +77,7 @@ class System:
     lock_rows: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
     switched: dict = field(default_factory=dict)   # friction name -> StickSlip (mode history)
     # issue 11: why the compiled core cannot run this system (rows the kernels do not carry: couplers,
-    # user constraints; sensors); empty when it can.  compile_system checks it.
+    # user constraints); empty when it can (callable sensors are called back: solvers.pyloads).  compile_system checks it.
     not_compiled: list = field(default_factory=list)
     # Caches of functions of this System alone (packed constraint rows, friction base rows, the compiled
     # model, the assembled initial state): computed on first use, never changed after, shared by the
@@ -187,7 +187,6 @@ def _assemble_system(model) -> System:
     groups, owners, owner_rows = _groups(specs, fid)
     not_compiled = [f"{g.kind} rows ({', '.join(sorted({owners[r] for r in g.row_adr}))})"
                     for g in groups if g.kind not in KERNEL_KINDS + ("curve", "coord")]
-    not_compiled += [f"sensor '{n}'" for n, sn in getattr(model, "sensors", {}).items() if sn.text is None]
     as_idx = lambda x, n: np.array([r.start for r in x], dtype=int).reshape(-1, 1) + np.arange(n)  # noqa: E731
     sys = System(model, bodies, fid, len(q0), nv, len(owners), as_idx(r_idx, 3), as_idx(p_idx, 4),
                  as_idx(rd_idx, 3), as_idx(w_idx, 3), np.array(rigid, dtype=int), np.array(v_adr),

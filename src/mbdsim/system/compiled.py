@@ -381,25 +381,34 @@ def _loads(sys, skip=()):
             arr([p[2] for p in sp], (m, 4)))
 
 
-def compile_system(sys, rows, state=None, friction=False) -> CompiledModel:
+def _callable_curves(sys) -> bool:
+    """Whether a point-on-curve constraint has a Python-callable curve (tabulated to the run's tolerance)."""
+    from ..model.curves import Spline
+    return any(not isinstance(pc.curve, Spline) and getattr(pc.curve, "expressions", None) is None
+               for pc in getattr(sys.model, "path_constraints", {}).values())
+
+
+def compile_system(sys, rows, state=None, friction=False, tol=None) -> CompiledModel:
     """CompiledModel of System `sys` with independent constraint rows `rows`; NotCompiled if unsupported.
     With the assembled state=(q, v) a tree of one-degree-of-freedom joints gets its joint-coordinate
     model (system.jointtree; dims[5] = 1: integrated by the articulated-body algorithm).  Joint friction
     (lock rows) only with `friction` (the caller runs its stick/slip events: solvers.compiled_run), in
     absolute coordinates.  Kept in sys.derived for the same rows, state and flag (a System reused for an
-    unchanged Model compiles once)."""
+    unchanged Model compiles once). tol = (rtol, atol) of the run: the tolerance of the tables of
+    Python-callable point-on-curve curves (system.pathtable; part of the key only for such a model)."""
     rows = np.asarray(rows, dtype=np.int64)
+    tol = tuple(tol) if tol is not None and _callable_curves(sys) else None
     key = (rows.tobytes(), None if state is None else tuple(np.asarray(x, float).tobytes() for x in state),
-           bool(friction))
+           bool(friction), tol)
     kept = sys.derived.get("compiled")
     if kept is not None and kept[0] == key:
         return kept[1]
-    cm = _compile_system(sys, rows, None if friction and len(sys.lock_rows) else state, friction)
+    cm = _compile_system(sys, rows, None if friction and len(sys.lock_rows) else state, friction, tol)
     sys.derived["compiled"] = (key, cm)
     return cm
 
 
-def _compile_system(sys, rows, state, friction=False) -> CompiledModel:
+def _compile_system(sys, rows, state, friction=False, tol=None) -> CompiledModel:
     nf = sys.nbody + 1
     rows = np.asarray(rows, dtype=np.int64)
     paths = len(getattr(sys.model, "path_constraints", {})) > 0   # (absolute coordinates: solvers.pathcoord)
@@ -428,7 +437,7 @@ def _compile_system(sys, rows, state, friction=False) -> CompiledModel:
     lc, lstack = (loopcoords.empty(), 4) if tree_coords else loopcoords.pack(sys, bi, bj)
     if len(lc[0]):   # couplers in absolute coordinates (issue 29): the link rows are not solved for
         rows = rows[~np.isin(rows, loopcoords.link_rows(sys))]
-    pc, pstack = pathcoords.pack(sys) if paths else (pathcoords.empty(), 4)
+    pc, pstack = pathcoords.pack(sys, *(tol or ())) if paths else (pathcoords.empty(), 4)
     if paths:        # point-on-curve: the tangential rows are residuals only
         rows = rows[~np.isin(rows, pathcoords.tangent_rows(sys))]
     code, consts, tables, start, end, stack, pyd, dslots = _driver_programs(fns)

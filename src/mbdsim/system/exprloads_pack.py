@@ -6,7 +6,8 @@ sensors into the tuple `ex` (measures, loads, packed postfix programs of `system
 then the sensors: program, direction, stop flag and value, slots 18-21); `work(ex)` gives its scratch
 (slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
 count and scratch; `solvers.fastdop.run` watches them).
-A Python callable, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
+A Python-callable sensor is a program calling its ctypes callback (solvers.pyloads.sensor_callback) with t.
+A Python-callable load, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
 event-driven reference path), raises NotCompiled with the reason. On the joint-coordinate path a joint
 measure reads the tree's own coordinate: angle = angle at assembly + sign theta (sign -1 when the
 joint's body_i is the child in the tree).
@@ -201,10 +202,18 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
             loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, value), -1, -1]))
     sn = []
     for sensor in sensors:
-        if sensor.text is None:
-            raise NotCompiled(f"sensor '{sensor.name}' is a Python callable")
-        le = parse_load(sys.model, sensor.text, f"sensor '{sensor.name}'", "signal")
-        sn.append((program(sensor, le, "sensor"), sensor.direction, int(sensor.action == "stop"), sensor.value))
+        if sensor.text is None:   # a Python callable: called back through a ctypes callback (solvers.pyloads)
+            from ..solvers.pyloads import sensor_callback
+            from .._exprtree import Var
+            em = exprvm._Emitter({"t": 0})
+            em.user_call(sensor_callback(sensor).address, (Var("t"),))   # signal(t, state) at the kernel's frames
+            progs.append(exprvm.Program(np.array(em.code, np.int64).reshape(-1, 2), np.array(em.consts, float),
+                                        np.zeros(0), max(em.max_depth, 1)))
+            p = len(progs) - 1
+        else:
+            le = parse_load(sys.model, sensor.text, f"sensor '{sensor.name}'", "signal")
+            p = program(sensor, le, "sensor")
+        sn.append((p, sensor.direction, int(sensor.action == "stop"), sensor.value))
     if not loads and not sn:
         return empty(), 4
     pk = exprvm.pack(progs)

@@ -5,8 +5,13 @@ spline tables); `pack(programs)` concatenates a model's programs into single arr
 (numba, compiled once and cached: its signature is fixed arrays) evaluates program k with the variable
 values x. Semantics are numpy's (nan for log of a negative number, inf for division by zero), the
 Adams library (STEP, STEP5, HAVSIN, POLY, SHF with derivative orders; IMPACT, BISTOP and their d/dx) as in `mbdsim.functions`, and
-spline tables (Akima, cubic) as piecewise cubics with their derivatives. Variables are slots of x
-(e.g. x[0] = t [s]); a program never runs Python.
+spline tables (Akima, cubic) as piecewise cubics with their derivatives, and user functions (issue 29:
+`mbdsim.userfunctions`, numba.njit / numba.cfunc functions of float64 arguments) called through their C
+address: op USER after the arguments and a constant holding the address (exact as a float64: addresses are
+below 2**53); its operand is 8 * (index of a constant counting the calls that returned a non-finite value:
+the run reports them, `mbdsim.userfunctions.failures`) + the number of arguments (1..6). Variables are
+slots of x (e.g. x[0] = t [s]); a program never runs Python (a sensor's Python callable is reached the same
+way, through a ctypes callback: solvers.pyloads).
 """
 from __future__ import annotations
 
@@ -18,6 +23,8 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from .._exprtree import Bin, Call, Const, ExpressionError, Fn, Neg, Var
+from ..solvers.pycall import (call_double_1, call_double_2, call_double_3, call_double_4, call_double_5,
+                              call_double_6)
 
 # opcodes (operand in the second column)
 CONST, VAR, ADD, SUB, MUL, DIV, POW, NEG, ATAN2 = 0, 1, 2, 3, 4, 5, 6, 7, 8
@@ -25,6 +32,7 @@ UNARY = {"sin": 10, "cos": 11, "tan": 12, "asin": 13, "acos": 14, "atan": 15, "s
          "tanh": 18, "exp": 19, "log": 20, "sqrt": 21, "abs": 22, "sign": 23}
 LIB = {"STEP": 30, "STEP5": 31, "HAVSIN": 32, "POLY": 33, "SHF": 34, "IMPACT": 35, "BISTOP": 36}
 TABLE = 40
+USER = 50
 _BIN = {"+": ADD, "-": SUB, "*": MUL, "/": DIV, "**": POW}
 
 
@@ -91,6 +99,9 @@ class _Emitter:
             raise ExpressionError(f"cannot compile expression node {n!r}")
 
     def _call(self, n):
+        if getattr(n.table, "address", None) is not None:   # a user function (mbdsim.userfunctions)
+            self.user_call(n.table.address, n.args)
+            return
         if n.table is not None:          # a spline table reads its first argument only
             self.emit(n.args[0])
             pp = getattr(n.table, "_interp", None)
@@ -108,6 +119,17 @@ class _Emitter:
             self.push(LIB[n.name], n.order * 64 + len(n.args), len(n.args) - 1)
         else:
             raise ExpressionError(f"function {n.name!r} is not available in compiled code")
+
+
+    def user_call(self, address, args):
+        """The arguments, the C address of the function (a constant) and the USER op (its operand: the
+        counter constant of non-finite returns, and the number of arguments)."""
+        for a in args:
+            self.emit(a)
+        self.consts.append(float(address))
+        self.push(CONST, len(self.consts) - 1)
+        self.consts.append(0.0)
+        self.push(USER, (len(self.consts) - 1) * 8 + len(args), len(args) + 1)
 
 
 def compile_expr(expr, variables: dict[str, int]) -> Program:
@@ -132,6 +154,7 @@ def pack(programs) -> Packed:
     for p in programs:
         c = p.code.copy()
         c[c[:, 0] == CONST, 1] += nc
+        c[c[:, 0] == USER, 1] += nc * 8
         tab = c[:, 0] == TABLE
         c[tab, 1] += nt * 8
         codes.append(c)
@@ -150,8 +173,14 @@ def pack(programs) -> Packed:
 
 def time_programs(tf):
     """(value, d1, d2) programs in the variable t (slot 0) of a TimeFunction, or None when it is a Python
-    callable or an integral evaluated by quadrature (those stay on the Python path)."""
+    callable or an integral evaluated by quadrature (those stay on the Python path). A numba.njit /
+    numba.cfunc function of t (and its d1 / d2 when given as such) is called from the programs
+    (mbdsim.userfunctions.time_programs)."""
     from ..timefunctions import _Constant
+    from ..userfunctions import time_programs as user_time_programs
+    progs = user_time_programs(tf)
+    if progs is not None:
+        return progs
     if getattr(tf, "expr", None) is not None:
         return tuple(compile_expr(e, {"t": 0}) for e in (tf.f, tf.f_d1, tf.f_d2))
     if isinstance(tf.f, _Constant):
@@ -233,6 +262,29 @@ def _table(tables, off, order, x):
     if order == 3:
         return 6.0 * a3
     return 0.0
+
+
+@kernel(_nrt=False, error_model="numpy")
+def _user_call(address, nargs, stack, base):
+    """f(stack[base], ..., stack[base + nargs - 1]) of the C function `double f(double, ...)` at `address`
+    (nan for address 0 or an arity beyond pycall.MAX_ARGS)."""
+    if address == 0:
+        return np.nan
+    if nargs == 1:
+        return call_double_1(address, stack[base])
+    if nargs == 2:
+        return call_double_2(address, stack[base], stack[base + 1])
+    if nargs == 3:
+        return call_double_3(address, stack[base], stack[base + 1], stack[base + 2])
+    if nargs == 4:
+        return call_double_4(address, stack[base], stack[base + 1], stack[base + 2], stack[base + 3])
+    if nargs == 5:
+        return call_double_5(address, stack[base], stack[base + 1], stack[base + 2], stack[base + 3],
+                             stack[base + 4])
+    if nargs == 6:
+        return call_double_6(address, stack[base], stack[base + 1], stack[base + 2], stack[base + 3],
+                             stack[base + 4], stack[base + 5])
+    return np.nan
 
 
 @kernel(_nrt=False, error_model="numpy")
@@ -339,7 +391,15 @@ def eval_program(code, consts, tables, start, end, x, stack):
                     r += b
             sp = base + 1
             stack[base] = r
-        else:                                      # spline table: AKISPL-style, argument first
+        elif op == 40:                             # spline table: AKISPL-style, argument first
             r = _table(tables, arg // 8, arg % 8, stack[sp - 1])
             stack[sp - 1] = r
+        else:                                      # USER: f(args) at the address on the stack's top
+            nargs = arg % 8
+            base = sp - 1 - nargs
+            r = _user_call(np.int64(stack[sp - 1]), nargs, stack, base)
+            if not np.isfinite(r):
+                consts[arg // 8] += 1.0
+            stack[base] = r
+            sp = base + 1
     return stack[0]

@@ -131,6 +131,12 @@ def _walk(root, model_attrs, refs=None, portable=False) -> tuple[bytes, bool]:
         elif t.__module__.startswith("numba.") and isinstance(getattr(obj, "py_func", None), types.FunctionType):
             add(b"J")                       # a numba.njit dispatcher: as the Python function it compiles
             push(obj.py_func)               # (its own fields are numba's caches: megabytes of objects)
+        elif t.__module__.startswith("numba.") and isinstance(getattr(obj, "_pyfunc", None), types.FunctionType):
+            add(b"K")                       # a numba.cfunc: as its Python function and signature
+            push([obj._pyfunc, str(getattr(obj, "_sig", ""))])
+        elif t.__module__ == "mbdsim.userfunctions" and t.__name__ == "UserFunction":
+            add(b"U")                       # a user function: by name, arity and what it compiles (not its
+            push([obj.name, obj.nargs, obj.fn])   # C address, which differs between processes)
         elif portable and isinstance(obj, types.FunctionType):
             add(b"P")
             push(_code(obj))

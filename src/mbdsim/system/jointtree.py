@@ -51,8 +51,6 @@ def _why_not(sys, rows) -> str | None:
         return "path or friction constraints"
     if any(g.kind not in KERNEL_KINDS + ("coord",) for g in sys.groups):
         return "rows the compiled core does not carry"
-    if any(sn.text is None for sn in getattr(model, "sensors", {}).values()):
-        return "sensors written as Python callables"
     if len(rows) != sys.nc:
         return "redundant constraints"
     if any(b.is_particle for b in sys.bodies):

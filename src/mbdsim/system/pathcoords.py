@@ -1,5 +1,6 @@
 """Point-on-curve (path) constraints packed for the compiled kernels (`solvers.pathcoord`, CompiledModel slot 49),
-issue 29: curves written as expression strings in s (mbdsim.Curve of three expressions).
+issue 29: curves written as expression strings in s (mbdsim.Curve of three expressions), mbdsim.Spline, and
+Python-callable curves tabulated as splines to the run's tolerance (system.pathtable).
 
 The curve parameter s of each constraint stays an auxiliary coordinate of the state (system.constraints.path),
 but not a velocity variable of the KKT solve (the compiled velocity layout has six slots per frame): the
@@ -34,11 +35,11 @@ def tangent_rows(sys) -> np.ndarray:
     return np.array([int(r0) + 2 for g in sys.groups if g.kind == "curve" for r0 in g.row_adr], dtype=np.int64)
 
 
-def pack(sys) -> tuple[tuple, int]:
-    """(`pc`, stack size) of the System's path constraints; NotCompiled (system.compiled) for a curve that is
-    not written as expressions or a Spline (a Python callable)."""
+def pack(sys, rtol=None, atol=None) -> tuple[tuple, int]:
+    """(`pc`, stack size) of the System's path constraints; a Python-callable curve is tabulated as a spline
+    to the run's rtol / atol (system.pathtable)."""
     from . import exprvm
-    from .compiled import NotCompiled
+    from .pathtable import tabulate
     groups = [g for g in sys.groups if g.kind == "curve"]
     if not groups:
         return empty(), 4
@@ -49,16 +50,15 @@ def pack(sys) -> tuple[tuple, int]:
         for k, (cp, r) in enumerate(zip(g.fns, g.row_adr)):
             curve = cp.spec.curve
             exprs = getattr(curve, "expressions", None)
-            if isinstance(curve, Spline):
-                cs = curve._cs
+            tabulated = not isinstance(curve, Spline) and exprs is None
+            if isinstance(curve, Spline) or tabulated:   # a Python callable: its table (system.pathtable)
+                cs = curve._cs if not tabulated else tabulate(curve, rtol, atol, cp.spec.name)[0]
                 ckind.append(1)
                 breaks.extend(np.asarray(cs.x, float))
                 coef.extend(np.moveaxis(np.asarray(cs.c, float), 1, 0))   # (nseg, 4, 3)
                 sptr.append(sptr[-1] + len(cs.x) - 1)
                 periodic.append(int(curve.closed))
                 progs.extend(exprvm.constant_program(0.0) for _ in range(9))
-            elif exprs is None:
-                raise NotCompiled(f"point-on-curve '{cp.spec.name}': a Python-callable curve is not compiled yet")
             else:
                 e1 = [e.derivative("s") for e in exprs]
                 e2 = [e.derivative("s") for e in e1]
