@@ -263,18 +263,19 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
         if getattr(sys.model, "sensors", None):
             raise ModelError(f"sensor '{next(iter(sys.model.sensors))}'", "method", "sensors are located by "
                              "the index-1 methods (method='auto', 'dop853', 'rk45', 'radau' or 'bdf'), not HHT")
-        if _default_method(sys.model) != "hht":
-            names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
-            raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
-                             "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
-                             "'bdf'); the HHT method cannot include it")
-        if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run)
+        names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
+        reason = "the compiled core is off (USE_COMPILED)"
+        if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run; joint friction included)
             from .hht import ALPHA
             from .hht_run import integrate_hht_compiled
             try:
                 return integrate_hht_compiled(sys, rep, times, rtol, atol, max_step, ALPHA, progress)
-            except NotCompiled:
-                pass   # sensors, switching elements: the reference HHT locates their events
+            except NotCompiled as exc:
+                reason = str(exc)   # sensors, switching elements: the reference HHT locates their events
+        if names:   # the reference HHT has no stick/slip events
+            raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip runs on the "
+                             f"compiled HHT, which cannot run this model ({reason}); use method='dop853', "
+                             "'rk45', 'radau' or 'bdf'")
         res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res

@@ -1,0 +1,86 @@
+"""A held group on the compiled core (issue 29): a crank-rocker with friction in all four pins coasts to
+rest; its four locks are dependent (one DOF), so the pins stick as one group whose static capacity is
+shared.  Against closed forms: while the crank torque T = r t stays below the group's capacity
+C = sum_k |c_k| mu_s N_k (c_k the pins' joint rates per unit crank rate at the stop, from the four-bar's
+closed-form positions; N_k the preloads, the pins being unloaded at rest without gravity) the mechanism
+stays where it stopped; it breaks away at t = C / r; kinetic energy + dissipation = initial energy +
+the drive's work to 1e-6 of the initial energy; the stop and the breakaway where the event-driven
+reference path (force_elements.friction_lcp, scipy's DOP853) puts them.
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mbdsim as mb
+from test_friction_loops import drive_work, four_bar_points, rz
+
+RATE, MU_S, MU_D = 0.05, 0.4, 0.3
+PRELOADS = {"O2": 0.02, "A": 0.01, "B": 0.015, "O4": 0.012}   # [N m]
+TH0 = 0.3
+
+
+def held_four_bar(w0=-2.0):
+    """Crank-rocker (test_friction_loops' links) without gravity, coasting from w0 [rad/s], pin friction
+    with preloads in every joint, a crank torque RATE * t [N m]."""
+    m = mb.Model("held_four_bar", gravity=(0, 0, 0))
+    A, B, O4 = four_bar_points(TH0)
+    ang = lambda v: rz(np.arctan2(v[1], v[0]))  # noqa: E731
+    crank = m.add_body("crank", 0.5, (1e-4, 4e-4, 4e-4), position=A / 2, orientation=ang(A))
+    coupler = m.add_body("coupler", 1.0, (1e-4, 0.01, 0.01), position=(A + B) / 2, orientation=ang(B - A))
+    rocker = m.add_body("rocker", 0.8, (1e-4, 6e-3, 6e-3), position=(B + O4) / 2, orientation=ang(B - O4))
+    z = (0, 0, 1)
+    joints = [m.add_revolute("O2", m.ground, crank, (0, 0, 0), z, initial_velocity=[w0]),
+              m.add_revolute("A", crank, coupler, A, z), m.add_revolute("B", coupler, rocker, B, z),
+              m.add_revolute("O4", m.ground, rocker, O4, z)]
+    for jt in joints:
+        m.add_friction("f_" + jt.name, jt, MU_S, MU_D, pin_radius=0.01, preload=PRELOADS[jt.name])
+    m.add_torque("drive", crank, (0, 0, f"{RATE}*t"))
+    return m
+
+
+def link_angles(th):
+    """Crank, coupler and rocker angles [rad] at crank angle th (closed-form positions)."""
+    A, B, O4 = four_bar_points(th)
+    return np.array([th, np.arctan2(*(B - A)[1::-1]), np.arctan2(*(B - O4)[1::-1])])
+
+
+def capacity(th):
+    """The group's static capacity C [N m] at crank angle th: sum_k |c_k| mu_s N_k, c_k the joint rates
+    of O2, A, B, O4 per unit crank rate (central differences of the closed-form angles)."""
+    d = 1e-6
+    r2, r3, r4 = (link_angles(th + d) - link_angles(th - d)) / (2 * d)
+    c = {"O2": r2, "A": r3 - r2, "B": r4 - r3, "O4": r4}
+    return MU_S * sum(abs(c[n]) * PRELOADS[n] for n in PRELOADS)
+
+
+def stop_and_breakaway(res):
+    ev = [res.friction_events("f_" + n) for n in PRELOADS]
+    stops = [[t for t, m, _ in e if m == "stick"] for e in ev]
+    slips = [[t for t, m, _ in e if m == "slip" and t > 0] for e in ev]
+    return stops, slips
+
+
+def test_four_bar_stopped_with_friction_in_every_pin_is_held_as_one_group_compiled():
+    res = mb.simulate(held_four_bar(), 2.0, output_step=0.005, rtol=1e-9)
+    assert res.success, res.message
+    assert "(compiled)" in res.stats["method"], res.stats["method"]
+    stops, slips = stop_and_breakaway(res)
+    t_s = stops[0][0]
+    assert all(s[0] == pytest.approx(t_s, abs=1e-12) for s in stops)   # the pins stop together
+    t_b = slips[0][0]
+    assert all(s[0] == pytest.approx(t_b, abs=1e-12) for s in slips)   # and break away together
+    th_s = float(res.at(t_s).joint_coordinate("O2")[0]) + TH0
+    assert RATE * t_s < capacity(th_s)                                 # held at the stop
+    assert t_b == pytest.approx(capacity(th_s) / RATE, rel=1e-6)       # the closed-form breakaway load
+    held = (res.time > t_s + 1e-9) & (res.time < t_b - 1e-9)
+    assert np.count_nonzero(held) > 50
+    assert np.max(np.abs(res.joint_coordinate("O2")[held] + TH0 - th_s)) < 1e-10
+    for n in PRELOADS:
+        assert np.max(np.abs(res.joint_velocity(n)[held])) < 1e-10
+    assert res.joint_velocity("O2")[-1] > 0.1                          # moving again, with the torque
+    E = res.kinetic_energy()
+    W = np.array([0.0] + [drive_work(res, [0.0, t_s, t_b, t][:2 + (t > t_s) + (t > t_b)] + [t] * 0,
+                                     lambda r: RATE * r.time * r.joint_velocity("O2")) for t in res.time[1:]])
+    # (the work up to each sample: Gauss-Legendre on the smooth pieces between the events)
+    assert np.max(np.abs(E + res.dissipated_energy() - E[0] - W)) < 1e-6 * E[0]
