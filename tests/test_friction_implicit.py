@@ -1,0 +1,55 @@
+"""Joint friction stick/slip on the compiled implicit steppers, HHT-alpha and Radau IIA (issue 29).
+
+The spring-pulled block's breakaway (k vp t = mu_s m g) and next stop against the closed form; the
+coasting slider-crank (friction in the bore of a closed loop) comes to rest with kinetic + potential +
+dissipated energy = the initial energy to 1e-6 of it, and stops when the compiled DOP853 (an explicit
+method, its events on its own dense output) says. Each run states "(compiled)" in res.stats["method"].
+"""
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import mbdsim as mb
+from test_compiled_friction import closed_form, spring_pulled_block
+from test_friction_loops import slider_crank
+
+METHODS = [("hht", "HHT (compiled)", 1e-9), ("radau", "Radau IIA (compiled)", None)]
+
+
+@pytest.mark.parametrize("method, name, rtol", METHODS)
+def test_spring_pulled_block_breakaway_and_stop_on_implicit_steppers(method, name, rtol):
+    tb, ts, xs = closed_form()
+    model, slide = spring_pulled_block()
+    res = mb.simulate(model, ts + 0.05, output_step=0.01, method=method, rtol=rtol)
+    assert res.success, res.message
+    assert res.stats["method"] == name
+    ev = res.friction_events("friction")
+    assert [mode for _, mode, _ in ev[:3]] == ["stick", "slip", "stick"]
+    assert ev[1][0] == pytest.approx(tb, rel=1e-8)   # the stick phase is exact: the anchor is a driver
+    assert ev[2][0] == pytest.approx(ts, rel=1e-6)
+    assert float(res.at(ev[2][0]).joint_coordinate(slide)[0]) == pytest.approx(xs, rel=1e-6)
+    before = res.time < tb - 1e-3   # stuck: static friction carries the spring force k vp t
+    assert np.allclose(res.friction_force("friction")[before], -200.0 * 0.5 * res.time[before], atol=1e-8)
+    after = res.time > ev[2][0] + 1e-3   # stuck again
+    assert np.max(np.abs(res.joint_velocity(slide)[after])) < 1e-9
+
+
+@pytest.mark.parametrize("method, name, rtol", METHODS)
+def test_coasting_slider_crank_energy_balance_on_implicit_steppers(method, name, rtol):
+    res = mb.simulate(slider_crank("coast", mu=0.4), 3.5, output_step=0.01, method=method, rtol=rtol)
+    assert res.success, res.message
+    assert res.stats["method"] == name
+    ev = res.friction_events("friction")
+    assert ev[-1][1] == "stick" and ev[-1][0] < 3.0
+    after = res.time > ev[-1][0]
+    assert np.max(np.abs(res.joint_velocity("O")[after])) < 1e-9   # at rest, and staying there
+    E = res.kinetic_energy() + res.potential_energy()
+    D = res.dissipated_energy()
+    assert D[-1] > 0.5 * E[0]
+    assert np.max(np.abs(E + D - E[0])) < 1e-6 * E[0]
+    ref = mb.simulate(slider_crank("coast", mu=0.4), ev[-1][0] + 0.05, output_step=0.05, method="dop853")
+    assert ref.stats["method"].startswith("DOP853") and "(compiled)" in ref.stats["method"]
+    ev_ref = ref.friction_events("friction")
+    assert [(m, d) for _, m, d in ev_ref] == [(m, d) for _, m, d in ev]
+    assert np.allclose([e[0] for e in ev_ref], [e[0] for e in ev], rtol=1e-6, atol=0)
