@@ -197,6 +197,32 @@ def coasting_slider_crank(bore=0.0, pins=0.0):
     return m
 
 
+def coasting_four_bar(mu=0.0):
+    """Crank-rocker (crank 0.1 m, coupler 0.35 m, rocker 0.3 m, ground link 0.4 m) in a vertical plane,
+    released at 1 rev/s; pin friction mu (pin radius 0.05 m) in all four pins: it comes to rest with the
+    four pins stuck as one held group (their locks dependent); no friction element where mu = 0."""
+    a4, b4, c4, d4, th = 0.1, 0.35, 0.3, 0.4, 0.3
+    A = a4 * np.array([np.cos(th), np.sin(th), 0.0])
+    O4 = np.array([d4, 0.0, 0.0])
+    dist = np.linalg.norm(O4 - A)
+    ex = (O4 - A) / dist
+    x = (b4**2 - c4**2 + dist**2) / (2 * dist)
+    B = A + x * ex + np.sqrt(b4**2 - x**2) * np.array([-ex[1], ex[0], 0.0])
+    from scipy.spatial.transform import Rotation
+    ang = lambda v: Rotation.from_rotvec([0.0, 0.0, np.arctan2(v[1], v[0])])  # noqa: E731
+    m = mb.Model("four_bar", gravity=(0.0, -9.81, 0.0))
+    crank = m.add_body("crank", 0.5, (1e-4, 4e-4, 4e-4), position=A / 2, orientation=ang(A))
+    coupler = m.add_body("coupler", 1.0, (1e-4, 0.01, 0.01), position=(A + B) / 2, orientation=ang(B - A))
+    rocker = m.add_body("rocker", 0.8, (1e-4, 6e-3, 6e-3), position=(B + O4) / 2, orientation=ang(B - O4))
+    z = (0, 0, 1)
+    joints = [m.add_revolute("O2", m.ground, crank, (0, 0, 0), z, initial_velocity=[2 * np.pi]),
+              m.add_revolute("A", crank, coupler, A, z), m.add_revolute("B", coupler, rocker, B, z),
+              m.add_revolute("O4", m.ground, rocker, O4, z)]
+    for jt in joints if mu else ():
+        m.add_friction("f_" + jt.name, jt, mu, mu, pin_radius=0.05)
+    return m
+
+
 def timed(fn):
     fn()
     ts = []
@@ -239,6 +265,8 @@ CASES = [
      lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", ()),   # different motions
     ("joint friction, bore (coasting slider-crank comes to rest and sticks) vs none",
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
+    ("joint friction, all four pins (coasting four-bar comes to rest, held as one group) vs none",
+     lambda: coasting_four_bar(0.3), coasting_four_bar, "simulate", ()),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
     ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,
