@@ -4,7 +4,7 @@ same motion, measured in one process run (ratios count; absolute times on this m
     python3 bench/vocabulary.py            # writes bench/VOCABULARY.md
     python3 bench/vocabulary.py gear       # only the cases whose name contains "gear": their rows replaced
 
-Each case: the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
+Each case (name, element's model, baseline's model, analysis, joints compared[, method]): the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
 call (the Model is built once; the first call assembles and compiles it), the method each ran
 (res.stats["method"]) and the largest difference between the two runs' joint coordinates (the same motion,
 so the difference is the accuracy check of the cheaper formulation).
@@ -267,6 +267,10 @@ CASES = [
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
     ("joint friction, all four pins (coasting four-bar comes to rest, held as one group) vs none",
      lambda: coasting_four_bar(0.3), coasting_four_bar, "simulate", ()),
+    ("joint friction, bore, HHT (coasting slider-crank comes to rest and sticks) vs none, HHT",
+     lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", (), "hht"),
+    ("joint friction, bore, Radau (coasting slider-crank comes to rest and sticks) vs none, Radau",
+     lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", (), "radau"),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
     ("helix vs straight line, both expression curves (bead, point-on-curve, compiled)", helix_bead,
@@ -282,10 +286,11 @@ def main(only=None):
              "Written by `python3 bench/vocabulary.py`: median of %d calls after a warm-up, same process." % REPEAT,
              "", "| case | element | baseline | ratio | element's method | max joint-coordinate difference |",
              "|---|---|---|---|---|---|"]
-    for name, make, make_base, analysis, joints in CASES:
+    for name, make, make_base, analysis, joints, *method in CASES:   # (an optional 6th field: the method)
         if only and only not in name:
             continue
-        run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01)) if analysis == "simulate" else \
+        opts = {"method": method[0]} if method else {}
+        run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01, **opts)) if analysis == "simulate" else \
             (lambda m: mb.kinematics(m, end_time=2.0, output_step=0.01))
         m, mb_ = make(), make_base()
         te, re = timed(lambda: run(m))
