@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import mbdsim as mb
-from test_compiled_friction import closed_form, spring_pulled_block
+from test_compiled_friction import G, closed_form, spring_pulled_block
 from test_friction_loops import four_bar, slider_crank
 
 METHODS = [("hht", "HHT (compiled)", 1e-9), ("radau", "Radau IIA (compiled)", None)]
@@ -74,3 +74,38 @@ def test_four_bar_held_by_all_pins_on_radau():
     assert np.max(np.abs(res.joint_velocity("O2")[res.time > t_stop])) < 1e-10
     E = res.kinetic_energy() + res.potential_energy()
     assert np.max(np.abs(E + res.dissipated_energy() - E[0])) < 1e-6 * E[0]
+
+
+def stiff_pulled_block(k_stiff=1e7, c_stiff=3000.0):
+    """The spring-pulled block carrying a 0.01 kg tag on a slide of its own, held to it by a stiff,
+    overdamped spring-damper (k_stiff [N/m], c_stiff [N s/m]: eigenvalues about -k/c and -c/m, a stiff
+    machine); the tag's weight goes through the block into its friction slide."""
+    mdl = mb.Model("stiff_block", gravity=(0, -G, 0))
+    block = mdl.add_particle("block", 2.0, (0, 0, 0))
+    tag = mdl.add_particle("tag", 0.01, (0.1, 0, 0))
+    anchor = mdl.add_particle("anchor", 1.0, (1, 0, 0), velocity=(0.5, 0, 0))
+    slide = mdl.add_translational("slide", mdl.ground, block, (0, 0, 0), (1, 0, 0))
+    mdl.add_translational("tag_slide", block, tag, (0.1, 0, 0), (1, 0, 0))
+    rail = mdl.add_translational("rail", mdl.ground, anchor, (1, 0, 0), (1, 0, 0))
+    mdl.add_motion("pull", rail, displacement="0.5*t")
+    mdl.add_spring_damper("spring", (anchor, (1, 0, 0)), (block, (0, 0, 0)), 200.0, free_length=1.0)
+    mdl.add_spring_damper("stiff", (block, (0.1, 0, 0)), (tag, (0.1, 0, 0)), k_stiff, free_length=0.0,
+                          damping=c_stiff)
+    mdl.add_friction("friction", slide, 0.5, 0.3)
+    return mdl, slide
+
+
+def test_stiff_machine_with_friction_on_radau():
+    """A stiff machine with stick/slip runs on the compiled Radau in a few hundred steps (DOP853 takes
+    ~29,000 on it) with the breakaway and stop of the block's closed form for the total mass 2.01 kg
+    (the tag's stiff spring deflects by m_tag a / k ~ 1e-9 m)."""
+    tb, ts, xs = closed_form(m=2.01)
+    model, slide = stiff_pulled_block()
+    res = mb.simulate(model, ts + 0.05, output_step=0.01, method="radau")
+    assert res.success, res.message
+    assert res.stats["method"] == "Radau IIA (compiled)" and res.stats["steps"] < 1000
+    ev = res.friction_events("friction")
+    assert [mode for _, mode, _ in ev] == ["stick", "slip", "stick"]
+    assert ev[1][0] == pytest.approx(tb, rel=1e-8)
+    assert ev[2][0] == pytest.approx(ts, rel=1e-6)
+    assert float(res.at(ev[2][0]).joint_coordinate(slide)[0]) == pytest.approx(xs, rel=1e-6)
