@@ -8,6 +8,9 @@ between outputs is the run's own dense output (projected onto the constraints, a
 multipliers from the compiled kernel), nothing integrated again. For method "radau", models with expression
 sensors or switching force elements (contact onset, stops) stay on the reference path (`NotCompiled`),
 which locates their events; the automatic method's continuation runs them compiled, as its DOP853 part.
+Joint friction with stick/slip runs here (and on HHT): the step loop stops at each switching event,
+located on the step's polynomial (solvers.fastswitch), and `integrate` restarts it there with the modes
+`friction_run.FrictionModes.decide` takes (the decision of every stepper).
 """
 from __future__ import annotations
 
