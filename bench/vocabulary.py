@@ -267,6 +267,10 @@ CASES = [
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
     ("joint friction, all four pins (coasting four-bar comes to rest, held as one group) vs none",
      lambda: coasting_four_bar(0.3), coasting_four_bar, "simulate", ()),
+    ("joint friction, bore + two pins, HHT (coasting slider-crank, slipping through dead centres) vs none, HHT",
+     lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", (), "hht"),
+    ("joint friction, bore + two pins, Radau (coasting slider-crank, slipping through dead centres) vs none, "
+     "Radau", lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", (), "radau"),
     ("joint friction, bore, HHT (coasting slider-crank comes to rest and sticks) vs none, HHT",
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", (), "hht"),
     ("joint friction, bore, Radau (coasting slider-crank comes to rest and sticks) vs none, Radau",
