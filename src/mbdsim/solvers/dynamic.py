@@ -196,8 +196,9 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
-            if exc.prefix is not None and _default_method(model) == "hht":   # the compiled Radau IIA continues
-                from .radau_run import continue_radau                       # from there, at auto's tolerance
+            if exc.prefix is not None and not getattr(model, "sensors", None):   # the compiled Radau IIA continues
+                from .radau_run import continue_radau   # from there, at auto's tolerance (joint friction too: its
+                #                                         events on Radau's steps, the same modes)
                 res = continue_radau(sys, rep, times, exc, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
                                      reason)
                 res.stats["rtol_reached"] = rt
