@@ -89,6 +89,10 @@ class RadauRun(CompiledRun):
                 if status == fastdop.FRICTION_EVENT:   # a stick/slip event at st[0]: decide, restart there
                     self.friction.decide(st[0], y)     # (the one decision of every stepper: friction_run)
                     st[1:] = 0.0
+                    if tout[-1] - st[0] <= 1e-14 * max(1.0, abs(st[0])):   # at the end time: its state is the
+                        Y[iout:] = y                                         # last output (absolute coordinates)
+                        iout, status = nout, 0
+                        break
                 if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
                     if 2 * (SY.size + SQ.size) * 8 <= CHECKPOINT_BUDGET:
                         SY, ST, SQ = (np.concatenate([x, np.zeros_like(x)]) for x in (SY, ST, SQ))
