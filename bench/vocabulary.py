@@ -4,7 +4,7 @@ same motion, measured in one process run (ratios count; absolute times on this m
     python3 bench/vocabulary.py            # writes bench/VOCABULARY.md
     python3 bench/vocabulary.py gear       # only the cases whose name contains "gear": their rows replaced
 
-Each case: the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
+Each case (name, element's model, baseline's model, analysis, joints compared[, method]): the median wall time of `REPEAT` calls of `mb.simulate` / `mb.kinematics` after one warm-up
 call (the Model is built once; the first call assembles and compiles it), the method each ran
 (res.stats["method"]) and the largest difference between the two runs' joint coordinates (the same motion,
 so the difference is the accuracy check of the cheaper formulation).
@@ -224,6 +224,32 @@ def coasting_slider_crank(bore=0.0, pins=0.0):
     return m
 
 
+def coasting_four_bar(mu=0.0):
+    """Crank-rocker (crank 0.1 m, coupler 0.35 m, rocker 0.3 m, ground link 0.4 m) in a vertical plane,
+    released at 1 rev/s; pin friction mu (pin radius 0.05 m) in all four pins: it comes to rest with the
+    four pins stuck as one held group (their locks dependent); no friction element where mu = 0."""
+    a4, b4, c4, d4, th = 0.1, 0.35, 0.3, 0.4, 0.3
+    A = a4 * np.array([np.cos(th), np.sin(th), 0.0])
+    O4 = np.array([d4, 0.0, 0.0])
+    dist = np.linalg.norm(O4 - A)
+    ex = (O4 - A) / dist
+    x = (b4**2 - c4**2 + dist**2) / (2 * dist)
+    B = A + x * ex + np.sqrt(b4**2 - x**2) * np.array([-ex[1], ex[0], 0.0])
+    from scipy.spatial.transform import Rotation
+    ang = lambda v: Rotation.from_rotvec([0.0, 0.0, np.arctan2(v[1], v[0])])  # noqa: E731
+    m = mb.Model("four_bar", gravity=(0.0, -9.81, 0.0))
+    crank = m.add_body("crank", 0.5, (1e-4, 4e-4, 4e-4), position=A / 2, orientation=ang(A))
+    coupler = m.add_body("coupler", 1.0, (1e-4, 0.01, 0.01), position=(A + B) / 2, orientation=ang(B - A))
+    rocker = m.add_body("rocker", 0.8, (1e-4, 6e-3, 6e-3), position=(B + O4) / 2, orientation=ang(B - O4))
+    z = (0, 0, 1)
+    joints = [m.add_revolute("O2", m.ground, crank, (0, 0, 0), z, initial_velocity=[2 * np.pi]),
+              m.add_revolute("A", crank, coupler, A, z), m.add_revolute("B", coupler, rocker, B, z),
+              m.add_revolute("O4", m.ground, rocker, O4, z)]
+    for jt in joints if mu else ():
+        m.add_friction("f_" + jt.name, jt, mu, mu, pin_radius=0.05)
+    return m
+
+
 def timed(fn):
     fn()
     ts = []
@@ -271,6 +297,16 @@ CASES = [
      lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", ()),   # different motions
     ("joint friction, bore (coasting slider-crank comes to rest and sticks) vs none",
      lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", ()),
+    ("joint friction, all four pins (coasting four-bar comes to rest, held as one group) vs none",
+     lambda: coasting_four_bar(0.3), coasting_four_bar, "simulate", ()),
+    ("joint friction, bore + two pins, HHT (coasting slider-crank, slipping through dead centres) vs none, HHT",
+     lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", (), "hht"),
+    ("joint friction, bore + two pins, Radau (coasting slider-crank, slipping through dead centres) vs none, "
+     "Radau", lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", (), "radau"),
+    ("joint friction, bore, HHT (coasting slider-crank comes to rest and sticks) vs none, HHT",
+     lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", (), "hht"),
+    ("joint friction, bore, Radau (coasting slider-crank comes to rest and sticks) vs none, Radau",
+     lambda: coasting_slider_crank(0.4), coasting_slider_crank, "simulate", (), "radau"),
     ("helix (expression curve) vs straight spline (bead, point-on-curve)", helix_bead, line_bead,
      "simulate", ()),   # different motions: no coordinate difference
     ("helix as a Python-callable curve (tabulated) vs straight spline (bead, point-on-curve)", helix_py_bead,
@@ -288,10 +324,11 @@ def main(only=None):
              "Written by `python3 bench/vocabulary.py`: median of %d calls after a warm-up, same process." % REPEAT,
              "", "| case | element | baseline | ratio | element's method | max joint-coordinate difference |",
              "|---|---|---|---|---|---|"]
-    for name, make, make_base, analysis, joints in CASES:
+    for name, make, make_base, analysis, joints, *method in CASES:   # (an optional 6th field: the method)
         if only and only not in name:
             continue
-        run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01)) if analysis == "simulate" else \
+        opts = {"method": method[0]} if method else {}
+        run = (lambda m: mb.simulate(m, end_time=2.0, output_step=0.01, **opts)) if analysis == "simulate" else \
             (lambda m: mb.kinematics(m, end_time=2.0, output_step=0.01))
         m, mb_ = make(), make_base()
         te, re = timed(lambda: run(m))

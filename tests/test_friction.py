@@ -236,11 +236,18 @@ def test_other_index1_methods_locate_the_stop(method):
     assert res.joint_coordinate(joint)[-1] == pytest.approx(-v0**2 / (2 * a), rel=1e-6)
 
 
-def test_default_method_with_friction_is_the_event_driven_dop853():
-    """mb.simulate without a method picks dop853 for stick/slip friction; an explicit 'hht' is refused."""
-    model, _ = incline(15, 0.0)
+def test_default_method_with_friction_is_the_event_driven_dop853(monkeypatch):
+    """mb.simulate without a method picks dop853 for stick/slip friction; an explicit 'hht' runs the
+    compiled HHT (its events on the steps' polynomials, issue 29), and where the compiled core is off
+    (the reference HHT has no stick/slip events) it is refused, naming the methods that can."""
+    model, joint = incline(15, 0.0)
     res = mb.simulate(model, 0.5, 0.1)
     assert res.success and res.stats["method"].startswith("auto: DOP853")   # the automatic method falls back to it
+    res = mb.simulate(model, 0.5, 0.1, method="hht")
+    assert res.success and res.stats["method"] == "HHT (compiled)"
+    assert np.max(np.abs(res.joint_coordinate(joint))) < 1e-12   # tan(15 deg) = 0.27 < mu_s = 0.4: held
+    from mbdsim.solvers import dynamic
+    monkeypatch.setattr(dynamic, "USE_COMPILED", False)
     with pytest.raises(mb.ModelError) as err:
         mb.simulate(model, 0.5, 0.1, method="hht")
     assert err.value.field == "method" and "dop853" in str(err.value)

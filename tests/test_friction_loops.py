@@ -190,6 +190,7 @@ def test_coasting_four_bar_with_pin_friction_comes_to_rest_and_stays():
     capacity is the sum of the pins' - the mechanism then stays where it stopped."""
     res = mb.simulate(four_bar("coast", mu=0.3, pin=0.05), 1.5, output_step=0.01, method="dop853", rtol=1e-8)
     assert res.success, res.message
+    assert "(compiled)" in res.stats["method"], res.stats["method"]   # the held group runs compiled (issue 29)
     last = [res.friction_events(n)[-1] for n in ("f_O2", "f_A", "f_B", "f_O4")]
     assert all(m == "stick" for _, m, _ in last)
     t_stop = max(e[0] for e in last)

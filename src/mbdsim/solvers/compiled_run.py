@@ -292,11 +292,11 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     with the compiled DOP853 (raises NotCompiled when the model needs the reference path, and Stiff
     when stiff_check is set and the model is stiff). progress(t) is called with the time reached [s]
     every chunk of outputs; Ctrl-C ends the run with success=False and every output before it."""
-    friction = len(sys.lock_rows) > 0   # joint friction: absolute coordinates, no stiffness hand-over
+    friction = len(sys.lock_rows) > 0   # joint friction: absolute coordinates (stiff: on to Radau, its modes)
     if sys.derived.get("friction not compiled"):   # a held group met by an earlier try (solvers.friction_run)
         raise NotCompiled(sys.derived["friction not compiled"])
-    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check and not friction,
-                      state=(rep.q, rep.v), friction=friction)
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check, state=(rep.q, rep.v),
+                      friction=friction)
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
     times = np.asarray(times, float)

@@ -196,8 +196,9 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
-            if exc.prefix is not None and _default_method(model) == "hht":   # the compiled Radau IIA continues
-                from .radau_run import continue_radau                       # from there, at auto's tolerance
+            if exc.prefix is not None and not getattr(model, "sensors", None):   # the compiled Radau IIA continues
+                from .radau_run import continue_radau   # from there, at auto's tolerance (joint friction too: its
+                #                                         events on Radau's steps, the same modes)
                 res = continue_radau(sys, rep, times, exc, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
                                      reason)
                 res.stats["rtol_reached"] = rt
@@ -263,18 +264,19 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
         if getattr(sys.model, "sensors", None):
             raise ModelError(f"sensor '{next(iter(sys.model.sensors))}'", "method", "sensors are located by "
                              "the index-1 methods (method='auto', 'dop853', 'rk45', 'radau' or 'bdf'), not HHT")
-        if _default_method(sys.model) != "hht":
-            names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
-            raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip is modelled "
-                             "by the event-driven index-1 methods (method='dop853', 'rk45', 'radau' or "
-                             "'bdf'); the HHT method cannot include it")
-        if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run)
+        names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
+        reason = "the compiled core is off (USE_COMPILED)"
+        if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run; joint friction included)
             from .hht import ALPHA
             from .hht_run import integrate_hht_compiled
             try:
                 return integrate_hht_compiled(sys, rep, times, rtol, atol, max_step, ALPHA, progress)
-            except NotCompiled:
-                pass   # sensors, switching elements: the reference HHT locates their events
+            except NotCompiled as exc:
+                reason = str(exc)   # sensors, switching elements: the reference HHT locates their events
+        if names:   # the reference HHT has no stick/slip events
+            raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip runs on the "
+                             f"compiled HHT, which cannot run this model ({reason}); use method='dop853', "
+                             "'rk45', 'radau' or 'bdf'")
         res = integrate_hht(sys, rep, times, rtol, atol, max_step, progress=progress)
         res.stats.setdefault("method", "HHT")
         return res

@@ -19,8 +19,15 @@ solutions are k more solves with it, the iteration works on k x k matrices only 
 `force_elements.friction_kkt`, which is the independent reference).
 
 Switching functions (`switching`, located on the step's dense output by `fastdop`): slip: s xd + V_TOL/2
-(zero when the joint has come to rest); stick: mu_static N - |lambda_f| + STICK_TOL (1 + mu_static N)
-(zero when static friction cannot hold it); 1 otherwise.
+(zero when the joint has come to rest); stick: C - |lambda_f| + STICK_TOL (1 + C) with the static
+capacity C = mu_static N (zero when static friction cannot hold it); 1 otherwise.  A held group (joints
+of a loop stopped together whose lock rows depend on each other, `friction_run`): only the sticking
+element's lock acts, its held members h (mode 0, fw[20][h] = that element) add their capacities in the
+ratio c_h of their joint rates to its (fw[21][h], on the motions the other rows allow):
+C = mu_s N_e + sum_h |c_h| mu_s,h N_h, the closed form of the reference's least-load distribution
+(`force_elements.friction_lcp.group_load`) when each held lock row depends on one sticking lock; the
+tolerance is then n_g STICK_TOL (1 + C) for a group of n_g joints, so that at its zero the reference's
+per-member margins reject sticking (the decision at the event is the reference's).
 
 cm[48] (system.compiled._friction), per element e of k:
   0 lock (k,) int64: its lock row;  1 jrows (k, R) int64: the joint's rows (-1 padding);
@@ -33,7 +40,8 @@ the last accepted step (k,), 3 unit accelerations (k, nf, 6), 4 unit multipliers
 scratch (nf, 6), 6 zeros (nc), 7 S (k, k), 8 right-hand side (k,), 9 f (k,), 10 previous f (k,),
 11 frozen term directions (k, 4, 3), 12 vd (nv), 13 lambda (nc) and 14 v (nf, 6) of the switching
 functions, 15 [failed element + 1, iterations] int64, 16 new switching values (k,), 17 reaction
-scratch (3, 3), 18 switching scratch (k,), 19 combined multipliers (nc).
+scratch (3, 3), 18 switching scratch (k,), 19 combined multipliers (nc), 20 held group (k,) int64 (the
+sticking element whose capacity a held element shares, -1: none), 21 its joint-rate ratio c_h (k,).
 """
 from __future__ import annotations
 
@@ -241,7 +249,13 @@ def switching(fc, fw, Jc, bi, bj, A, lam, v6, g):
         elif mode[e] == 2:
             reaction(fc, e, Jc, bi, bj, A, lam, R)
             cap = fc[4][e, 0] * normal_load(fc, e, A, R, fw[11], False, False)
-            g[e] = cap - abs(lam[lock[e]]) + STICK_TOL * (1.0 + cap)
+            n_g = 1.0
+            for h in range(mode.shape[0]):   # the held members of its group share the capacity
+                if fw[20][h] == e:
+                    reaction(fc, h, Jc, bi, bj, A, lam, R)
+                    cap += abs(fw[21][h]) * fc[4][h, 0] * normal_load(fc, h, A, R, fw[11], False, False)
+                    n_g += 1.0
+            g[e] = cap - abs(lam[lock[e]]) + n_g * STICK_TOL * (1.0 + cap)
         else:
             g[e] = 1.0
 

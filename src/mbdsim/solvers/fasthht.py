@@ -35,7 +35,8 @@ from .._jit import entry, kernel
 from .fastdop import CHECKPOINTS_FULL, _project
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, _to6, increment_into, read_state,
                       rhs, write_state)
-from .fastradau import _lu, _lu_solve, dense
+from .fastradau import _lu, _lu_solve
+from .fastswitch import dense, friction_event, start, stop_at
 
 NEWTON_MAXITER = 8
 STAGNATION = 0.9        # as fastradau: corrections that stop contracting below the tolerance are converged
@@ -280,6 +281,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         for k in range(2, N_ST):
             st[k] = 0.0
         st[8] = 1.0
+        start(cm, wk, t, y, S[9])   # joint friction: the switching values at the (re)start
     eps = 2.220446049250313e-16
     newton_tol = max(10.0 * eps / rtol, min(0.03, np.sqrt(rtol)))
     budget = max(EVALS_PER_RETURN // max(n, 1), 200)
@@ -401,6 +403,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             write_state(cm, wk, yo, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
             iout += 1
             written += 1
+        if cm[48][0].shape[0]:   # a stick/slip event in the step (fastswitch): the state there, to the caller
+            t_ev = friction_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])
+            if t_ev < np.inf:
+                return stop_at(cm, wk, Q, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo)
         for i in range(n):
             yq[i] = y[i]
             y[i] = ynew[i]

@@ -30,6 +30,7 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from .._jit import entry, kernel
 from .fastdop import CHECKPOINTS_FULL, _project
 from .fastdyn import CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, read_state, rhs, write_state
+from .fastswitch import dense, friction_event, start, stop_at  # noqa: F401  (dense: the steps' polynomial, also HHT's)
 
 S6 = 6.0 ** 0.5
 C = np.array([(4.0 - S6) / 10.0, (4.0 + S6) / 10.0, 1.0])
@@ -275,14 +276,6 @@ def _initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     return min(100.0 * h0, h1, max_step)
 
 
-@kernel(_nrt=False)
-def dense(Q, y0, t0, h, t, out):
-    """The collocation polynomial of the step (t0, h) from y0 (coefficients Q, 3 x n) at t into out."""
-    x = (t - t0) / h
-    for i in range(out.shape[0]):
-        out[i] = y0[i] + x * (Q[0, i] + x * (Q[1, i] + x * Q[2, i]))
-
-
 @entry(_nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk, proj_tol, stats,
         Jm, LR, LC, piv, S, cv, SY, ST, SQ, ns, start_row):
@@ -308,6 +301,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             return s_, iout
         h = _initial_step(cm, wk, t, y, f, rtol, atol, max_step, S[17], S[16], S[18])
         st[1] = h
+        start(cm, wk, t, y, S[17])   # joint friction: the switching values at the (re)start
         for k in range(2, N_ST):
             st[k] = 0.0
     eps = 2.220446049250313e-16
@@ -428,6 +422,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             write_state(cm, wk, yo, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
             iout += 1
             written += 1
+        if cm[48][0].shape[0]:   # a stick/slip event in the step: the state there, back to the caller
+            t_ev = friction_event(cm, wk, Q, y, t, h, ynew, S[17], S[18])
+            if t_ev < np.inf:
+                return stop_at(cm, wk, Q, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo)
         for i in range(n):
             yq[i] = y[i]
             y[i] = ynew[i]

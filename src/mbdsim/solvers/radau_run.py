@@ -8,6 +8,9 @@ between outputs is the run's own dense output (projected onto the constraints, a
 multipliers from the compiled kernel), nothing integrated again. For method "radau", models with expression
 sensors or switching force elements (contact onset, stops) stay on the reference path (`NotCompiled`),
 which locates their events; the automatic method's continuation runs them compiled, as its DOP853 part.
+Joint friction with stick/slip runs here (and on HHT): the step loop stops at each switching event,
+located on the step's polynomial (solvers.fastswitch), and `integrate` restarts it there with the modes
+`friction_run.FrictionModes.decide` takes (the decision of every stepper).
 """
 from __future__ import annotations
 
@@ -79,16 +82,26 @@ class RadauRun(CompiledRun):
         cap = 64 if keep else 0
         SY, ST, SQ, ns = np.zeros((cap, n)), np.zeros((cap, 2)), np.zeros((cap, 3, n)), np.zeros(1, np.int64)
         status = 0
+        if self.friction is not None:   # the initial modes (all joints at rest decided together)
+            self.friction.decide(t0, y)
         try:
-            while status in (0, fastdop.CHECKPOINTS_FULL) and iout < nout:
+            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.FRICTION_EVENT) and iout < nout:
+                if status == fastdop.FRICTION_EVENT:   # a stick/slip event at st[0]: decide, restart there
+                    self.friction.decide(st[0], y)     # (the one decision of every stepper: friction_run)
+                    st[1:] = 0.0
+                    if tout[-1] - st[0] <= 1e-14 * max(1.0, abs(st[0])):   # at the end time: its state is the
+                        Y[iout:] = y                                         # last output (absolute coordinates)
+                        iout, status = nout, 0
+                        break
                 if status == fastdop.CHECKPOINTS_FULL:   # grow, or stop keeping them beyond the budget
                     if 2 * (SY.size + SQ.size) * 8 <= CHECKPOINT_BUDGET:
                         SY, ST, SQ = (np.concatenate([x, np.zeros_like(x)]) for x in (SY, ST, SQ))
                     else:
                         keep, SY, ST, SQ = False, SY[:0], ST[:0], SQ[:0]
                 status, iout = self._step_loop(a, w, st, y, f, tout, iout, Y, scratch, SY, ST, SQ, ns, start_row)
-                if st[1] == 0.0:   # the start failed
-                    iout = 0
+                if st[1] == 0.0:   # the start failed (a restart after a friction event keeps the outputs before it)
+                    if st[0] == t0:
+                        iout = 0
                     break
                 notify(progress, st[0], None if partial is None else (lambda n=iout: partial(Y, n)))
         except KeyboardInterrupt:
@@ -144,6 +157,8 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
                                    message="partial (run in progress)")
     Y, n, status, t_fail, y_fail = run.integrate(times[0], y0, times, progress, True, partial, y_start)
     success, message, error = True, "ok", None
+    if status == fastdyn.FRICTION_FAILED:   # name the element whose coupled solve failed
+        run.run_error = run.friction.failure(t_fail, y_fail)
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed", run.run_error)
         success = False
@@ -157,14 +172,26 @@ def integrate_radau(sys, rep, times, rtol, atol, max_step, progress=None):
     """Dynamic analysis with the compiled Radau IIA (method "radau"); NotCompiled when the model needs the
     reference path, has expression sensors (watched by DOP853's step loop only) or force elements with
     switching functions (contacts, stops, friction: scipy's Radau on the reference path cuts its steps at
-    their events, mbdsim.solvers.events)."""
-    from ..system.force_elements import evaluator
+    their events, mbdsim.solvers.events; joint friction runs compiled, its stick/slip events located
+    on the steps' polynomials: solvers.fastswitch)."""
     if getattr(sys.model, "sensors", None):
         raise NotCompiled("expression sensors are watched by the compiled DOP853 only")
-    if any(hasattr(evaluator(e), "switch") for e in sys.model.forces.values()):   # contacts, stops, friction:
-        raise NotCompiled("switching elements: the reference path cuts steps at their events")  # events located
-    run = RadauRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v))
+    _switching_check(sys)
+    run = RadauRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v), friction=len(sys.lock_rows) > 0)
     return _integrate(sys, rep, run, times, progress)
+
+
+def _switching_check(sys):
+    """NotCompiled when force elements other than joint friction have switching functions (contacts,
+    stops: the reference path cuts steps at their events), or a held friction group an earlier try met
+    (solvers.friction_run); joint friction's stick/slip events are located by the compiled implicit
+    steppers themselves (solvers.fastswitch)."""
+    from ..model.friction_path import JointFriction
+    from ..system.force_elements import evaluator
+    if sys.derived.get("friction not compiled"):
+        raise NotCompiled(sys.derived["friction not compiled"])
+    if any(hasattr(evaluator(e), "switch") and not isinstance(e, JointFriction) for e in sys.model.forces.values()):
+        raise NotCompiled("switching elements: the reference path cuts steps at their events")
 
 
 def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):

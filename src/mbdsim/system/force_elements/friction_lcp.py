@@ -18,7 +18,11 @@ decided in one step:
    solved with the coupled KKT system (`friction_kkt`: N follows the reactions) and checked -
    a slipping joint must accelerate in its direction (s xdd >= 0), a sticking set must hold within
    the static capacities.  Assignments are tried with the most joints sticking first, so static
-   friction holds whenever it can (mu_static > mu_dynamic leaves stick and slip both consistent).
+   friction holds whenever it can (mu_static > mu_dynamic leaves stick and slip both consistent);
+   among as many sticks, the slips in the directions of the joints' frictionless accelerations
+   first.  An assignment that makes a joint slip which the stuck ones lock kinematically (its
+   constrained mobility with their lock rows added is ~0: a loop stuck at one joint cannot slip at
+   another) is not a solution and is not tried.
    Sticking joints whose lock rows depend on each other (a 1-DOF loop stopped with friction in every
    pin: one lock stops them all) are "held": only an independent subset of the locks is active, and
    the group's capacity is the sum of its members': the static friction needed is distributed over the
@@ -150,9 +154,12 @@ def decide_all(sys, t, q, v):
         return
     target = {n: float(_coordinate(sys, fr, elems[n])[0]) for n in others}
     groups = [others] if len(others) <= MAX_JOINT else [[n] for n in others]
+    locked = {}
     for group in groups:
         best, best_viol = None, np.inf
-        for combo in assignments(len(group)):
+        for combo in _ordered(sys, q, v, t, base, J, gamma, group):
+            if _locked_slip(sys, Mk, J, base, group, combo, t, locked):
+                continue
             _apply(sys, t, J, base, group, combo, target)
             try:
                 viol = _violation(sys, q, v, t, base, J, gamma, group, combo)
@@ -164,6 +171,32 @@ def decide_all(sys, t, q, v):
             if viol < best_viol:
                 best, best_viol = combo, viol
         _apply(sys, t, J, base, group, best if best is not None else (0.0,) * len(group), target)
+
+
+def _ordered(sys, q, v, t, base, J, gamma, group):
+    """`assignments` of the group, most sticks first as there; among those with as many sticks, the slips
+    in the directions of the joints' accelerations with the group frictionless (the likely solution) first."""
+    vd = _solve(sys, q, v, t, base)[0]
+    natural = [float(np.sign(_joint_acc(J, gamma, vd, _lock(sys, n)))) for n in group]
+    return sorted(assignments(len(group)), key=lambda c: (sum(1 for x in c if x != 0.0),
+                                                         sum(1 for x, s in zip(c, natural) if x != 0.0 and x != s)))
+
+
+def _locked_slip(sys, Mk, J, base, group, combo, t, cache):
+    """Whether a joint that `combo` makes slip is kinematically locked by the stuck ones (its constrained
+    mobility with their lock rows added is ~0): it cannot move, so it is not slipping (Coulomb's slip needs
+    a relative motion); such assignments are not solutions (a loop stuck at one joint is stuck at all)."""
+    stuck = tuple(i for i, x in enumerate(combo) if x == 0.0)
+    if not stuck or len(stuck) == len(combo):
+        return False
+    if stuck not in cache:
+        others = [n for n, st in sys.switched.items() if n not in group and st.at(t) is not None
+                  and st.at(t)[0] in STUCK]
+        rows = np.concatenate([base, [_lock(sys, n) for n in others], [_lock(sys, group[i]) for i in stuck]])
+        Nb = null_basis(J[rows.astype(int)], sys.nv)
+        cache[stuck] = [i for i in range(len(combo)) if i not in stuck
+                        and mobility(Mk, Nb, J[_lock(sys, group[i])]) < RHO_TOL]
+    return bool(cache[stuck])
 
 
 def _apply(sys, t, J, base, group, combo, target):

@@ -1,0 +1,115 @@
+"""Stick/slip events of joint friction in the compiled implicit steppers (issue 29): Radau IIA
+(`fastradau.run`) and HHT-alpha (`fasthht.run`).
+
+Both steppers keep, for each accepted step (t0, h) from y0, a cubic polynomial of the state
+(`dense`: y0 + x (Q0 + x (Q1 + x Q2)), x = (t - t0) / h; Radau's collocation polynomial, HHT's Hermite
+polynomial). The switching functions of the friction elements (`fastfriction.switching`, through
+`fastdop._friction_g`: the coupled solve at the state, modes as decided in wk[50]) are evaluated at the
+end of every accepted step; one that was positive at the last accepted step and is no longer is located
+on that polynomial by the Illinois variant of regula falsi (to fastdop.SENSOR_XTOL, as DOP853's friction
+and sensor events on its own dense output). The stepper then ends the step there and returns
+fastdop.FRICTION_EVENT with the state at the event; the caller (`solvers.radau_run`, `solvers.friction_run`)
+decides the modes (one decision for every stepper: `FrictionModes.decide`) and restarts the stepper at
+the event.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
+from .._jit import kernel
+from .fastdop import FRICTION_EVENT, SENSOR_XTOL, _friction_g, _project
+from .fastdyn import OK
+
+
+@kernel(_nrt=False)
+def dense(Q, y0, t0, h, t, out):
+    """The step's polynomial (t0, h) from y0 (coefficients Q, 3 x n) at t [s] into out."""
+    x = (t - t0) / h
+    for i in range(out.shape[0]):
+        out[i] = y0[i] + x * (Q[0, i] + x * (Q[1, i] + x * Q[2, i]))
+
+
+@kernel(_nrt=False)
+def start(cm, wk, t, y, yo):
+    """The switching values at the stepper's (re)start (t [s], state y) as the last accepted ones
+    (wk[50][2]); yo: scratch (n)."""
+    if cm[48][0].shape[0]:
+        _friction_g(cm, wk, t, y, yo, wk[50][2])
+
+
+@kernel(_nrt=False)
+def _event_time(cm, wk, Q, y0, t0, h, e, yd, yo, g):
+    """The time [s] in (t0, t0 + h] at which element e's switching function changes sign on the step's
+    polynomial (Illinois regula falsi); -inf when the values at the ends do not bracket a change."""
+    a, b = t0, t0 + h
+    dense(Q, y0, t0, h, a, yd)
+    _friction_g(cm, wk, a, yd, yo, g)
+    fa = g[e]
+    dense(Q, y0, t0, h, b, yd)
+    _friction_g(cm, wk, b, yd, yo, g)
+    fb = g[e]
+    if fb == 0.0:
+        return b
+    if fa == 0.0 or (fa > 0.0) == (fb > 0.0):
+        return -np.inf
+    side = 0
+    for _ in range(200):
+        if b - a <= SENSOR_XTOL + 4e-16 * abs(b):
+            break
+        c = b - fb * (b - a) / (fb - fa)
+        if not a < c < b:
+            c = 0.5 * (a + b)
+        dense(Q, y0, t0, h, c, yd)
+        _friction_g(cm, wk, c, yd, yo, g)
+        fc = g[e]
+        if fc == 0.0:
+            return c
+        if (fc > 0.0) == (fb > 0.0):   # c replaces b; a is kept (its value halved when kept twice)
+            b, fb = c, fc
+            if side == -1:
+                fa *= 0.5
+            side = -1
+        else:                          # c replaces a
+            a, fa = c, fc
+            if side == 1:
+                fb *= 0.5
+            side = 1
+    return b   # the side where the switching function has crossed (the decision sees the new sign)
+
+
+@kernel(_nrt=False)
+def friction_event(cm, wk, Q, y0, t0, h, ynew, yd, yo):
+    """After the accepted step (t0, h) from y0 to ynew (polynomial Q): the first time [s] at which a
+    switching function that was positive at the last accepted step reaches zero, or np.inf when none did
+    (the values at ynew then become the last accepted ones). yd, yo: scratch (n)."""
+    fw = wk[50]
+    gp, gn = fw[2], fw[16]
+    if gp.shape[0] == 0:
+        return np.inf
+    _friction_g(cm, wk, t0 + h, ynew, yo, gn)
+    t_ev = np.inf
+    for e in range(gn.shape[0]):
+        if gp[e] > 0.0 and not gn[e] > 0.0:
+            te = _event_time(cm, wk, Q, y0, t0, h, e, yd, yo, fw[18])
+            t_ev = min(t_ev, te if te > t0 else t0 + h)
+    if t_ev == np.inf:
+        for e in range(gn.shape[0]):
+            gp[e] = gn[e]
+    return t_ev
+
+
+@kernel(_nrt=False)
+def stop_at(cm, wk, Q, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo):
+    """End the step (t0, h) from y at the event t_ev [s]: the outputs after it are dropped (the restart
+    writes them again), y becomes the step's polynomial state at t_ev projected onto the constraints
+    (positions and velocities), st[0] = t_ev; (FRICTION_EVENT or the projection's failure, next iout)."""
+    while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
+        iout -= 1
+    dense(Q, y, t0, h, t_ev, yo)
+    s_ = _project(cm, wk, t_ev, yo, proj_tol, bool(True))
+    stats[3] += 1
+    for i in range(y.shape[0]):
+        y[i] = yo[i]
+    st[0], st[1] = t_ev, h
+    return (FRICTION_EVENT if s_ == OK else s_), iout
