@@ -69,7 +69,7 @@ def _kept_sections(path, md):
         if "## " + head in written:
             sub = body[body.find("\n### ") + 1:] if "\n### " in body else ""
             if sub:
-                out += ["", f"### (kept from the previous RESULTS.md: {head.strip()})", "", sub.rstrip()]
+                out += ["", sub.rstrip()]   # (placed after the generated sections)
             continue
         out += ["", "## " + head, body.rstrip()]
     return out
