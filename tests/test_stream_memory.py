@@ -112,7 +112,7 @@ def test_streamed_run_memory_stops_growing_and_loads_only_what_it_needs(tmp_path
         assert heavy not in mods, f"the streamed run imported {heavy}"
     assert "mbdsim.solvers.fastdop.run" in out["loaded"]   # the probe sees loaded kernels
     if out["compiled"] == 0:   # from the cache: the standalone starting-step kernel is not loaded (compiling
-        assert "mbdsim.solvers.fastdop.initial_step" not in out["loaded"]   # run types its callees too)
+        assert "mbdsim.solvers.fastdopstep.initial_step" not in out["loaded"]   # run types its callees too)
     # resident memory after the first quarter of the run vs its end: bounded by one part, not the length
     seen = out["seen"]
     early = max(rss for t, rss in seen if t <= end / 4)

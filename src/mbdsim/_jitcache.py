@@ -36,7 +36,7 @@ from pathlib import Path
 _HERE = Path(__file__).parent
 KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.py", "system/exprloads_kernel.py",
                   "solvers/kkt_tree.py", "solvers/kkt_square.py", "solvers/fastloads.py", "solvers/fastdyn.py",
-                  "solvers/fastdop.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
+                  "solvers/fastdop.py", "solvers/fastdopstep.py", "solvers/fasttree.py", "solvers/minnorm.py", "solvers/fastkin.py",
                   "solvers/pycall.py", "cosim/_stepper.py", "solvers/fastnarrow.py", "solvers/fastcontact.py",
                   "solvers/treecoord.py", "solvers/fastradau.py", "solvers/fastbroad.py", "solvers/fastgjk.py",
                   "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py", "_slots.py",

@@ -12,7 +12,8 @@ geometrically on rejection down to the round-off limit, TINY_STEP; projections t
 steps, PROJECTION). The Butcher tableau is scipy's
 (`scipy.integrate._ivp.dop853_coefficients`); the control follows scipy's `DOP853`: error norm
 |h| |e5|^2 / sqrt(n (|e5|^2 + 0.01 |e3|^2)) with scale atol + rtol max(|y_old|, |y_new|), safety 0.9,
-factor limits 0.2..10, exponent -1/8.
+factor limits 0.2..10, exponent -1/8. The step's pieces (starting step, stages, dense output, projection,
+the watched sensors and friction switching functions) are in `fastdopstep`, re-exported here.
 """
 from __future__ import annotations
 
@@ -23,19 +24,16 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
-from ..system.exprloads_kernel import sensor_values
-from ..system.kernels import frames_into
-from . import fastfriction, fasttree
-from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, _to6, accelerations, joint_rows,
-                      normalize_into, project, read_state, rhs, tree_project, write_state)
+from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _friction_g, _project,  # noqa: F401
+                          _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, initial_step)
+from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows,
+                      project, read_state, rhs, tree_project, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
 EVENTS_FULL = 10       # run status: the sensor event buffer is full (hand the events over and call again)
-SENSOR_XTOL = 1e-13    # [s]: sensor times are located on the dense output to this
 FRICTION_EVENT = 13    # run status: a joint-friction switching function crossed zero; y is the state at st[0]
 
-N_STAGES = _c.N_STAGES
 # Hairer's stiffness test flags h |df|/|dy| above this; dop853.f uses 6.1, but stability-limited steps of an
 # overdamped 1e9 N/m spring hovered at 5.7 and were never flagged (0.74 s against HHT's 0.08 s): 5.0 is
 # ~0.8 of DOP853's real-axis stability bound, above what accuracy-limited steps give
@@ -50,46 +48,7 @@ COEFFS = (np.ascontiguousarray(_c.A), np.ascontiguousarray(_c.B), np.ascontiguou
           np.ascontiguousarray(_c.E3), np.ascontiguousarray(_c.E5), np.ascontiguousarray(_c.D))
 
 
-@kernel(_nrt=False)
-def _rms(x, scale):
-    s = 0.0
-    for i in range(x.shape[0]):
-        s += (x[i] / scale[i]) ** 2
-    return np.sqrt(s / x.shape[0])
 
-
-@kernel(_nrt=False, inline="always")
-def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
-    """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator;
-    work, scale, y1: scratch vectors of the state's size."""
-    n = y0.shape[0]
-    for i in range(n):
-        scale[i] = atol + abs(y0[i]) * rtol
-    d0, d1 = _rms(y0, scale), _rms(f0, scale)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, max_step)
-    for i in range(n):
-        y1[i] = y0[i] + h0 * f0[i]
-    if rhs(cm, wk, t0 + h0, y1, work, bool(True)) != OK:
-        return h0
-    for i in range(n):
-        work[i] = work[i] - f0[i]
-    d2 = _rms(work, scale) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
-    return min(100.0 * h0, h1, max_step)
-
-
-@kernel(_nrt=False, inline="always")
-def _project(cm, wk, t, y, tol, exact_factor=True):
-    """`fastdyn.project` of the state y = [q, v], or on the joint-coordinate tree the projection onto its
-    coordinate constraints (solvers.treecoord; nothing to do without them); status."""
-    if cm[31][5] == 1:
-        return tree_project(cm, wk, t, y, tol)[0]
-    nq = cm[31][0]
-    return project(cm, wk, t, y[:nq], y[nq:], tol, exact_factor)
 
 
 @entry(_nrt=False)
@@ -106,220 +65,13 @@ def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     return times.shape[0]
 
 
-@kernel(_nrt=False)
-def _dense(F, y_old, t_old, h, t, out):
-    x = (t - t_old) / h
-    for i in range(out.shape[0]):
-        out[i] = 0.0
-    nF = F.shape[0]
-    for a in range(nF):
-        f = F[nF - 1 - a]
-        for i in range(out.shape[0]):
-            out[i] += f[i]
-            out[i] *= x if a % 2 == 0 else (1.0 - x)
-    for i in range(out.shape[0]):
-        out[i] += y_old[i]
 
 
-@kernel(_nrt=False, inline="always")
-def _sensor_g(cm, wk, t, y, yo, g):
-    """Each expression sensor's signal minus its threshold at the integrator's state y at t [s] into g
-    (frames computed here from y: the tree's forward kinematics, or the absolute coordinates with the
-    Euler parameters normalised in the copy yo)."""
-    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
-    for i in range(y.shape[0]):
-        yo[i] = y[i]
-    if cm[31][5] == 1:
-        tw = wk[43]
-        fasttree.kinematics(cm[42], yo, yo.shape[0] // 2, r, A, rd, w, tw[10], tw[11])
-    else:
-        nq = cm[31][0]
-        normalize_into(cm, yo[:nq])
-        frames_into(yo[:nq], yo[nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
-    sensor_values(cm[43], wk[44], t, yo, r, A, rd, w, g)
 
 
-@kernel(_nrt=False)
-def _friction_g(cm, wk, t, y, yo, g):
-    """Each joint-friction element's switching function (solvers.fastfriction.switching) at the
-    integrator's state y at t [s] into g, from the coupled solve there (Euler parameters normalised in
-    the copy yo); status of that solve."""
-    fw = wk[50]
-    nq = cm[31][0]
-    for i in range(y.shape[0]):
-        yo[i] = y[i]
-    normalize_into(cm, yo[:nq])
-    s_ = accelerations(cm, wk, t, yo[:nq], yo[nq:], yo[:nq], fw[12], fw[13], bool(True))
-    _to6(cm, yo[nq:], fw[14])
-    fastfriction.switching(cm[48], fw, wk[5], cm[12], cm[13], wk[1], fw[13], fw[14], g)
-    return s_
 
 
-@kernel(_nrt=False)
-def _signal(cm, wk, t, y, yo, g, which):
-    """The watched signals at state y and t [s] into g: the sensors (which = 0, `_sensor_g`) or the
-    joint-friction switching functions (1, `_friction_g`)."""
-    if which == 0:
-        _sensor_g(cm, wk, t, y, yo, g)
-    else:
-        _friction_g(cm, wk, t, y, yo, g)
 
-
-@kernel(_nrt=False, inline="always")
-def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which):
-    """The time [s] in (t0, t0 + h] at which signal k (`_signal` `which`: a sensor's value, a friction
-    element's switching function) changes sign on the dense output (F, y0) of the step from t0, by the
-    Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the step's ends do not
-    bracket a sign change (the crossing is then not an event, as a failed bracket of the reference
-    path's brentq)."""
-    a, b = t0, t0 + h
-    _dense(F, y0, t0, h, a, yd)
-    _signal(cm, wk, a, yd, yo, g, which)
-    fa = g[k]
-    _dense(F, y0, t0, h, b, yd)
-    _signal(cm, wk, b, yd, yo, g, which)
-    fb = g[k]
-    if fb == 0.0:
-        return b
-    if fa == 0.0 or (fa > 0.0) == (fb > 0.0):
-        return -np.inf
-    side = 0
-    for _ in range(200):
-        if b - a <= SENSOR_XTOL + 4e-16 * abs(b):
-            break
-        c = b - fb * (b - a) / (fb - fa)
-        if not a < c < b:
-            c = 0.5 * (a + b)
-        _dense(F, y0, t0, h, c, yd)
-        _signal(cm, wk, c, yd, yo, g, which)
-        fc = g[k]
-        if fc == 0.0:
-            return c
-        if (fc > 0.0) == (fb > 0.0):   # c replaces b; a is kept (its value halved when kept twice)
-            b, fb = c, fc
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:                          # c replaces a
-            a, fa = c, fc
-            if side == 1:
-                fb *= 0.5
-            side = 1
-    return 0.5 * (a + b)
-
-
-@kernel(_nrt=False, inline="always")
-def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
-    """Sensors after the accepted step (t, h) from y to ynew: each sign change of a sensor's value since the
-    last accepted step is located on the step's dense output (F, computed here unless have_F); a crossing
-    in the sensor's direction is an event, appended (time [s], sensor) to the event buffer unless it comes
-    after the step's first "stop" event. The values at ynew become the last accepted ones (the sign after
-    the event where a value is exactly zero). Returns (the time [s] of the first "stop" event, np.inf if
-    none; whether F holds the step's dense output)."""
-    ex, ew = cm[43], wk[44]
-    g_prev, g_new, EVT, nev, g_tmp = ew[2], ew[3], ew[4], ew[5], ew[6]
-    n_s = g_new.shape[0]
-    _sensor_g(cm, wk, t + h, ynew, scale, g_new)
-    t_stop = np.inf
-    n0 = nev[0]
-    for k in range(n_s):
-        gp, gn = g_prev[k], g_new[k]
-        if gp == 0.0 or (gn != 0.0 and (gn > 0.0) == (gp > 0.0)):
-            continue
-        if not have_F:
-            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
-            have_F = True
-        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0)
-        rising = gn > gp
-        if tk <= t or (ex[19][k] != 0 and (ex[19][k] > 0) != rising):
-            continue
-        EVT[nev[0], 0] = tk
-        EVT[nev[0], 1] = k
-        nev[0] += 1
-        if ex[20][k] == 1:
-            t_stop = min(t_stop, tk)
-    if t_stop < np.inf:   # events after the stop did not happen
-        m = n0
-        for e in range(n0, nev[0]):
-            if EVT[e, 0] <= t_stop + 1e-12 * max(1.0, abs(t_stop)):
-                EVT[m, 0], EVT[m, 1] = EVT[e, 0], EVT[e, 1]
-                m += 1
-        nev[0] = m
-    for k in range(n_s):
-        if g_new[k] != 0.0:
-            g_prev[k] = g_new[k]
-        elif g_prev[k] != 0.0:   # exactly at the threshold: the sign after the crossing
-            g_prev[k] = -g_prev[k]
-    return t_stop, have_F
-
-
-@kernel(_nrt=False)
-def _watch_friction(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
-    """Joint friction after the accepted step (t, h) from y to ynew: the first time a switching function
-    that was positive at the last accepted step reaches zero, located on the step's dense output (F,
-    computed here unless have_F), or np.inf when none did (the values at ynew then become the last
-    accepted ones); and whether F holds the step's dense output."""
-    fw = wk[50]
-    gp, gn = fw[2], fw[16]
-    _friction_g(cm, wk, t + h, ynew, scale, gn)
-    t_ev = np.inf
-    for e in range(gn.shape[0]):
-        if gp[e] > 0.0 and not gn[e] > 0.0:
-            if not have_F:
-                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
-                have_F = True
-            te = _sensor_time(cm, wk, F, y, t, h, e, ys, scale, fw[18], 1)
-            t_ev = min(t_ev, te if te > t else t + h)
-    if t_ev == np.inf:
-        for e in range(gn.shape[0]):
-            gp[e] = gn[e]
-    return t_ev, have_F
-
-
-@kernel(_nrt=False, inline="always")
-def _stages(cm, wk, co, t, h, y, K, ys, ynew):
-    """The 12 stages of a DOP853 step from y (K[0] = f(t, y) given), ynew and K[12] = f(t + h, ynew);
-    False when an evaluation failed."""
-    A, B, C = co[0], co[1], co[2]
-    n = y.shape[0]
-    for s in range(1, N_STAGES):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, i]
-            ys[i] = y[i] + h * acc
-        if rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True)) != OK:
-            return False
-    for i in range(n):
-        acc = 0.0
-        for j in range(N_STAGES):
-            acc += B[j] * K[j, i]
-        ynew[i] = y[i] + h * acc
-    return rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
-
-
-@kernel(_nrt=False, inline="always")
-def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
-    """The 7th-order dense output coefficients F (7, n) of an accepted step (3 more evaluations)."""
-    A, C, D = co[0], co[2], co[5]
-    n = y.shape[0]
-    for s in range(N_STAGES + 1, 16):
-        for i in range(n):
-            acc = 0.0
-            for j in range(s):
-                acc += A[s, j] * K[j, i]
-            ys[i] = y[i] + h * acc
-        rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True))
-    for i in range(n):
-        dy = ynew[i] - y[i]
-        F[0, i] = dy
-        F[1, i] = h * K[0, i] - dy
-        F[2, i] = 2.0 * dy - h * (K[N_STAGES, i] + K[0, i])
-        for r in range(4):
-            acc = 0.0
-            for j in range(16):
-                acc += D[r, j] * K[j, i]
-            F[3 + r, i] = h * acc
 
 
 @entry(_nrt=False)
