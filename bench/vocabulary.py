@@ -145,6 +145,38 @@ def geared_four_bar(geared):
     return m
 
 
+def planetary(geared):
+    """Planetary gear set with a fixed ring (sun r_s 0.03, planet r_p 0.015, ring 0.06 m): the sun on a revolute
+    and a coaxial cylindrical joint (a closed loop: absolute coordinates), the carrier on a revolute, the
+    planet pinned on it; the sun mesh r_s (theta_s - theta_c) + r_p phi = 0 moves three bodies (sun, carrier,
+    planet), the ring mesh r_p phi + r_r theta_c = 0 two. Torque 0.02 N m on the sun, a torsion spring
+    (2 N m/rad) on the carrier. Baseline: the carrier alone (on a revolute and a cylindrical joint) with the
+    reflected inertia n^2 J_s + J_c + m_p a^2 + J_p (1 - r_r / r_p)^2, n = 1 + r_r / r_s, and torque n T_s."""
+    rs, rp = 0.03, 0.015
+    rr, a = rs + 2 * rp, rs + rp
+    Js, Jc, Jp, mp, Ts = 2e-4, 5e-4, 3e-5, 0.2, 0.02
+    n = 1 + rr / rs
+    z = (0, 0, 1)
+    m = mb.Model("planetary", gravity=(0.0, 0.0, 0.0))
+    J = Jc if geared else n * n * Js + Jc + mp * a * a + Jp * (1 - rr / rp) ** 2
+    m.add_body("carrier", 0.5, inertia=(J, J, J), position=(0.0, 0.0, 0.01))
+    m.add_revolute("Rc", m.ground, "carrier", (0, 0, 0.01), z)
+    m.add_torsion_spring("spring", "Rc", 2.0)
+    if not geared:
+        m.add_cylindrical("Cc", m.ground, "carrier", (0, 0, 0.01), z)
+        m.add_torque("T", "carrier", (0.0, 0.0, n * Ts))
+        return m
+    m.add_body("sun", 0.3, inertia=(Js, Js, Js), position=(0.0, 0.0, 0.0))
+    m.add_body("planet", mp, inertia=(Jp, Jp, Jp), position=(a, 0.0, 0.0))
+    m.add_revolute("Rs", m.ground, "sun", (0, 0, 0), z)
+    m.add_cylindrical("Cs", m.ground, "sun", (0, 0, 0), z)
+    m.add_revolute("Rp", "carrier", "planet", (a, 0, 0), z)
+    m.add_user_constraint("sun_mesh", f"{rs}*(Rs - Rc) + {rp}*Rp")
+    m.add_user_constraint("ring_mesh", f"{rp}*Rp + {rr}*Rc")
+    m.add_torque("T", "sun", (0.0, 0.0, Ts))
+    return m
+
+
 def bead(curve, s0, velocity):
     """A 0.2 kg bead on a fixed curve, gravity -z (2 s: a helix in s runs to s = -15 rad, a line 17 m)."""
     m = mb.Model("bead", gravity=(0.0, 0.0, -9.81))
@@ -235,6 +267,8 @@ CASES = [
      lambda: gear_train(False), "simulate", ("p3",)),
     ("four-bar crank geared to a flywheel (closed loop) vs the four-bar with its reflected inertia",
      lambda: geared_four_bar(True), lambda: geared_four_bar(False), "simulate", ("O", "C")),
+    ("planetary gear set, sun mesh moving three bodies (closed loop) vs the carrier with its reflected inertia",
+     lambda: planetary(True), lambda: planetary(False), "simulate", ("Rc",)),
     ("joint friction, bore + two pins (coasting slider-crank, slipping through dead centres) vs none",
      lambda: coasting_slider_crank(0.02, 0.02), coasting_slider_crank, "simulate", ()),   # different motions
     ("joint friction, bore (coasting slider-crank comes to rest and sticks) vs none",

@@ -136,6 +136,21 @@ def residuals(cm, wk, times, Y, idx, rows, val, arg):
 
 @kernel(_nrt=False)
 def _factor(cm, wk):
+    """`_factor_rows`, then the wide coupler rows bordered on it (solvers.loopcoord: the solve of each one's
+    load with the other rows and their Schur complement). False if singular."""
+    if not _factor_rows(cm, wk):
+        return False
+    lc, lw = cm[50], wk[52]
+    if lc[17].shape[0] == 0:
+        return True
+    for a in range(lc[17].shape[0]):
+        loopcoord.wide_unit_load(lc, lw, a)
+        _solve_rows(cm, wk, lw[13], lw[14], lw[7][a], lw[8][a])
+    return loopcoord.wide_schur(lc, lw)
+
+
+@kernel(_nrt=False)
+def _factor_rows(cm, wk):
     """Factor the augmented matrix at the rows in wk: dense LU (dims[4] = 1, singular body masses), the
     square Jacobian's LU (dims[4] = 2, zero-DOF models, `kkt_square`; the tree instead where it declines)
     or the tree elimination of `kkt_tree` over the loop rows in use (wk[46]), re-selected (`_reselect`)
@@ -205,6 +220,16 @@ def _reselect(cm, wk):
 
 @kernel(_nrt=False)
 def _solve(cm, wk, F, c_rows, x6, lam):
+    """Accelerations x6 (six slots per frame) and multipliers lam (at the rows solved for) of loads F (nf, 6)
+    and row right-hand sides c_rows (nc,) with the factorisation of `_factor`: `_solve_rows`, then the
+    wide coupler rows' bordered correction (solvers.loopcoord.wide_correct)."""
+    _solve_rows(cm, wk, F, c_rows, x6, lam)
+    if cm[50][17].shape[0]:
+        loopcoord.wide_correct(cm[50], wk[52], c_rows, x6, lam)
+
+
+@kernel(_nrt=False)
+def _solve_rows(cm, wk, F, c_rows, x6, lam):
     if cm[31][4] == 1:
         dense_solve(cm[32], wk[32], wk[33], F, c_rows, x6, lam, wk[39])
         return
@@ -530,6 +555,11 @@ def newton_positions(cm, wk, t, q, v, tol):
             if not np.isfinite(r):
                 return NONFINITE, size, nfactor
             res = max(res, r)
+        if cm[50][17].shape[0]:   # wide coupler rows (bordered on the others)
+            r = loopcoord.wide_residual(cm[50], wk[4])
+            if not np.isfinite(r):
+                return NONFINITE, size, nfactor
+            res = max(res, r)
         if res <= tol:
             if cm[50][0].shape[0]:   # loop couplers: psi <- the continued angles at the converged q
                 loopcoord.sync_q(cm[50], wk[52], q)
@@ -587,6 +617,8 @@ def project_velocities(cm, wk, v, refactor=True):
     for i in range(active.shape[0] + sel.shape[0]):   # the rows solved for (loop rows re-selected)
         row = active[i] if i < active.shape[0] else sel[i - active.shape[0]]
         c[row] = nu[row] - _row_dot(Jc, bi, bj, row, v6)
+    if cm[50][17].shape[0]:   # wide coupler rows
+        loopcoord.wide_velocity_rhs(cm[50], wk[52], nu, v6, c)
     _solve(cm, wk, zero6, c, x6, lam)
     vadr, rigid = cm[5], cm[6]
     for f in range(1, x6.shape[0]):
