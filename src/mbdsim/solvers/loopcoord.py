@@ -19,7 +19,7 @@ A row whose terms move at most two bodies besides ground is written into the com
 blocks) and solved as a loop row of the tree elimination (or a row of the dense or square LU). A *wide* row
 (lc[17]: three or more bodies, a differential or a planetary mesh through its carrier) has G_a = sum_k f_k
 J_Xk on as many bodies as its terms move; it stays out of the rows factored and enters the solve bordered
-(`fastdyn._factor`, `fastdyn._solve`): with E_a, EL_a the solve of the load G_a^T with the other rows
+(`fastsolve._factor`, `fastsolve._solve`): with E_a, EL_a the solve of the load G_a^T with the other rows
 (accelerations, their multipliers; zero row right-hand sides) and P = G E (symmetric positive
 semi-definite, factored by pivoted Cholesky: dependent wide rows get zero multipliers, as loop rows),
 a solve for loads F and right-hand sides c is the solve x0, lambda0 with the other rows, then
