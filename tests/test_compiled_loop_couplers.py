@@ -155,15 +155,3 @@ def test_driven_shaft_geared_in_a_loop_kinematics_runs_compiled_through_turns():
     assert "compiled" in res.stats["method"]
     assert np.max(np.abs(res.joint_coordinate("R2") + 6.0 * res.time)) < 1e-9   # 18 rad: several turns
 
-
-def test_coupler_moving_three_bodies_in_a_loop_names_why_it_keeps_the_reference_path():
-    model = _shafts_in_a_loop()
-    s3 = model.add_body("s3", 1.0, inertia=(0.01, 0.01, 0.01), position=(0.4, 0.0, 0.0))
-    model.add_revolute("R3", model.ground, s3, (0.4, 0, 0), (0, 0, 1))
-    model.add_user_constraint("u", "R1 + R2 + R3")
-    model.joints["R1"].initial_velocity = np.array([1.0])
-    res = _quiet(mb.simulate, model, 0.05, output_step=0.01)
-    assert res.success, res.message
-    assert "moves 3 bodies" in res.stats["method"] and "'u'" in res.stats["method"]
-    X = res.joint_coordinate("R1") + res.joint_coordinate("R2") + res.joint_coordinate("R3")
-    assert np.max(np.abs(X)) < 1e-8

@@ -40,7 +40,7 @@ KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.p
                   "solvers/pycall.py", "cosim/_stepper.py", "solvers/fastnarrow.py", "solvers/fastcontact.py",
                   "solvers/treecoord.py", "solvers/fastradau.py", "solvers/fastbroad.py", "solvers/fastgjk.py",
                   "solvers/fastmesh.py", "solvers/fasthht.py", "solvers/fastedges.py", "_slots.py",
-                  "solvers/loopcoord.py", "solvers/pathcoord.py",
+                  "solvers/loopcoord.py", "solvers/pathcoord.py", "solvers/fastsolve.py",
                   "solvers/fastfriction.py", "solvers/fastridge.py", "solvers/fastmeshpair.py",
                   "solvers/fastswitch.py")
 

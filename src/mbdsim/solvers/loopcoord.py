@@ -15,8 +15,23 @@ X = psi + wrap(theta - psi): psi is integrated along (psi' = theta', psi'' = the
 branch; the link rows wrap(theta - psi) = 0 of the reference path (system.constraints.coupler) are not
 solved for (their multipliers f_k lambda are written for the record).
 
+A row whose terms move at most two bodies besides ground is written into the compact Jacobian Jc (two
+blocks) and solved as a loop row of the tree elimination (or a row of the dense or square LU). A *wide* row
+(lc[17]: three or more bodies, a differential or a planetary mesh through its carrier) has G_a = sum_k f_k
+J_Xk on as many bodies as its terms move; it stays out of the rows factored and enters the solve bordered
+(`fastsolve._factor`, `fastsolve._solve`): with E_a, EL_a the solve of the load G_a^T with the other rows
+(accelerations, their multipliers; zero row right-hand sides) and P = G E (symmetric positive
+semi-definite, factored by pivoted Cholesky: dependent wide rows get zero multipliers, as loop rows),
+a solve for loads F and right-hand sides c is the solve x0, lambda0 with the other rows, then
+
+    mu = P^-1 (G x0 - c_w),   x = x0 - E mu,   lambda = lambda0 - EL mu,   lambda_w = mu
+
+so that M x + J^T lambda + G^T mu = F, J x = c, G x = c_w (`wide_unit_load`, `wide_schur`,
+`wide_correct`): the cost of one more loop row per wide row.
+
 lc = cm[50] (layout in system.loopcoords), lw = wk[52]: x, stack, X (nt), X' (nt), the terms' Jacobian
-blocks Jt (nt, 2, 6) on their own frames (velocity-variable axes, as rows_kernel's Jc), quad (nt), f_k (nt).
+blocks Jt (nt, 2, 6) on their own frames (velocity-variable axes, as rows_kernel's Jc), quad (nt), f_k (nt),
+then the wide rows' E, EL, P, its factor, pivots, right-hand side, a load, zero right-hand sides.
 """
 from __future__ import annotations
 
@@ -26,6 +41,7 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from .._jit import kernel
 from ..system.exprvm import eval_program
 from ..system.kernels import _angle_row, _dot2_row, _put, row_rate
+from .kkt_tree import chol_solve, pivoted_chol
 
 
 @kernel(_nrt=False)
@@ -138,3 +154,96 @@ def sync_v(lc, lw, v6, v):
     for j in range(lc[8].shape[0]):
         if lc[8][j] == 0:
             v[lc[13][j]] = _term_dot(lc, lw, j, v6)
+
+
+@kernel(_nrt=False)
+def wide_dot(lc, lw, a, x6):
+    """G_a . x6 of wide row a (x6: six slots per frame) from the terms' blocks of the last `coord_rows`."""
+    i = lc[17][a]
+    s = 0.0
+    for j in range(lc[1][i], lc[1][i + 1]):
+        s += lw[6][j] * _term_dot(lc, lw, j, x6)
+    return s
+
+
+@kernel(_nrt=False)
+def wide_unit_load(lc, lw, a):
+    """The load G_a^T of wide row a into lw[13] (zeroed first), lw[14] and EL_a zeroed: the right-hand
+    sides of its unit solve (the caller solves into E_a, EL_a)."""
+    F, zc, EL = lw[13], lw[14], lw[8]
+    for f in range(F.shape[0]):
+        for k in range(6):
+            F[f, k] = 0.0
+    for r in range(zc.shape[0]):
+        zc[r] = 0.0
+        EL[a, r] = 0.0
+    i = lc[17][a]
+    for j in range(lc[1][i], lc[1][i + 1]):
+        fk = lw[6][j]
+        for side in range(2):
+            fr = lc[9][j] if side == 0 else lc[10][j]
+            if fr != 0:
+                for k in range(6):
+                    F[fr, k] += fk * lw[4][j, side, k]
+
+
+@kernel(_nrt=False)
+def wide_schur(lc, lw):
+    """P = G E (symmetrised) of the wide rows and its pivoted Cholesky factor (rank and order in lw[11]);
+    True unless a pivot is not finite."""
+    E, P, nw = lw[7], lw[9], lc[17].shape[0]
+    for a in range(nw):
+        for b in range(nw):
+            P[a, b] = wide_dot(lc, lw, a, E[b])
+    for a in range(nw):
+        for b in range(a):
+            s = 0.5 * (P[a, b] + P[b, a])
+            P[a, b] = s
+            P[b, a] = s
+        if not np.isfinite(P[a, a]):
+            return False
+    pivoted_chol(P, nw, lw[10], lw[11])
+    return True
+
+
+@kernel(_nrt=False)
+def wide_correct(lc, lw, c_rows, x6, lam):
+    """The bordered correction of a solve x6, lam with the other rows (module docstring): the wide rows'
+    multipliers mu = P^-1 (G x6 - c_w) (zero beyond the rank), x6 -= E mu, lam -= EL mu, lam_w = mu."""
+    perm, b, E, EL = lw[11], lw[12], lw[7], lw[8]
+    nw = lc[17].shape[0]
+    rank = perm[0]
+    for a in range(nw):
+        w = perm[1 + a]
+        b[0, a] = wide_dot(lc, lw, w, x6) - c_rows[lc[0][lc[17][w]]] if a < rank else 0.0
+    chol_solve(lw[10], 0, rank, b, 0)
+    for a in range(nw):
+        w = perm[1 + a]
+        mu = b[0, a]
+        lam[lc[0][lc[17][w]]] = mu
+        if mu == 0.0:
+            continue
+        for f in range(x6.shape[0]):
+            for k in range(6):
+                x6[f, k] -= E[w, f, k] * mu
+        for r in range(lam.shape[0]):
+            lam[r] -= EL[w, r] * mu
+
+
+@kernel(_nrt=False)
+def wide_residual(lc, phi):
+    """Largest |phi| [m or rad] of the wide rows (NaN wins)."""
+    res = 0.0
+    for a in range(lc[17].shape[0]):
+        r = abs(phi[lc[0][lc[17][a]]])
+        if not r <= res:
+            res = r
+    return res
+
+
+@kernel(_nrt=False)
+def wide_velocity_rhs(lc, lw, nu, v6, c):
+    """c_w = nu - G v6 of the wide rows (the velocity projection's right-hand sides)."""
+    for a in range(lc[17].shape[0]):
+        row = lc[0][lc[17][a]]
+        c[row] = nu[row] - wide_dot(lc, lw, a, v6)

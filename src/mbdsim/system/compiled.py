@@ -177,7 +177,7 @@ class Work:
              _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
              _friction_work(cm.friction or _friction(None), nf, nc, nv),   # 50: joint friction (solvers.fastfriction)
              pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
-             loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack))   # 52: solvers.loopcoord
+             loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack, nf, nc))   # 52: solvers.loopcoord
         work = cls(a)
         work.__dict__["model"] = cm   # (for the slot types, `arrays`)
         return work
@@ -436,8 +436,9 @@ def _compile_system(sys, rows, state, friction=False, tol=None) -> CompiledModel
     kind, bi, bj, V, par, drv, fns = packed
     kind, bi, bj, drv = kind.copy(), bi.copy(), bj.copy(), drv.copy()
     lc, lstack = (loopcoords.empty(), 4) if tree_coords else loopcoords.pack(sys, bi, bj)
-    if len(lc[0]):   # couplers in absolute coordinates (issue 29): the link rows are not solved for
-        rows = rows[~np.isin(rows, loopcoords.link_rows(sys))]
+    if len(lc[0]):   # couplers in absolute coordinates (issue 29): the link rows are not solved for, the
+        lc = loopcoords.only_wide(lc, rows)   # wide rows (3+ bodies) bordered on the others (solvers.loopcoord)
+        rows = rows[~np.isin(rows, np.concatenate([loopcoords.link_rows(sys), loopcoords.wide_rows(lc)]))]
     pc, pstack = pathcoords.pack(sys, *(tol or ())) if paths else (pathcoords.empty(), 4)
     if paths:        # point-on-curve: the tangential rows are residuals only
         rows = rows[~np.isin(rows, pathcoords.tangent_rows(sys))]
@@ -460,19 +461,20 @@ def _compile_system(sys, rows, state, friction=False, tol=None) -> CompiledModel
                          sys.mass.astype(float), sys.inertia_B.astype(float), kind, bi, bj,
                          V, par, drv, code, consts, tables, start, end, *loads,
                          topo, np.array([sys.nq, sys.nv, sys.nc, nf, dense, mode], np.int64),
-                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo), pyl, pyd,
+                         np.sort(rows), stack, bushings, tree, ex, ex_stack, _contacts(sys), _candidates(sys, topo, loopcoords.wide_rows(lc)), pyl, pyd,
                          tuple(input_slots), dslots, _shape_contacts(sys, pyl), coords, cstack, lc, lstack, pc, pstack,
                          _friction(sys if len(sys.lock_rows) else None))
 
 
-def _candidates(sys, topo) -> np.ndarray:
+def _candidates(sys, topo, wide=()) -> np.ndarray:
     """All loop rows of the spanning tree (`topology._full_topology`) when `topo`, the topology of the
     selected rows, has the same tree rows (the tree-first selection of system.rows.independent_rows),
-    else the selected loop rows only (no re-selection)."""
+    else the selected loop rows only (no re-selection); never the wide coupler rows `wide` (bordered)."""
     from .topology import _full_topology
     full = _full_topology(sys)
     if full is None or not np.array_equal(np.sort(full.blk_rows), np.sort(topo.blk_rows)):
         return np.asarray(topo.loop_rows, dtype=np.int64).copy()
     loop = np.asarray(full.loop_rows, dtype=np.int64)
-    skip = np.concatenate([loopcoords.link_rows(sys), pathcoords.tangent_rows(sys)])   # never solved for
+    skip = np.concatenate([loopcoords.link_rows(sys), pathcoords.tangent_rows(sys),   # never solved for
+                           np.asarray(wide, dtype=np.int64)])
     return loop[~np.isin(loop, skip)].copy()
