@@ -12,26 +12,10 @@ import pytest
 
 import mbdsim
 from mbdsim import _jitcache, _kernelpack
+from test_kernel_cache import CHILD as KERNEL_CACHE_CHILD
 
-CHILD = """
-from numba.core import event
-count = [0]
-class Count(event.Listener):
-    def on_start(self, ev):
-        count[0] += ev.data["dispatcher"].py_func.__module__.startswith("mbdsim.")
-    def on_end(self, ev):
-        pass
-event.register("numba:compile", Count())
-import mbdsim as mb
-from mbdsim import _jitcache
-model = mb.Model("pendulum", gravity=(0.0, -9.81, 0.0))
-rod = model.add_body("rod", mass=2.0, inertia=(2.0 / 12, 0.0, 2.0 / 12), position=(0.5, 0, 0))
-pin = model.add_revolute("pin", model.ground, rod, point=(0, 0, 0), axis=(0, 0, 1))
-res = mb.simulate(model, end_time=2.0, output_step=0.01)
-assert res.success and "DOP853 (compiled)" in res.stats["method"], res.stats
-print(_jitcache.UNPACKED)
-print(count[0])
-"""
+# the README pendulum in a child process (test_kernel_cache's), then whether it unpacked the archive
+CHILD = KERNEL_CACHE_CHILD + "from mbdsim import _jitcache\nprint(_jitcache.UNPACKED)\n"
 
 
 def _archive() -> Path:
@@ -65,7 +49,7 @@ def test_empty_cache_runs_the_readme_pendulum_without_compiling(tmp_path):
                MBDSIM_QUIET_COMPILE="1")
     out = subprocess.run([sys.executable, "-c", CHILD], env=env, capture_output=True, text=True, timeout=1200)
     assert out.returncode == 0, out.stderr[-3000:]
-    unpacked, compiled = out.stdout.splitlines()[-2:]
+    compiled, unpacked = out.stdout.splitlines()[-2:]
     assert unpacked == _archive().name
     assert int(compiled) == 0, f"{compiled} kernels compiled despite the shipped archive"
 

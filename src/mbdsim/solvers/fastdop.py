@@ -107,7 +107,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         s_ = rhs(cm, wk, t, y, f, bool(True))
         if s_ != OK:
             return s_, iout
-        h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
+        h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2], 7)
         st[1] = h
         if watch:   # the sensors' values at the start: a sign change from them is an event
             _sensor_g(cm, wk, t, y, sc[3], wk[44][2])
@@ -304,7 +304,7 @@ def span(cm, wk, co, st, y, f, tout, Y, YJ, VD, LAM, rtol, atol, max_step, max_s
     if abs(tout[0] - t0) <= 1e-14 * max(1.0, abs(t0)):
         write_state(cm, wk, y, Y[0], Y[0, :0])
         iout = 1
-    st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2])
+    st[1] = initial_step(cm, wk, t0, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2], 7)
     while status == OK and iout < tout.shape[0]:
         status, iout = run(cm, wk, co, st, y, f, tout[-1], tout, iout, Y, rtol, atol, max_step, max_steps,
                            tout.shape[0], 1e-12, stats, K, F, sc, False, Y[:0], Y[:0, :2], stats[:1], False)

@@ -32,9 +32,9 @@ def _rms(x, scale):
 
 
 @kernel(_nrt=False, inline="always")
-def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
-    """Hairer's starting step (as scipy's select_initial_step) for an order-7 error estimator;
-    work, scale, y1: scratch vectors of the state's size."""
+def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1, order=7):
+    """Hairer's starting step (as scipy's select_initial_step) for an error estimator of `order` (DOP853: 7,
+    Radau IIA: 3); work, scale, y1: scratch vectors of the state's size."""
     n = y0.shape[0]
     for i in range(n):
         scale[i] = atol + abs(y0[i]) * rtol
@@ -51,7 +51,7 @@ def initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
     if d1 <= 1e-15 and d2 <= 1e-15:
         h1 = max(1e-6, h0 * 1e-3)
     else:
-        h1 = (0.01 / max(d1, d2)) ** (1.0 / 8.0)
+        h1 = (0.01 / max(d1, d2)) ** (1.0 / (order + 1.0))
     return min(100.0 * h0, h1, max_step)
 
 
@@ -115,6 +115,25 @@ def _friction_g(cm, wk, t, y, yo, g):
 
 
 @kernel(_nrt=False)
+def _dense_cubic(Q, y0, t0, h, t, out):
+    """An implicit step's polynomial (t0, h) from y0 (coefficients Q, 3 x n: Radau's collocation
+    polynomial, HHT's Hermite cubic; solvers.fastswitch) at t [s] into out."""
+    x = (t - t0) / h
+    for i in range(out.shape[0]):
+        out[i] = y0[i] + x * (Q[0, i] + x * (Q[1, i] + x * Q[2, i]))
+
+
+@kernel(_nrt=False)
+def _at(F, y0, t0, h, t, out, cubic):
+    """A step's interpolant at t [s] into out: DOP853's dense output (F, 7 x n), or with `cubic` an implicit
+    step's polynomial (3 x n)."""
+    if cubic:
+        _dense_cubic(F, y0, t0, h, t, out)
+    else:
+        _dense(F, y0, t0, h, t, out)
+
+
+@kernel(_nrt=False)
 def _signal(cm, wk, t, y, yo, g, which):
     """The watched signals at state y and t [s] into g: the sensors (which = 0, `_sensor_g`) or the
     joint-friction switching functions (1, `_friction_g`)."""
@@ -125,17 +144,19 @@ def _signal(cm, wk, t, y, yo, g, which):
 
 
 @kernel(_nrt=False, inline="always")
-def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which):
+def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which, cubic, right):
     """The time [s] in (t0, t0 + h] at which signal k (`_signal` `which`: a sensor's value, a friction
-    element's switching function) changes sign on the dense output (F, y0) of the step from t0, by the
-    Illinois variant of regula falsi to SENSOR_XTOL; -inf when its values at the step's ends do not
-    bracket a sign change (the crossing is then not an event, as a failed bracket of the reference
-    path's brentq)."""
+    element's switching function) changes sign on the interpolant (F, y0) of the step from t0 (`_at`:
+    DOP853's dense output, or with `cubic` an implicit step's polynomial), by the Illinois variant of
+    regula falsi to SENSOR_XTOL; -inf when its values at the step's ends do not bracket a sign change (the
+    crossing is then not an event, as a failed bracket of the reference path's brentq). The located time
+    is the bracket's midpoint, or with `right` its end on the crossed side (where the decision that follows
+    sees the new sign)."""
     a, b = t0, t0 + h
-    _dense(F, y0, t0, h, a, yd)
+    _at(F, y0, t0, h, a, yd, cubic)
     _signal(cm, wk, a, yd, yo, g, which)
     fa = g[k]
-    _dense(F, y0, t0, h, b, yd)
+    _at(F, y0, t0, h, b, yd, cubic)
     _signal(cm, wk, b, yd, yo, g, which)
     fb = g[k]
     if fb == 0.0:
@@ -149,7 +170,7 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which):
         c = b - fb * (b - a) / (fb - fa)
         if not a < c < b:
             c = 0.5 * (a + b)
-        _dense(F, y0, t0, h, c, yd)
+        _at(F, y0, t0, h, c, yd, cubic)
         _signal(cm, wk, c, yd, yo, g, which)
         fc = g[k]
         if fc == 0.0:
@@ -164,7 +185,7 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which):
             if side == 1:
                 fb *= 0.5
             side = 1
-    return 0.5 * (a + b)
+    return b if right else 0.5 * (a + b)
 
 
 @kernel(_nrt=False, inline="always")
@@ -188,7 +209,7 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
         if not have_F:
             _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
             have_F = True
-        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0)
+        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0, False, False)
         rising = gn > gp
         if tk <= t or (ex[19][k] != 0 and (ex[19][k] > 0) != rising):
             continue
@@ -227,7 +248,7 @@ def _watch_friction(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
             if not have_F:
                 _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
                 have_F = True
-            te = _sensor_time(cm, wk, F, y, t, h, e, ys, scale, fw[18], 1)
+            te = _sensor_time(cm, wk, F, y, t, h, e, ys, scale, fw[18], 1, False, False)
             t_ev = min(t_ev, te if te > t else t + h)
     if t_ev == np.inf:
         for e in range(gn.shape[0]):

@@ -29,6 +29,7 @@ import numpy as np
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel
 from .fastdop import CHECKPOINTS_FULL, _project
+from .fastdopstep import initial_step
 from .fastdyn import CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, read_state, rhs, write_state
 from .fastswitch import dense, friction_event, start, stop_at  # noqa: F401  (dense: the steps' polynomial, also HHT's)
 
@@ -249,33 +250,6 @@ def _predict(h, h_old, e, e_old):
     return mult * e ** -0.25
 
 
-@kernel(_nrt=False)
-def _initial_step(cm, wk, t0, y0, f0, rtol, atol, max_step, work, scale, y1):
-    """Hairer's starting step for an error estimator of order 3 (as scipy's select_initial_step)."""
-    n = y0.shape[0]
-    d0, d1 = 0.0, 0.0
-    for i in range(n):
-        scale[i] = atol + abs(y0[i]) * rtol
-        d0 += (y0[i] / scale[i]) ** 2
-        d1 += (f0[i] / scale[i]) ** 2
-    d0, d1 = np.sqrt(d0 / n), np.sqrt(d1 / n)
-    h0 = 1e-6 if (d0 < 1e-5 or d1 < 1e-5) else 0.01 * d0 / d1
-    h0 = min(h0, max_step)
-    for i in range(n):
-        y1[i] = y0[i] + h0 * f0[i]
-    if rhs(cm, wk, t0 + h0, y1, work, bool(True)) != OK:
-        return h0
-    d2 = 0.0
-    for i in range(n):
-        d2 += ((work[i] - f0[i]) / scale[i]) ** 2
-    d2 = np.sqrt(d2 / n) / h0
-    if d1 <= 1e-15 and d2 <= 1e-15:
-        h1 = max(1e-6, h0 * 1e-3)
-    else:
-        h1 = (0.01 / max(d1, d2)) ** 0.25
-    return min(100.0 * h0, h1, max_step)
-
-
 @entry(_nrt=False)
 def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_steps, chunk, proj_tol, stats,
         Jm, LR, LC, piv, S, cv, SY, ST, SQ, ns, start_row):
@@ -299,7 +273,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         s_ = rhs(cm, wk, t, y, f, bool(True))
         if s_ != OK:
             return s_, iout
-        h = _initial_step(cm, wk, t, y, f, rtol, atol, max_step, S[17], S[16], S[18])
+        h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, S[17], S[16], S[18], 3)
         st[1] = h
         start(cm, wk, t, y, S[17])   # joint friction: the switching values at the (re)start
         for k in range(2, N_ST):

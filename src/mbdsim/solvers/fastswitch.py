@@ -18,16 +18,12 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastdop import FRICTION_EVENT, SENSOR_XTOL, _friction_g, _project
+from .fastdop import FRICTION_EVENT, _friction_g, _project
+from .fastdopstep import _dense_cubic, _sensor_time
 from .fastdyn import OK
 
 
-@kernel(_nrt=False)
-def dense(Q, y0, t0, h, t, out):
-    """The step's polynomial (t0, h) from y0 (coefficients Q, 3 x n) at t [s] into out."""
-    x = (t - t0) / h
-    for i in range(out.shape[0]):
-        out[i] = y0[i] + x * (Q[0, i] + x * (Q[1, i] + x * Q[2, i]))
+dense = _dense_cubic   # the step's polynomial (fastdopstep)
 
 
 @kernel(_nrt=False)
@@ -36,46 +32,6 @@ def start(cm, wk, t, y, yo):
     (wk[50][2]); yo: scratch (n)."""
     if cm[48][0].shape[0]:
         _friction_g(cm, wk, t, y, yo, wk[50][2])
-
-
-@kernel(_nrt=False)
-def _event_time(cm, wk, Q, y0, t0, h, e, yd, yo, g):
-    """The time [s] in (t0, t0 + h] at which element e's switching function changes sign on the step's
-    polynomial (Illinois regula falsi); -inf when the values at the ends do not bracket a change."""
-    a, b = t0, t0 + h
-    dense(Q, y0, t0, h, a, yd)
-    _friction_g(cm, wk, a, yd, yo, g)
-    fa = g[e]
-    dense(Q, y0, t0, h, b, yd)
-    _friction_g(cm, wk, b, yd, yo, g)
-    fb = g[e]
-    if fb == 0.0:
-        return b
-    if fa == 0.0 or (fa > 0.0) == (fb > 0.0):
-        return -np.inf
-    side = 0
-    for _ in range(200):
-        if b - a <= SENSOR_XTOL + 4e-16 * abs(b):
-            break
-        c = b - fb * (b - a) / (fb - fa)
-        if not a < c < b:
-            c = 0.5 * (a + b)
-        dense(Q, y0, t0, h, c, yd)
-        _friction_g(cm, wk, c, yd, yo, g)
-        fc = g[e]
-        if fc == 0.0:
-            return c
-        if (fc > 0.0) == (fb > 0.0):   # c replaces b; a is kept (its value halved when kept twice)
-            b, fb = c, fc
-            if side == -1:
-                fa *= 0.5
-            side = -1
-        else:                          # c replaces a
-            a, fa = c, fc
-            if side == 1:
-                fb *= 0.5
-            side = 1
-    return b   # the side where the switching function has crossed (the decision sees the new sign)
 
 
 @kernel(_nrt=False)
@@ -91,7 +47,7 @@ def friction_event(cm, wk, Q, y0, t0, h, ynew, yd, yo):
     t_ev = np.inf
     for e in range(gn.shape[0]):
         if gp[e] > 0.0 and not gn[e] > 0.0:
-            te = _event_time(cm, wk, Q, y0, t0, h, e, yd, yo, fw[18])
+            te = _sensor_time(cm, wk, Q, y0, t0, h, e, yd, yo, fw[18], 1, True, True)
             t_ev = min(t_ev, te if te > t0 else t0 + h)
     if t_ev == np.inf:
         for e in range(gn.shape[0]):
