@@ -21,7 +21,9 @@ the normal).  They are left in the slot rows of sc[29] (used, depth [m], point [
 which solvers.fastcontact applies.
 
 For a box or hull the walk also collects the mesh's ridges and peaks inside it (solvers.fastridge), in
-the RIDGE_ROWS rows after the candidates' slots.  Two triangle meshes: solvers.fastmeshpair.
+the RIDGE_ROWS rows after the candidates' slots; for a capsule, a cylinder or an ellipsoid likewise the
+ridges and peaks that press into its curved surface (fastridge.curved_ridge_points: a cylinder lying along
+a ridge, a capsule across one, an ellipsoid on a peak).  Two triangle meshes: solvers.fastmeshpair.
 """
 from __future__ import annotations
 
@@ -29,8 +31,8 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import BOX, CAPSULE, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
-from .fastridge import ridge_points
+from .fastnarrow import BOX, CAPSULE, CYLINDER, ELLIPSOID, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastridge import curved_ridge_points, ridge_points
 
 NSLOT = 4          # contact directions kept per candidate point
 COS_SAME = 0.95    # normals closer than this (cosine) are one direction
@@ -209,6 +211,7 @@ def mesh_points(sc, x, msh, Px, Pm):
     nrow = min(nc * NSLOT, S.shape[0])
     clear_slots(S, nrow)
     ridges = kd == BOX or kd == HULL
+    curved = kd == CAPSULE or kd == CYLINDER or kd == ELLIPSOID
     nxt = nrow
     # x's ground box, as a box in the mesh's axes
     g0, g1, g2 = 0.5 * (BB[x, 0] + BB[x, 3]) - Pm[0], 0.5 * (BB[x, 1] + BB[x, 4]) - Pm[1], \
@@ -234,6 +237,8 @@ def mesh_points(sc, x, msh, Px, Pm):
                     _triangle(sc, x, Px, Pm, t, S, cap)
                     if ridges:
                         nxt = ridge_points(sc, x, Px, Pm, t, S, nxt)
+                    elif curved:
+                        nxt = curved_ridge_points(sc, x, Px, Pm, t, S, nxt)
         elif top + 2 <= stack.shape[0]:
             stack[top] = links[nd, 0]
             stack[top + 1] = links[nd, 1]
