@@ -61,6 +61,11 @@ def _points(ground_geo, geo, pos, orient=None, center=None, gorient=None):
     return pts[pts.time == 0.0].sort_values("x")
 
 
+def _hull_cube():
+    """The 0.2 m cube as a convex hull of its corners."""
+    return mb.ConvexMesh(0.1 * np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]))
+
+
 D = 3e-4   # depth [m]
 EDGE = dict(gorient=_rot("x", np.pi / 4), center=(0, 0, -0.1 * np.sqrt(2)))   # a 0.2 m box, its top edge on x
 
@@ -72,12 +77,17 @@ EDGE = dict(gorient=_rot("x", np.pi / 4), center=(0, 0, -0.1 * np.sqrt(2)))   # 
     (mb.Cylinder(0.05, 0.1, axis="y"), (0.0, 0.0, 0.05 - D), (0, 0, 1), 1e-5),    # GJK/EPA
     (mb.Ellipsoid((0.08, 0.05, 0.03)), (0.0, 0.0, 0.03 - D), (0, 0, 1), 1e-5),  # GJK/EPA
 ])
-def test_curved_shape_on_a_box_edge_is_one_point_of_the_exact_depth(geo, pos, n_ref, tol):
+@pytest.mark.parametrize("edge", ["box", "hull"])
+def test_curved_shape_on_a_box_edge_is_one_point_of_the_exact_depth(geo, pos, n_ref, tol, edge):
     """A box's top edge (along x, at z = 0) under a sphere (also off to the side: the normal along the line from
     the edge to the centre), a capsule and a cylinder across it, an ellipsoid on it: one point, as deep as the
     radius (semi-axis) less the centre's distance from the edge, its force k d^e; the normal to tol (EPA's
-    polytope on a curved Minkowski difference: a few 1e-6)."""
-    p = _points(mb.Box((0.2, 0.2, 0.2)), geo, pos, **EDGE)
+    polytope on a curved Minkowski difference: a few 1e-6; the same for the box as a convex hull, by EPA)."""
+    if edge == "hull":
+        box, tol = _hull_cube(), 1e-5
+    else:
+        box = mb.Box((0.2, 0.2, 0.2))
+    p = _points(box, geo, pos, **EDGE)
     assert len(p) == 1, p
     assert abs(p.penetration.iloc[0] - D) < 1e-6 * D, p.penetration.iloc[0]
     assert abs(p.normal_force.iloc[0] - K * D ** E) < 1e-5 * K * D ** E
@@ -87,12 +97,14 @@ def test_curved_shape_on_a_box_edge_is_one_point_of_the_exact_depth(geo, pos, n_
 
 @pytest.mark.parametrize("geo", [mb.Capsule(0.05, 0.1, axis="x"), mb.Cylinder(0.05, 0.1, axis="x")])
 @pytest.mark.parametrize("theta", [0.0, 0.004])
-def test_capsule_and_cylinder_lying_along_a_box_edge_touch_at_both_ends(geo, theta):
+@pytest.mark.parametrize("edge", ["box", "hull"])
+def test_capsule_and_cylinder_lying_along_a_box_edge_touch_at_both_ends(geo, theta, edge):
     """Lying along the box's top edge, tilted by theta about y: a line contact, a point at each end of the
     axis (x = +-h cos theta on the edge), each as deep as the radius less the distance of that edge point
     from the axis (its end at axial coordinate +-h): the deeper end carries more, as a line contact must."""
     r, h, zc = 0.05, 0.05, 0.05 - D
-    p = _points(mb.Box((0.2, 0.2, 0.2)), geo, (0.0, 0.0, zc), _rot("y", -theta), **EDGE)
+    box = mb.Box((0.2, 0.2, 0.2)) if edge == "box" else _hull_cube()
+    p = _points(box, geo, (0.0, 0.0, zc), _rot("y", -theta), **EDGE)
     assert len(p) == 2, p
     u = np.array([np.cos(theta), 0.0, np.sin(theta)])   # the axis, tilted: end +x up
     for s, (_, row) in zip((-1, 1), p.iterrows()):
