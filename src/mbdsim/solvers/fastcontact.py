@@ -45,7 +45,8 @@ from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
-from .fastedges import hull_edges
+from .fastcross import edge_crossings
+from .fastedges import FACE_COS, hull_edges
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
 from .fastmesh import NSLOT, mesh_points
@@ -164,20 +165,21 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
                 best, ref, gbest = D, rs, g
             if not D > 0.0:
                 return   # a separating face: no contact
-    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, r, A, rd, w, rigid, F, rec,
-                                                        nrec):
-        return   # separated along an edge-edge axis, or an edge-edge contact
-    if (kind[a] == HULL or kind[b] == HULL) and (kind[a] == BOX or kind[a] == HULL) and \
-            (kind[b] == BOX or kind[b] == HULL):
-        st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, a, b, Pa, Pb, best)
-        if st == 1:
-            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, L0, L1, L2, D)
-        if st != 0:
-            return   # separated along an edge-edge axis (fastedges), or an edge-edge contact
     rs, xs = (b, a) if ref == b else (a, b)
     Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
     sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
     q0, q1, q2, m0, m1, m2 = face(Pr, planes, spl[rs, 0], gbest)
+    # edge-edge axes (an axis within FACE_COS of the reference face's normal is that face's contact)
+    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, m0, m1, m2, r, A, rd, w, rigid,
+                                                        F, rec, nrec):
+        return   # separated along an edge-edge axis, or an edge-edge contact
+    if (kind[a] == HULL or kind[b] == HULL) and (kind[a] == BOX or kind[a] == HULL) and \
+            (kind[b] == BOX or kind[b] == HULL):
+        st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, a, b, Pa, Pb, best, m0, m1, m2)
+        if st == 1:
+            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, L0, L1, L2, D)
+        if st != 0:
+            return   # separated along an edge-edge axis (fastedges), or an edge-edge contact
     if kind[xs] != BOX and kind[xs] != HULL and not deepest_on_face(sc, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1,
                                                                      m2):
         _curved_point(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
@@ -199,6 +201,10 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
         h = 0.5 * d
         _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
                sign * m0, sign * m1, sign * m2, d)
+    S = sc[29]   # the incident's edges leaving the reference through its side planes (solvers.fastcross)
+    for s in range(edge_crossings(sc, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1, m2, tol, S)):
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[s, 2], S[s, 3], S[s, 4], sign * m0, sign * m1,
+               sign * m2, S[s, 1])
 
 
 @kernel(_nrt=False)
@@ -280,7 +286,7 @@ def _edge_line(sc, pair, poly, cur, Pp, Pc, n0, n1, n2, sign, r, A, rd, w, rigid
 
 
 @kernel(_nrt=False)
-def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, nrec):
+def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, m0, m1, m2, r, A, rd, w, rigid, F, rec, nrec):
     """Edge-edge axes of two boxes (the cross products of their edge directions): True when one separates
     them, or when one penetrates clearly less than the best face (below 0.95 of it; faces are preferred
     for resting contact) and the contact at the closest points of the two supporting edges is applied."""
@@ -305,7 +311,7 @@ def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, n
             D = ext - s
             if not D > 0.0:
                 return True
-            if D < best:
+            if D < best and abs(x0 * m0 + x1 * m1 + x2 * m2) <= FACE_COS:
                 best, bi, bj, L0, L1, L2 = D, i, j, x0, x1, x2
     if bi < 0:
         return False

@@ -10,7 +10,9 @@ axes; an explicit stack, sc[30]) and, per triangle met (its outward normal m by 
   touching when nearer than the radius, with the normal from that point to the centre;
 * any other shape: its candidate points against the triangle's plane (solvers.fastnarrow.candidate:
   vertices, cylinder rim points, the ellipsoid's deepest point) that lie below it (by less than the
-  shape's bounding radius) and whose foot lies on the triangle, with normal m.
+  shape's bounding radius) and whose foot lies on the triangle, with normal m; none when the shape's
+  centre (`interior_point`) lies behind the triangle's plane (the far side of a closed mesh thinner than
+  the shape, whose vertices lie behind it by less than the bounding radius: not a contact).
 
 The points of one candidate met through several triangles are merged per normal direction (normals within
 COS_SAME of the slot's mean count as one: a point over a shared edge of a flat or gently curved mesh is
@@ -152,6 +154,18 @@ def point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2
 
 
 @kernel(_nrt=False)
+def interior_point(kind, Px, verts, v0, v1):
+    """A ground point inside a convex shape (pose Px): the mean of a convex hull's vertices rows v0..v1, else
+    the origin of its local frame (the centre of a box, cylinder, ellipsoid)."""
+    if kind != HULL or v1 <= v0:
+        return Px[0], Px[1], Px[2]
+    s0 = s1 = s2 = 0.0
+    for k in range(v0, v1):
+        s0, s1, s2 = s0 + verts[k, 0], s1 + verts[k, 1], s2 + verts[k, 2]
+    return to_ground(Px, s0 / (v1 - v0), s1 / (v1 - v0), s2 / (v1 - v0))
+
+
+@kernel(_nrt=False)
 def _triangle(sc, x, Px, Pm, t, S, cap):
     """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points no deeper than cap [m] into
     the slots S."""
@@ -176,6 +190,9 @@ def _triangle(sc, x, Px, Pm, t, S, cap):
             h = 0.5 * (p[0] - dist)
             _keep(S, k, p[0] - dist, q0 - h * n0, q1 - h * n1, q2 - h * n2, n0, n1, n2)
         return
+    o0, o1, o2 = interior_point(kd, Px, verts, sv[x, 0], sv[x, 1])
+    if not m0 * (o0 - a0) + m1 * (o1 - a1) + m2 * (o2 - a2) > 0.0:
+        return   # the shape's centre behind the triangle: a far face of a closed mesh, not a contact
     for k in range(n_candidates(kd, sv[x, 1] - sv[x, 0])):
         y0, y1, y2 = candidate(kd, Px, p, verts, sv[x, 0], m0, m1, m2, k)
         point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2, cap)
