@@ -95,15 +95,17 @@ def pack_contacts(sys, elems) -> tuple:
     (geometry.bvh), (29) mesh contact slots (solvers.fastmesh), (30) the hierarchy walk's stack, (31) edge
     ranges (ns, 2) into (32) the edges of boxes and hulls (ne, 2: rows of (7); solvers.fastedges), (33) per
     triangle of (22) its ridge and peak bits (nt,: geometry.ridges, solvers.fastridge), (34) the node boxes of
-    (27) swept along their triangles' inward normals (nn, 6: geometry.bvh.swept, solvers.fastmeshpair)."""
+    (27) swept along their triangles' inward normals (nn, 6: geometry.bvh.swept, solvers.fastmeshpair), (35) per
+    triangle of (22) and corner e the triangle across its edge e, e + 1, or -1 (nt, 3: geometry.ridges.
+    ridge_neighbours, the normal-cone test of solvers.fastridge.curved_ridge_points)."""
     from ..solvers.fastcontact import NREC
     from ..solvers.fastgjk import MAX_ITER
     from ..solvers.fastmesh import NSLOT, RIDGE_ROWS
     from ..solvers.fastmeshpair import SKIN
     from .bvh import build, swept
-    from .ridges import ridge_masks
+    from .ridges import ridge_masks, ridge_neighbours
     index, rows, verts, planes, pairs, par = {}, [], [], [], [], []
-    lbox, meta, tris, nodes, links, eran, edges, rmask, sweep = [], [], [], [], [], [], [], [], []
+    lbox, meta, tris, nodes, links, eran, edges, rmask, sweep, nbr = [], [], [], [], [], [], [], [], [], []
     nv = npl = nt = nn = ne = 0
     for ei, e in enumerate(elems):
         for a, b in e.pairs:
@@ -123,6 +125,8 @@ def pack_contacts(sys, elems) -> tuple:
                         order, nb, nl = build(v, f)
                         tris.append(f[order] + nv)
                         rmask.append(ridge_masks(v, f[order]))
+                        nb_t = ridge_neighbours(f[order])
+                        nbr.append(np.where(nb_t >= 0, nb_t + nt, -1))
                         nodes.append(nb)
                         sweep.append(swept(v, f[order], nb, nl, SKIN * rad))
                         nl = nl.copy()
@@ -168,7 +172,8 @@ def pack_contacts(sys, elems) -> tuple:
             np.array(eran, np.int64).reshape(ns, 2),
             np.concatenate(edges).reshape(-1, 2) if edges else np.zeros((0, 2), np.int64),
             np.concatenate(rmask) if rmask else np.zeros(0, np.int64),
-            np.concatenate(sweep).reshape(-1, 6) if sweep else np.zeros((0, 6)))
+            np.concatenate(sweep).reshape(-1, 6) if sweep else np.zeros((0, 6)),
+            np.concatenate(nbr).reshape(-1, 3) if nbr else np.zeros((0, 3), np.int64))
 
 
 def empty_contacts() -> tuple:
@@ -179,4 +184,4 @@ def empty_contacts() -> tuple:
             z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
             z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
             z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i), z((0, 2), i), z((0, 2), i),
-            z(0, i), z((0, 6)))
+            z(0, i), z((0, 6)), z((0, 3), i))

@@ -68,3 +68,27 @@ def ridge_masks(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
     own = pv[own]
     np.bitwise_or.at(mask, own // 3, 8 << (own % 3))
     return mask
+
+
+def ridge_neighbours(faces: np.ndarray) -> np.ndarray:
+    """Per triangle of faces (m, 3) and corner e, the triangle across its edge from corner e to e + 1 (mod 3)
+    (an edge shared by exactly two triangles), else -1 (solvers.fastridge's normal-cone test)."""
+    f = np.asarray(faces, np.int64).reshape(-1, 3)
+    m = len(f)
+    out = np.full((m, 3), -1, np.int64)
+    if m == 0:
+        return out
+    nv = int(f.max()) + 1
+    fi = np.repeat(np.arange(m), 3)
+    ci = np.tile(np.arange(3), m)
+    a, b = f[fi, ci], f[fi, (ci + 1) % 3]
+    key = np.minimum(a, b) * nv + np.maximum(a, b)
+    srt = np.argsort(key, kind="stable")
+    ks = key[srt]
+    start = np.flatnonzero(np.r_[True, ks[1:] != ks[:-1]])
+    count = np.diff(np.r_[start, len(ks)])
+    two = start[count == 2]
+    e1, e2 = srt[two], srt[two + 1]
+    out[fi[e1], ci[e1]] = fi[e2]
+    out[fi[e2], ci[e2]] = fi[e1]
+    return out

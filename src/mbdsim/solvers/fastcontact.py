@@ -13,7 +13,11 @@ the closest points of their segments; against a box or convex hull, the separati
 polyhedra's face normals picks the reference face of least penetration, whose normal is the contact normal
 of every point: the incident shape's candidate points below it and inside the reference (vertices, rim
 points, ...) and, between two polyhedra, the reference's vertices inside the incident one, so face and
-line contacts get several points and the right moments; a convex shape against a triangle mesh through
+line contacts get several points and the right moments; a curved shape (sphere, capsule, cylinder,
+ellipsoid) none of whose deepest candidates lies over that face presses on an edge or a vertex of the
+polyhedron instead (`_curved_point`: one point, a sphere or capsule on a box by the distance of its core
+from the box, the others by GJK/EPA; a capsule or cylinder lying along the edge, `_edge_line`, a point at
+each end of the part of the edge beside its axis); a convex shape against a triangle mesh through
 its bounding-volume hierarchy (solvers.fastmesh; with a box or hull also the mesh's ridges and peaks
 inside it, solvers.fastridge; a mesh no larger than a box or hull it meets puts its vertices on the
 polyhedron's faces instead); two triangle meshes by the vertices of each against the other's triangles
@@ -41,15 +45,16 @@ from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross, _force as _point_force
-from .fastedges import hull_edges
+from .fastcross import edge_crossings
+from .fastedges import FACE_COS, hull_edges
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
 from .fastmesh import NSLOT, mesh_points
 from .fastmeshpair import mesh_mesh_points
-from .fastnarrow import (BOX, CAPSULE, CYLINDER, HULL, MESH, PLANE, SPHERE, candidate, dir_local, face, inside_except,
-                         n_candidates, segments_closest, support_depth, to_ground, to_local)
+from .fastnarrow import (BOX, CAPSULE, CYLINDER, HULL, LINE_SIN, MESH, PLANE, SPHERE, candidate, deepest_on_face,
+                         exit_depth, face, inside_except, n_candidates, pressed, segments_closest, support_depth,
+                         to_ground)
 
-LINE_SIN = 0.02   # sine of the largest angle between two axes that still touch along a line
 RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
 NREC = 15
 REC_FIELDS = ("pair", "x", "y", "z", "nx", "ny", "nz", "penetration", "normal_force", "friction_x",
@@ -160,20 +165,25 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
                 best, ref, gbest = D, rs, g
             if not D > 0.0:
                 return   # a separating face: no contact
-    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, r, A, rd, w, rigid, F, rec,
-                                                        nrec):
-        return   # separated along an edge-edge axis, or an edge-edge contact
-    if (kind[a] == HULL or kind[b] == HULL) and (kind[a] == BOX or kind[a] == HULL) and \
-            (kind[b] == BOX or kind[b] == HULL):
-        st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, a, b, Pa, Pb, best)
-        if st == 1:
-            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, L0, L1, L2, D)
-        if st != 0:
-            return   # separated along an edge-edge axis (fastedges), or an edge-edge contact
     rs, xs = (b, a) if ref == b else (a, b)
     Pr, Px = (Pb, Pa) if ref == b else (Pa, Pb)
     sign = -1.0 if ref == b else 1.0   # n = sign * m runs from shape_i (a) to shape_j (b)
     q0, q1, q2, m0, m1, m2 = face(Pr, planes, spl[rs, 0], gbest)
+    # edge-edge axes (an axis within FACE_COS of the reference face's normal is that face's contact)
+    if kind[a] == BOX and kind[b] == BOX and _box_edges(sc, pair, a, b, Pa, Pb, best, m0, m1, m2, r, A, rd, w, rigid,
+                                                        F, rec, nrec):
+        return   # separated along an edge-edge axis, or an edge-edge contact
+    if (kind[a] == HULL or kind[b] == HULL) and (kind[a] == BOX or kind[a] == HULL) and \
+            (kind[b] == BOX or kind[b] == HULL):
+        st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, a, b, Pa, Pb, best, m0, m1, m2)
+        if st == 1:
+            _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, L0, L1, L2, D)
+        if st != 0:
+            return   # separated along an edge-edge axis (fastedges), or an edge-edge contact
+    if kind[xs] != BOX and kind[xs] != HULL and not deepest_on_face(sc, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1,
+                                                                     m2):
+        _curved_point(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        return   # a curved shape on an edge or a vertex of the polyhedron: one point, the exact normal
     _against(sc, pair, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1, m2, sign, r, A, rd, w, rigid, F, rec, nrec)
     if kind[xs] != BOX and kind[xs] != HULL:
         return
@@ -184,17 +194,99 @@ def _polytope_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
         v0, v1, v2 = to_ground(Pr, verts[sv[rs, 0] + k, 0], verts[sv[rs, 0] + k, 1], verts[sv[rs, 0] + k, 2])
         if not inside_except(Px, planes, spl[xs, 0], spl[xs, 1] - spl[xs, 0], -1, v0, v1, v2, tol):
             continue
-        d = _exit_depth(Px, planes, spl[xs, 0], spl[xs, 1], v0, v1, v2, m0, m1, m2)
-        if not d > 0.0 or _pressed(Px, Pr, verts, sv[xs, 0], sv[xs, 1], planes, spl[rs, 0], spl[rs, 1], gbest,
+        d = exit_depth(Px, planes, spl[xs, 0], spl[xs, 1], v0, v1, v2, m0, m1, m2)
+        if not d > 0.0 or pressed(Px, Pr, verts, sv[xs, 0], sv[xs, 1], planes, spl[rs, 0], spl[rs, 1], gbest,
                                    v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
             continue
         h = 0.5 * d
         _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, v0 - h * m0, v1 - h * m1, v2 - h * m2,
                sign * m0, sign * m1, sign * m2, d)
+    S = sc[29]   # the incident's edges leaving the reference through its side planes (solvers.fastcross)
+    for s in range(edge_crossings(sc, xs, rs, gbest, Px, Pr, q0, q1, q2, m0, m1, m2, tol, S)):
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[s, 2], S[s, 3], S[s, 4], sign * m0, sign * m1,
+               sign * m2, S[s, 1])
 
 
 @kernel(_nrt=False)
-def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, nrec):
+def _curved_point(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
+    """A curved shape against an edge or a vertex of a box or hull: one point, a sphere or capsule on a box
+    by the distance of its core from the box (closed form, fastgjk.rounded_penetration), the others by
+    GJK/EPA."""
+    kind, prm, rad = sc[1], sc[4], sc[5]
+    if kind[a] == BOX and (kind[b] == SPHERE or kind[b] == CAPSULE):
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(kind[b], Pb, prm[b], BOX, Pa, prm[a])
+    elif kind[b] == BOX and (kind[a] == SPHERE or kind[a] == CAPSULE):
+        depth, n0, n1, n2, p0, p1, p2 = rounded_penetration(kind[a], Pa, prm[a], BOX, Pb, prm[b])
+        n0, n1, n2 = -n0, -n1, -n2
+    else:
+        depth, n0, n1, n2, p0, p1, p2 = penetration(sc, a, b, Pa, Pb, 1e-10 * (rad[a] + rad[b]))
+    if not depth > 0.0:
+        return
+    if kind[a] == CAPSULE or kind[a] == CYLINDER or kind[b] == CAPSULE or kind[b] == CYLINDER:
+        cur, poly, Pc, Pp, sign = (a, b, Pa, Pb, -1.0) if kind[a] == CAPSULE or kind[a] == CYLINDER else \
+            (b, a, Pb, Pa, 1.0)
+        if _edge_line(sc, pair, poly, cur, Pp, Pc, sign * n0, sign * n1, sign * n2, sign, r, A, rd, w, rigid, F,
+                      rec, nrec):
+            return
+    _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, depth)
+
+
+@kernel(_nrt=False)
+def _edge_line(sc, pair, poly, cur, Pp, Pc, n0, n1, n2, sign, r, A, rd, w, rigid, F, rec, nrec):
+    """A capsule or cylinder cur whose side lies along an edge of the polyhedron poly (the contact normal n,
+    from poly towards cur, within LINE_SIN of perpendicular to cur's axis; poly's vertices that support it
+    along n, within LINE_SIN of its size, spanning a segment within LINE_SIN of the axis): a line contact, a
+    point at each end of the part of that edge beside the axis, each as deep as the radius less its distance
+    from the axis (the capsule's core).  True when it is such a line (its points applied); sign: +1 when
+    poly is the pair's shape_i."""
+    prm, sv, verts, rad = sc[4], sc[6], sc[7], sc[5]
+    u0, u1, u2 = Pc[5], Pc[8], Pc[11]
+    if abs(u0 * n0 + u1 * n1 + u2 * n2) > LINE_SIN:
+        return False
+    p = prm[cur]
+    top = -np.inf
+    for k in range(sv[poly, 0], sv[poly, 1]):
+        g0, g1, g2 = to_ground(Pp, verts[k, 0], verts[k, 1], verts[k, 2])
+        top = max(top, g0 * n0 + g1 * n1 + g2 * n2)
+    tol = LINE_SIN * 2.0 * rad[poly]
+    lo, hi, klo, khi = np.inf, -np.inf, -1, -1
+    for k in range(sv[poly, 0], sv[poly, 1]):
+        g0, g1, g2 = to_ground(Pp, verts[k, 0], verts[k, 1], verts[k, 2])
+        if g0 * n0 + g1 * n1 + g2 * n2 >= top - tol:
+            z = (g0 - Pc[0]) * u0 + (g1 - Pc[1]) * u1 + (g2 - Pc[2]) * u2
+            if z < lo:
+                lo, klo = z, k
+            if z > hi:
+                hi, khi = z, k
+    if khi < 0 or not hi - lo > 1e-9 * rad[cur]:
+        return False
+    a0, a1, a2 = to_ground(Pp, verts[klo, 0], verts[klo, 1], verts[klo, 2])
+    b0, b1, b2 = to_ground(Pp, verts[khi, 0], verts[khi, 1], verts[khi, 2])
+    e0, e1, e2 = b0 - a0, b1 - a1, b2 - a2
+    x0, x1, x2 = _cross(u0, u1, u2, e0, e1, e2)
+    if x0 * x0 + x1 * x1 + x2 * x2 > LINE_SIN * LINE_SIN * (e0 * e0 + e1 * e1 + e2 * e2):
+        return False
+    t0, t1 = max(lo, -p[1]), min(hi, p[1])
+    if not t0 < t1:
+        return False
+    for end in range(2):
+        z = t0 if end == 0 else t1
+        f = (z - lo) / (hi - lo)
+        q0, q1, q2 = a0 + f * e0, a1 + f * e1, a2 + f * e2
+        zq = min(max((q0 - Pc[0]) * u0 + (q1 - Pc[1]) * u1 + (q2 - Pc[2]) * u2, -p[1]), p[1])
+        d0, d1, d2 = q0 - Pc[0] - zq * u0, q1 - Pc[1] - zq * u1, q2 - Pc[2] - zq * u2
+        L = np.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+        if not (L < p[0] and L > 0.0):
+            continue
+        d0, d1, d2 = d0 / L, d1 / L, d2 / L   # outward of cur, towards poly
+        h = 0.5 * (p[0] - L)
+        _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, q0 + h * d0, q1 + h * d1, q2 + h * d2,
+               -sign * d0, -sign * d1, -sign * d2, p[0] - L)
+    return True
+
+
+@kernel(_nrt=False)
+def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, m0, m1, m2, r, A, rd, w, rigid, F, rec, nrec):
     """Edge-edge axes of two boxes (the cross products of their edge directions): True when one separates
     them, or when one penetrates clearly less than the best face (below 0.95 of it; faces are preferred
     for resting contact) and the contact at the closest points of the two supporting edges is applied."""
@@ -219,7 +311,7 @@ def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, n
             D = ext - s
             if not D > 0.0:
                 return True
-            if D < best:
+            if D < best and abs(x0 * m0 + x1 * m1 + x2 * m2) <= FACE_COS:
                 best, bi, bj, L0, L1, L2 = D, i, j, x0, x1, x2
     if bi < 0:
         return False
@@ -240,39 +332,6 @@ def _box_edges(sc, pair, a, b, Pa, Pb, face_depth, r, A, rd, w, rigid, F, rec, n
     _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, 0.5 * (X[0] + Y[0]), 0.5 * (X[1] + Y[1]),
            0.5 * (X[2] + Y[2]), L0, L1, L2, best)
     return True
-
-
-@kernel(_nrt=False)
-def _exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
-    """Distance [m] from the point v inside a polyhedron (pose P) to its surface along -m."""
-    y0, y1, y2 = to_local(P, v0, v1, v2)
-    u0, u1, u2 = dir_local(P, m0, m1, m2)
-    best = np.inf
-    for g in range(p0_, p1_):
-        nm = planes[g, 0] * u0 + planes[g, 1] * u1 + planes[g, 2] * u2
-        if nm < -1e-12:
-            t = (planes[g, 0] * y0 + planes[g, 1] * y1 + planes[g, 2] * y2 - planes[g, 3]) / nm
-            if t < best:
-                best = t
-    return best
-
-
-@kernel(_nrt=False)
-def _pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
-    """Whether an incident vertex that `_against` used (below the reference face g, inside the reference)
-    lies on the normal line through the reference vertex v (within tol [m])."""
-    for k in range(x0_, x1_):
-        u0, u1, u2 = to_ground(Px, verts[k, 0], verts[k, 1], verts[k, 2])
-        if not m0 * (q0 - u0) + m1 * (q1 - u1) + m2 * (q2 - u2) > 0.0:
-            continue
-        if not inside_except(Pr, planes, p0_, p1_ - p0_, g, u0, u1, u2, tol):
-            continue
-        e0, e1, e2 = u0 - v0, u1 - v1, u2 - v2
-        en = e0 * m0 + e1 * m1 + e2 * m2
-        e0, e1, e2 = e0 - en * m0, e1 - en * m1, e2 - en * m2
-        if e0 * e0 + e1 * e1 + e2 * e2 <= tol * tol:
-            return True
-    return False
 
 
 @kernel(_nrt=False)

@@ -1,11 +1,15 @@
 """Edge-edge axes of two polyhedra at least one of which is a convex hull (issue 30).
 
-`hull_edges(sc, a, b, Pa, Pb, face_depth)` tests the axes L = e_a x e_b over the edges of shape a and of
-shape b (sc[31] edge ranges, sc[32] edges as pairs of vertex rows of sc[7]; geometry.pack): the depth along L
+`hull_edges(sc, a, b, Pa, Pb, face_depth, m0, m1, m2)` tests the axes L = e_a x e_b over the edges of shape a
+and of shape b (sc[31] edge ranges, sc[32] edges as pairs of vertex rows of sc[7]; geometry.pack): the depth along L
 (oriented from a's centre towards b's) is D = max over a's vertices of L.x - min over b's vertices of L.x [m].
 Returns (status, p0, p1, p2, L0, L1, L2, D): status -1 when an axis separates the shapes, 1 when the least D
-is clearly below the best face depth (under 0.95 of it: faces are preferred for resting contact) and both
-edges support their shapes along it (p: the midpoint of the edges' closest points [m], ground), else 0.
+is clearly below the best face depth (under 0.95 of it: faces are preferred for resting contact), L is not
+within FACE_COS of the reference face's normal m (an edge lying on that face, a box across a hull's ridge:
+the face's contact, with a point where the edge crosses each side face, solvers.fastcross; the face depth
+of the separating-axis test counts the incident's parts beyond the face, so a long ridge under a tilted box
+went below 0.95 of it and the contact jumped between two points and one) and both edges support their
+shapes along it (p: the midpoint of the edges' closest points [m], ground), else 0.
 Boxes use fastcontact._box_edges (three edge directions each).
 """
 from __future__ import annotations
@@ -16,6 +20,8 @@ from .._jit import kernel
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from ..system.exprloads_kernel import _cross
 from .fastnarrow import dir_ground, segments_closest, to_ground
+
+FACE_COS = 0.999   # an edge-edge axis within this cosine of the reference face's normal is that face's contact
 
 
 @kernel(_nrt=False)
@@ -36,7 +42,7 @@ def _end(P, verts, k):
 
 
 @kernel(_nrt=False)
-def hull_edges(sc, a, b, Pa, Pb, face_depth):
+def hull_edges(sc, a, b, Pa, Pb, face_depth, m0, m1, m2):
     """Edge-edge axes of shapes a and b (module docstring)."""
     sv, verts, rad, se, E = sc[6], sc[7], sc[5], sc[31], sc[32]
     c0, c1, c2 = Pb[0] - Pa[0], Pb[1] - Pa[1], Pb[2] - Pa[2]
@@ -63,8 +69,8 @@ def hull_edges(sc, a, b, Pa, Pb, face_depth):
             D = hi - lo
             if not D > 0.0:
                 return -1, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-            if not D < best:
-                continue
+            if not D < best or abs(x0 * m0 + x1 * m1 + x2 * m2) > FACE_COS:
+                continue   # not the least, or the reference face's own contact (an edge lying on the face)
             # both edges must be the supporting features along the axis
             p0, p1, p2 = _end(Pa, verts, i0)
             q0, q1, q2 = _end(Pa, verts, i1)

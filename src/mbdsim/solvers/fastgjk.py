@@ -303,13 +303,29 @@ def _cylinder_closest(r, h, y0, y1, y2):
 
 
 @kernel(_nrt=False)
+def _box_closest(h0, h1, h2, y0, y1, y2):
+    """Closest point of the box's surface (half sizes h, local axes) to the local point y, outside or inside."""
+    if abs(y0) <= h0 and abs(y1) <= h1 and abs(y2) <= h2:   # inside: onto the nearest face
+        g0, g1, g2 = h0 - abs(y0), h1 - abs(y1), h2 - abs(y2)
+        if g0 <= g1 and g0 <= g2:
+            return (h0 if y0 >= 0.0 else -h0), y1, y2
+        if g1 <= g2:
+            return y0, (h1 if y1 >= 0.0 else -h1), y2
+        return y0, y1, (h2 if y2 >= 0.0 else -h2)
+    return min(max(y0, -h0), h0), min(max(y1, -h1), h1), min(max(y2, -h2), h2)
+
+
+@kernel(_nrt=False)
 def _signed_distance(kind, P, p, x0, x1, x2):
-    """(signed distance [m] of the ground point x to a cylinder or an ellipsoid, < 0 inside; the unit
+    """(signed distance [m] of the ground point x to a cylinder, an ellipsoid or a box, < 0 inside; the unit
     normal of the surface there, outward, ground; the closest surface point)."""
     y0, y1, y2 = dir_local(P, x0 - P[0], x1 - P[1], x2 - P[2])
     if kind == CYLINDER:
         c0, c1, c2 = _cylinder_closest(p[0], p[1], y0, y1, y2)
         inside = abs(y2) <= p[1] and y0 * y0 + y1 * y1 <= p[0] * p[0]
+    elif kind == BOX:
+        c0, c1, c2 = _box_closest(p[0], p[1], p[2], y0, y1, y2)
+        inside = abs(y0) <= p[0] and abs(y1) <= p[1] and abs(y2) <= p[2]
     else:
         c0, c1, c2 = _ellipsoid_closest(p[0], p[1], p[2], y0, y1, y2)
         inside = (y0 / p[0]) ** 2 + (y1 / p[1]) ** 2 + (y2 / p[2]) ** 2 < 1.0
@@ -325,16 +341,14 @@ def _signed_distance(kind, P, p, x0, x1, x2):
 
 
 @kernel(_nrt=False)
-def rounded_penetration(kind_r, Pr, pr, kind_s, Ps, ps):
-    """(depth [m], unit normal from the solid shape s (a cylinder or an ellipsoid) towards the rounded one
-    r (a sphere or capsule: a point or a segment swept by its radius), the point midway in the overlap):
-    the radius less the distance of the core from s, the segment's nearest point found by golden-section
-    search (the distance to a convex solid is convex along a segment)."""
-    h = pr[1] if kind_r == CAPSULE else 0.0
-    a0, a1, a2 = to_ground(Pr, 0.0, 0.0, -h)
-    b0, b1, b2 = to_ground(Pr, 0.0, 0.0, h)
+def segment_penetration(kind_s, Ps, ps, a0, a1, a2, b0, b1, b2, radius):
+    """(depth [m], unit normal from the solid s (a cylinder, an ellipsoid or a box) towards the segment a-b
+    swept by radius [m] (0: the bare segment), the point midway in the overlap, the segment's parameter
+    t in [0, 1] of its nearest point): radius less the distance of the segment from s, the nearest point
+    found by golden-section search (the signed distance to a convex solid is convex along a segment)."""
     t = 0.0
-    if h > 0.0:
+    dd = (b0 - a0) ** 2 + (b1 - a1) ** 2 + (b2 - a2) ** 2
+    if dd > 0.0:
         lo, hi = 0.0, 1.0
         g = 0.6180339887498949
         u, v = hi - g * (hi - lo), lo + g * (hi - lo)
@@ -350,10 +364,30 @@ def rounded_penetration(kind_r, Pr, pr, kind_s, Ps, ps):
                 v = lo + g * (hi - lo)
                 fv = _signed_distance(kind_s, Ps, ps, a0 + v * (b0 - a0), a1 + v * (b1 - a1), a2 + v * (b2 - a2))[0]
         t = 0.5 * (lo + hi)
+        # the ends themselves (the search's bracket never reaches them)
+        f0 = _signed_distance(kind_s, Ps, ps, a0, a1, a2)[0]
+        f1 = _signed_distance(kind_s, Ps, ps, b0, b1, b2)[0]
+        ft = _signed_distance(kind_s, Ps, ps, a0 + t * (b0 - a0), a1 + t * (b1 - a1), a2 + t * (b2 - a2))[0]
+        if f0 < ft and f0 <= f1:
+            t = 0.0
+        elif f1 < ft:
+            t = 1.0
     dist, n0, n1, n2, g0, g1, g2 = _signed_distance(kind_s, Ps, ps, a0 + t * (b0 - a0), a1 + t * (b1 - a1),
                                                     a2 + t * (b2 - a2))
-    depth = pr[0] - dist
+    depth = radius - dist
     if not depth > 0.0:
-        return 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, t
     hd = 0.5 * depth
-    return depth, n0, n1, n2, g0 - hd * n0, g1 - hd * n1, g2 - hd * n2
+    return depth, n0, n1, n2, g0 - hd * n0, g1 - hd * n1, g2 - hd * n2, t
+
+
+@kernel(_nrt=False)
+def rounded_penetration(kind_r, Pr, pr, kind_s, Ps, ps):
+    """(depth [m], unit normal from the solid shape s (a cylinder, an ellipsoid or a box) towards the rounded
+    one r (a sphere or capsule: a point or a segment swept by its radius), the point midway in the overlap):
+    `segment_penetration` of r's core."""
+    h = pr[1] if kind_r == CAPSULE else 0.0
+    a0, a1, a2 = to_ground(Pr, 0.0, 0.0, -h)
+    b0, b1, b2 = to_ground(Pr, 0.0, 0.0, h)
+    depth, n0, n1, n2, p0, p1, p2, _t = segment_penetration(kind_s, Ps, ps, a0, a1, a2, b0, b1, b2, pr[0])
+    return depth, n0, n1, n2, p0, p1, p2

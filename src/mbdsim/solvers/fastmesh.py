@@ -10,7 +10,9 @@ axes; an explicit stack, sc[30]) and, per triangle met (its outward normal m by 
   touching when nearer than the radius, with the normal from that point to the centre;
 * any other shape: its candidate points against the triangle's plane (solvers.fastnarrow.candidate:
   vertices, cylinder rim points, the ellipsoid's deepest point) that lie below it (by less than the
-  shape's bounding radius) and whose foot lies on the triangle, with normal m.
+  shape's bounding radius) and whose foot lies on the triangle, with normal m; none when the shape's
+  centre (`interior_point`) lies behind the triangle's plane (the far side of a closed mesh thinner than
+  the shape, whose vertices lie behind it by less than the bounding radius: not a contact).
 
 The points of one candidate met through several triangles are merged per normal direction (normals within
 COS_SAME of the slot's mean count as one: a point over a shared edge of a flat or gently curved mesh is
@@ -21,7 +23,9 @@ the normal).  They are left in the slot rows of sc[29] (used, depth [m], point [
 which solvers.fastcontact applies.
 
 For a box or hull the walk also collects the mesh's ridges and peaks inside it (solvers.fastridge), in
-the RIDGE_ROWS rows after the candidates' slots.  Two triangle meshes: solvers.fastmeshpair.
+the RIDGE_ROWS rows after the candidates' slots; for a capsule, a cylinder or an ellipsoid likewise the
+ridges and peaks that press into its curved surface (fastridge.curved_ridge_points: a cylinder lying along
+a ridge, a capsule across one, an ellipsoid on a peak).  Two triangle meshes: solvers.fastmeshpair.
 """
 from __future__ import annotations
 
@@ -29,8 +33,8 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import BOX, CAPSULE, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
-from .fastridge import ridge_points
+from .fastnarrow import BOX, CAPSULE, CYLINDER, ELLIPSOID, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastridge import curved_ridge_points, ridge_points
 
 NSLOT = 4          # contact directions kept per candidate point
 COS_SAME = 0.95    # normals closer than this (cosine) are one direction
@@ -150,6 +154,18 @@ def point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2
 
 
 @kernel(_nrt=False)
+def interior_point(kind, Px, verts, v0, v1):
+    """A ground point inside a convex shape (pose Px): the mean of a convex hull's vertices rows v0..v1, else
+    the origin of its local frame (the centre of a box, cylinder, ellipsoid)."""
+    if kind != HULL or v1 <= v0:
+        return Px[0], Px[1], Px[2]
+    s0 = s1 = s2 = 0.0
+    for k in range(v0, v1):
+        s0, s1, s2 = s0 + verts[k, 0], s1 + verts[k, 1], s2 + verts[k, 2]
+    return to_ground(Px, s0 / (v1 - v0), s1 / (v1 - v0), s2 / (v1 - v0))
+
+
+@kernel(_nrt=False)
 def _triangle(sc, x, Px, Pm, t, S, cap):
     """Shape x (pose Px) against triangle t of the mesh (pose Pm): its points no deeper than cap [m] into
     the slots S."""
@@ -174,6 +190,9 @@ def _triangle(sc, x, Px, Pm, t, S, cap):
             h = 0.5 * (p[0] - dist)
             _keep(S, k, p[0] - dist, q0 - h * n0, q1 - h * n1, q2 - h * n2, n0, n1, n2)
         return
+    o0, o1, o2 = interior_point(kd, Px, verts, sv[x, 0], sv[x, 1])
+    if not m0 * (o0 - a0) + m1 * (o1 - a1) + m2 * (o2 - a2) > 0.0:
+        return   # the shape's centre behind the triangle: a far face of a closed mesh, not a contact
     for k in range(n_candidates(kd, sv[x, 1] - sv[x, 0])):
         y0, y1, y2 = candidate(kd, Px, p, verts, sv[x, 0], m0, m1, m2, k)
         point_below(S, k, y0, y1, y2, a0, a1, a2, b0, b1, b2, c0, c1, c2, m0, m1, m2, cap)
@@ -209,6 +228,7 @@ def mesh_points(sc, x, msh, Px, Pm):
     nrow = min(nc * NSLOT, S.shape[0])
     clear_slots(S, nrow)
     ridges = kd == BOX or kd == HULL
+    curved = kd == CAPSULE or kd == CYLINDER or kd == ELLIPSOID
     nxt = nrow
     # x's ground box, as a box in the mesh's axes
     g0, g1, g2 = 0.5 * (BB[x, 0] + BB[x, 3]) - Pm[0], 0.5 * (BB[x, 1] + BB[x, 4]) - Pm[1], \
@@ -234,6 +254,8 @@ def mesh_points(sc, x, msh, Px, Pm):
                     _triangle(sc, x, Px, Pm, t, S, cap)
                     if ridges:
                         nxt = ridge_points(sc, x, Px, Pm, t, S, nxt)
+                    elif curved:
+                        nxt = curved_ridge_points(sc, x, Px, Pm, t, S, nxt)
         elif top + 2 <= stack.shape[0]:
             stack[top] = links[nd, 0]
             stack[top + 1] = links[nd, 1]

@@ -17,6 +17,7 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 
 SPHERE, PLANE, BOX, CYLINDER, CAPSULE, ELLIPSOID, HULL, MESH = 0, 1, 2, 3, 4, 5, 6, 7
 POLYTOPES = (BOX, HULL)
+LINE_SIN = 0.02   # sine of the largest angle between two axes (or an axis and an edge) that still touch along a line
 KIND_NAMES = ("sphere", "plane", "box", "cylinder", "capsule", "ellipsoid", "convex mesh", "mesh")
 _BOX_SIGNS = np.array([[sx, sy, sz] for sx in (-1.0, 1.0) for sy in (-1.0, 1.0) for sz in (-1.0, 1.0)])
 
@@ -174,3 +175,53 @@ def segments_closest(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2):
         t = 1.0
         s = min(max((B - C) / A_, 0.0), 1.0) if A_ > 0.0 else 0.0
     return (a0 + s * d0, a1 + s * d1, a2 + s * d2), (c0 + t * f0, c1 + t * f1, c2 + t * f2)
+
+
+@kernel(_nrt=False)
+def deepest_on_face(sc, x, ref, g, Px, Pr, q0, q1, q2, m0, m1, m2):
+    """Whether a deepest candidate point of the curved shape x below face g (point q, outward normal m) of
+    the polyhedron ref lies over that face (inside its other planes): then the face's normal is the contact
+    normal (a cylinder lying on the face, a sphere on it); else x presses on an edge or a vertex."""
+    kind, prm, sv, verts, spl, planes, rad = sc[1], sc[4], sc[6], sc[7], sc[8], sc[9], sc[5]
+    nc = n_candidates(kind[x], sv[x, 1] - sv[x, 0])
+    D = support_depth(kind[x], Px, prm[x], verts, sv[x, 0], sv[x, 1] - sv[x, 0], q0, q1, q2, m0, m1, m2)
+    tol = 1e-6 * rad[ref] + 1e-12
+    for k in range(nc):
+        c0, c1, c2 = candidate(kind[x], Px, prm[x], verts, sv[x, 0], m0, m1, m2, k)
+        if m0 * (q0 - c0) + m1 * (q1 - c1) + m2 * (q2 - c2) >= D - tol and \
+                inside_except(Pr, planes, spl[ref, 0], spl[ref, 1] - spl[ref, 0], g, c0, c1, c2, tol):
+            return True
+    return False
+
+
+@kernel(_nrt=False)
+def exit_depth(P, planes, p0_, p1_, v0, v1, v2, m0, m1, m2):
+    """Distance [m] from the point v inside a polyhedron (pose P) to its surface along -m."""
+    y0, y1, y2 = to_local(P, v0, v1, v2)
+    u0, u1, u2 = dir_local(P, m0, m1, m2)
+    best = np.inf
+    for g in range(p0_, p1_):
+        nm = planes[g, 0] * u0 + planes[g, 1] * u1 + planes[g, 2] * u2
+        if nm < -1e-12:
+            t = (planes[g, 0] * y0 + planes[g, 1] * y1 + planes[g, 2] * y2 - planes[g, 3]) / nm
+            if t < best:
+                best = t
+    return best
+
+
+@kernel(_nrt=False)
+def pressed(Px, Pr, verts, x0_, x1_, planes, p0_, p1_, g, v0, v1, v2, m0, m1, m2, q0, q1, q2, tol):
+    """Whether an incident vertex that `_against` used (below the reference face g, inside the reference)
+    lies on the normal line through the reference vertex v (within tol [m])."""
+    for k in range(x0_, x1_):
+        u0, u1, u2 = to_ground(Px, verts[k, 0], verts[k, 1], verts[k, 2])
+        if not m0 * (q0 - u0) + m1 * (q1 - u1) + m2 * (q2 - u2) > 0.0:
+            continue
+        if not inside_except(Pr, planes, p0_, p1_ - p0_, g, u0, u1, u2, tol):
+            continue
+        e0, e1, e2 = u0 - v0, u1 - v1, u2 - v2
+        en = e0 * m0 + e1 * m1 + e2 * m2
+        e0, e1, e2 = e0 - en * m0, e1 - en * m1, e2 - en * m2
+        if e0 * e0 + e1 * e1 + e2 * e2 <= tol * tol:
+            return True
+    return False
