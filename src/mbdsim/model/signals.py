@@ -68,7 +68,7 @@ class SignalsMixin:
         self.__dict__.setdefault("inputs", {})[name] = inp
         return inp
 
-    def add_function(self, name: str, function) -> Any:
+    def add_function(self, name: str, function: Any) -> Any:
         """Make the compiled function `function` callable as `name(x, ...)` in the model's load, sensor
         and output expressions: a `numba.njit` function or a `numba.cfunc` of 1 to 6 float64 arguments
         returning a float64, in the SI units of what it computes (mbdsim.userfunctions). The compiled
