@@ -7,32 +7,16 @@ import numpy as np
 import pytest
 
 import mbdsim as mb
+from test_shape_contact_ridge import _up, ridges   # faces turned up; two tents along y, ridges at x = +-0.03
 
 G, K, E = 9.81, 1e6, 1.5
 H, W = 0.02, 0.04   # tent: ridge height and half width [m]
-
-
-def _up(v, f):
-    f = np.array(f)
-    n = np.cross(v[f[:, 1]] - v[f[:, 0]], v[f[:, 2]] - v[f[:, 0]])
-    f[n[:, 2] < 0] = f[n[:, 2] < 0][:, ::-1]
-    return f
 
 
 def tent():
     """A tent along x (one ridge edge at y = 0, z = H, x in [-0.3, 0.3]) on a flat floor z = 0."""
     prof = [(-0.3, 0.0), (-W, 0.0), (0.0, H), (W, 0.0), (0.3, 0.0)]
     v = np.array([(x, y, z) for y, z in prof for x in (-0.3, 0.3)])
-    f = []
-    for i in range(len(prof) - 1):
-        f += [(2 * i, 2 * i + 2, 2 * i + 3), (2 * i, 2 * i + 3, 2 * i + 1)]
-    return v, _up(v, f)
-
-
-def two_ridges():
-    """Two tents along y (ridges at x = -0.03 and 0.03, height H) on a flat floor."""
-    prof = [(-0.3, 0.0), (-0.06, 0.0), (-0.03, H), (0.0, 0.0), (0.03, H), (0.06, 0.0), (0.3, 0.0)]
-    v = np.array([(x, y, z) for x, z in prof for y in (-0.3, 0.3)])
     f = []
     for i in range(len(prof) - 1):
         f += [(2 * i, 2 * i + 2, 2 * i + 3), (2 * i, 2 * i + 3, 2 * i + 1)]
@@ -179,7 +163,7 @@ def test_cylinder_and_capsule_rest_across_two_ridges_by_the_lever_rule(geo, c):
     shape = mb.Cylinder(r, 0.1, axis="x") if geo == "cylinder" else mb.Capsule(r, 0.1, axis="x")
     m = mb.Model(gravity=(0, 0, -G))
     b = m.add_body("b", mass, (1e-4, 2e-4, 2e-4), position=(c, 0.0, H + r - d.mean()))
-    fl = m.ground.add_shape("floor", mb.Mesh(*two_ridges()))
+    fl = m.ground.add_shape("floor", mb.Mesh(*ridges()))
     m.add_contact("c", fl, b.add_shape("geo", shape), k, e, 300.0, 1e-5, mu=0.5, friction_velocity=1e-3)
     res = mb.simulate(m, 0.3, 0.01, method="dop853", rtol=1e-8)
     assert res.success
