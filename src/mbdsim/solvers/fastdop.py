@@ -24,7 +24,7 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
-from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _friction_g, _project,  # noqa: F401
+from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _end_at, _friction_g, _project,  # noqa: F401
                           _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, initial_step)
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows,
                       project, read_state, rhs, tree_project, write_state)
@@ -224,30 +224,16 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             if have_F and not computed:
                 stats[2] += 3
             if t_ev < np.inf:
-                while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
-                    iout -= 1
-                _dense(F, y, t, h, t_ev, yo)
-                s_ = _project(cm, wk, t_ev, yo, proj_tol, bool(True))
-                stats[3] += 1
-                for i in range(n):
-                    y[i] = yo[i]
-                st[0], st[1] = t_ev, h
-                return (FRICTION_EVENT if s_ == OK else s_), iout
+                return _end_at(cm, wk, F, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(False),
+                               bool(True), FRICTION_EVENT)
         if n_sensors > 0:
             computed = have_F
             t_stop, have_F = _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale)
             if have_F and not computed:
                 stats[2] += 3
             if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
-                while iout > 0 and tout[iout - 1] > t_stop + 1e-14 * max(1.0, abs(t_stop)):
-                    iout -= 1
-                _dense(F, y, t, h, t_stop, yo)
-                s_ = _project(cm, wk, t_stop, yo, proj_tol, bool(False))
-                stats[3] += 1
-                for i in range(n):
-                    y[i] = yo[i]
-                st[0], st[1] = t_stop, h
-                return (SENSOR_STOP if s_ == OK else s_), iout
+                return _end_at(cm, wk, F, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo, bool(False),
+                               bool(False), SENSOR_STOP)
         for i in range(n):
             y[i] = ynew[i]
         if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the projection onto

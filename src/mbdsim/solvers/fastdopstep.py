@@ -133,6 +133,24 @@ def _at(F, y0, t0, h, t, out, cubic):
         _dense(F, y0, t0, h, t, out)
 
 
+@kernel(_nrt=False, inline="always")
+def _end_at(cm, wk, F, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo, cubic, exact, status):
+    """End the step (t0, h) from y at an event t_ev [s]: the outputs after it are dropped (a restart writes
+    them again), y becomes the step's interpolant (`_at`: DOP853's dense output, or with `cubic` an implicit
+    step's polynomial) at t_ev projected onto the constraints (`_project` with `exact`), st = (t_ev, h);
+    (`status`, or the projection's failure, and the next iout). Shared by DOP853's friction events and
+    stop sensors (solvers.fastdop) and the implicit steppers' friction events (solvers.fastswitch)."""
+    while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
+        iout -= 1
+    _at(F, y, t0, h, t_ev, yo, cubic)
+    s_ = _project(cm, wk, t_ev, yo, proj_tol, exact)
+    stats[3] += 1
+    for i in range(y.shape[0]):
+        y[i] = yo[i]
+    st[0], st[1] = t_ev, h
+    return (status if s_ == OK else s_), iout
+
+
 @kernel(_nrt=False)
 def _signal(cm, wk, t, y, yo, g, which):
     """The watched signals at state y and t [s] into g: the sensors (which = 0, `_sensor_g`) or the

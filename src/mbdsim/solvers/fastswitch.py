@@ -18,9 +18,8 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastdop import FRICTION_EVENT, _friction_g, _project
-from .fastdopstep import _dense_cubic, _sensor_time
-from .fastdyn import OK
+from .fastdop import FRICTION_EVENT, _friction_g
+from .fastdopstep import _dense_cubic, _end_at, _sensor_time
 
 
 dense = _dense_cubic   # the step's polynomial (fastdopstep)
@@ -60,12 +59,5 @@ def stop_at(cm, wk, Q, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo):
     """End the step (t0, h) from y at the event t_ev [s]: the outputs after it are dropped (the restart
     writes them again), y becomes the step's polynomial state at t_ev projected onto the constraints
     (positions and velocities), st[0] = t_ev; (FRICTION_EVENT or the projection's failure, next iout)."""
-    while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
-        iout -= 1
-    dense(Q, y, t0, h, t_ev, yo)
-    s_ = _project(cm, wk, t_ev, yo, proj_tol, bool(True))
-    stats[3] += 1
-    for i in range(y.shape[0]):
-        y[i] = yo[i]
-    st[0], st[1] = t_ev, h
-    return (FRICTION_EVENT if s_ == OK else s_), iout
+    return _end_at(cm, wk, Q, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(True), bool(True),
+                   FRICTION_EVENT)
