@@ -119,3 +119,17 @@ def test_entries_load_without_parsing_their_bitcode():
     hits, misses = map(int, lines[0].split()[:2])
     assert hits >= 1 and misses == 0
     assert lines[2].split() == ["1", "1", "0"]
+
+
+def test_the_lazy_imports_freeze_what_they_built():
+    """`mbdsim._load`: the import objects (numba's ~10^5) go to the collector's permanent generation, so
+    that later full collections and the interpreter's exit skip them; MBDSIM_GC_FREEZE=0 turns it off;
+    objects made after the import are collected as always."""
+    code = ("import gc, mbdsim as mb\nmb.simulate\nn = gc.get_freeze_count()\n"
+            "class A: pass\na = A(); a.me = a; import weakref; w = weakref.ref(a); del a\ngc.collect()\n"
+            "print(n, int(w() is None), int(gc.isenabled()))")
+    frozen, collected, enabled = map(int, _run(code)[0].split())
+    assert frozen > 20000 and collected == 1 and enabled == 1
+    off = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=300,
+                         env={**__import__("os").environ, "MBDSIM_GC_FREEZE": "0"})
+    assert off.stdout.split()[0] == "0", off.stderr[-2000:]

@@ -290,9 +290,13 @@ def show_warning(message, category, filename, lineno, file=None, line=None, _see
 
 def main(argv: Optional[List[str]] = None) -> None:
     """Console-script entry point (``mbdsim = "mbdsim.cli.app:main"``)."""
+    import gc
     import warnings
     warnings.showwarning = show_warning
-    app(args=argv, prog_name="mbdsim")
+    try:
+        app(args=argv, prog_name="mbdsim")
+    finally:   # the command is done and its files closed: the interpreter's exit need not traverse the
+        gc.freeze()   # ~10^5 objects of numba's and the kernels' loading again (0.1 s of every call; issue 32)
 
 
 if __name__ == "__main__":  # pragma: no cover
