@@ -69,3 +69,65 @@ def test_hull_wedge_rests_ridge_down_on_a_box_face():
     last = pts[pts.time == pts.time.max()]
     assert len(last) == 2
     assert np.allclose(last["penetration"].to_numpy(), d, rtol=1e-3)
+
+
+def _brute_edge_axes(verts, edges, poses):
+    """All edge pairs of two convex hulls: the axes along which each edge supports its shape (a's edge
+    along +L, b's along -L), by the support over every vertex: (any separates, least depth, its L)."""
+    X = [v @ R.T + o for v, (o, R) in zip(verts, poses)]
+    best, L_best, separated = np.inf, None, False
+    for i0, i1 in edges[0]:
+        ea = X[0][i1] - X[0][i0]
+        for j0, j1 in edges[1]:
+            eb = X[1][j1] - X[1][j0]
+            L = np.cross(ea, eb)
+            if np.linalg.norm(L) < 1e-6 * np.linalg.norm(ea) * np.linalg.norm(eb):
+                continue
+            L /= np.linalg.norm(L)
+            for sgn in (1.0, -1.0):
+                x = sgn * L
+                pa, pb = X[0] @ x, X[1] @ x
+                tol = 1e-9
+                if min(pa[i0], pa[i1]) < pa.max() - tol or max(pb[j0], pb[j1]) > pb.min() + tol:
+                    continue   # an edge that does not support its shape along the axis
+                D = pa.max() - pb.min()
+                separated |= not D > 0.0
+                if D < best:
+                    best, L_best = D, x
+    return separated, best, L_best
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_gauss_map_edge_axes_match_the_support_of_every_edge_pair(seed):
+    """fastedges.hull_edges tests only the edge pairs whose Gauss-map arcs cross: its verdict (separated or
+    not), least depth and axis match testing every edge pair by the support of all vertices."""
+    from mbdsim.geometry.pack import pack_contacts
+    from mbdsim.solvers.fastedges import hull_edges
+    from mbdsim.system.assemble import assemble_system
+    from mbdsim.system.frames import body_frames
+    from mbdsim.solvers.fastnarrow import pose
+    rng = np.random.default_rng(seed)
+    m = mb.Model()
+    a = m.add_body("a", 1.0, (1, 1, 1))
+    b = m.add_body("b", 1.0, (1, 1, 1), position=tuple(rng.normal(size=3) * 0.08))
+    ga = mb.ConvexMesh(rng.normal(size=(14, 3)) * (0.1, 0.06, 0.08))
+    gb = mb.ConvexMesh(rng.normal(size=(10, 3)) * 0.07) if seed % 2 else mb.Box((0.1, 0.14, 0.06))
+    q = rng.normal(size=4)
+    q /= np.linalg.norm(q)
+    w, x, y, z = q
+    Rb = np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                   [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                   [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]])
+    c = m.add_contact("c", a.add_shape("g", ga), b.add_shape("g", gb, orientation=Rb), 1e5, 1.5, 10, 1e-3)
+    sys = assemble_system(m)
+    sc = pack_contacts(sys, [c])
+    fr = body_frames(sys, sys.q0, sys.v0)
+    P = [pose(fr.r, fr.A, sc[0][s], sc[2][s], sc[3][s]) for s in range(2)]
+    st, p0, p1, p2, L0, L1, L2, D = hull_edges(sc, 0, 1, P[0], P[1], np.inf, 0.0, 0.0, 0.0)
+    verts = [sc[7][sc[6][s, 0]:sc[6][s, 1]] for s in range(2)]
+    edges = [sc[32][sc[31][s, 0]:sc[31][s, 1]] - sc[6][s, 0] for s in range(2)]
+    poses = [(np.array(p[:3]), np.array(p[3:]).reshape(3, 3)) for p in P]
+    separated, best, L_ref = _brute_edge_axes(verts, edges, poses)
+    assert st == (-1 if separated else 1), (st, separated, best)
+    if not separated:
+        assert abs(D - best) < 1e-12 and np.allclose((L0, L1, L2), L_ref, atol=1e-9), (D, best)

@@ -52,16 +52,23 @@ def hull_planes(mesh) -> np.ndarray:
     return np.column_stack([n, d])[np.sort(idx)]
 
 
-def _edges(kind, shape) -> np.ndarray:
-    """Edges (ne, 2: local vertex rows) of a box or hull (coplanar-face diagonals left out), else none."""
+def _edges(kind, shape) -> tuple:
+    """(edges (ne, 2: local vertex rows), normals (ne, 6): the outward unit normals of the two faces that
+    meet at each edge, shape axes) of a box or hull (coplanar-face diagonals left out), else none."""
     if kind == BOX:
-        return np.array([(i, j) for i in range(8) for j in range(i + 1, 8)
-                         if np.count_nonzero(_BOX_SIGNS[i] != _BOX_SIGNS[j]) == 1], np.int64)
+        ed = [(i, j) for i in range(8) for j in range(i + 1, 8)
+              if np.count_nonzero(_BOX_SIGNS[i] != _BOX_SIGNS[j]) == 1]
+        nrm = []
+        for i, j in ed:
+            a, b = [k for k in range(3) if _BOX_SIGNS[i][k] == _BOX_SIGNS[j][k]]   # the faces' axes
+            nrm.append(np.concatenate([np.eye(3)[a] * _BOX_SIGNS[i][a], np.eye(3)[b] * _BOX_SIGNS[i][b]]))
+        return np.array(ed, np.int64), np.array(nrm, float)
     if kind == HULL:
         m = shape.geometry.mesh
         sharp = np.asarray(m.face_adjacency_angles) > 1e-6
-        return np.asarray(m.face_adjacency_edges, np.int64)[sharp].reshape(-1, 2)
-    return np.zeros((0, 2), np.int64)
+        fn = np.asarray(m.face_normals, float)[np.asarray(m.face_adjacency, np.int64)[sharp]]
+        return np.asarray(m.face_adjacency_edges, np.int64)[sharp].reshape(-1, 2), fn.reshape(-1, 6)
+    return np.zeros((0, 2), np.int64), np.zeros((0, 6))
 
 
 def _local(shape):
@@ -97,7 +104,8 @@ def pack_contacts(sys, elems) -> tuple:
     triangle of (22) its ridge and peak bits (nt,: geometry.ridges, solvers.fastridge), (34) the node boxes of
     (27) swept along their triangles' inward normals (nn, 6: geometry.bvh.swept, solvers.fastmeshpair), (35) per
     triangle of (22) and corner e the triangle across its edge e, e + 1, or -1 (nt, 3: geometry.ridges.
-    ridge_neighbours, the normal-cone test of solvers.fastridge.curved_ridge_points)."""
+    ridge_neighbours, the normal-cone test of solvers.fastridge.curved_ridge_points), (36) per edge of (32) the
+    outward unit normals of its two faces (ne, 6: shape axes; the Gauss-map test of solvers.fastedges)."""
     from ..solvers.fastcontact import NREC
     from ..solvers.fastgjk import MAX_ITER
     from ..solvers.fastmesh import NSLOT, RIDGE_ROWS
@@ -106,6 +114,7 @@ def pack_contacts(sys, elems) -> tuple:
     from .ridges import ridge_masks, ridge_neighbours
     index, rows, verts, planes, pairs, par = {}, [], [], [], [], []
     lbox, meta, tris, nodes, links, eran, edges, rmask, sweep, nbr = [], [], [], [], [], [], [], [], [], []
+    enrm = []
     nv = npl = nt = nn = ne = 0
     for ei, e in enumerate(elems):
         for a, b in e.pairs:
@@ -137,8 +146,10 @@ def pack_contacts(sys, elems) -> tuple:
                         m = (nt, nt + len(f), nn, nn + len(nb))
                         nt, nn = nt + len(f), nn + len(nb)
                     meta.append(m)
-                    ed = _edges(kind, s) + nv
+                    ed, en = _edges(kind, s)
+                    ed = ed + nv
                     edges.append(ed)
+                    enrm.append(en)
                     eran.append((ne, ne + len(ed)))
                     ne += len(ed)
                     verts.append(v)
@@ -173,7 +184,8 @@ def pack_contacts(sys, elems) -> tuple:
             np.concatenate(edges).reshape(-1, 2) if edges else np.zeros((0, 2), np.int64),
             np.concatenate(rmask) if rmask else np.zeros(0, np.int64),
             np.concatenate(sweep).reshape(-1, 6) if sweep else np.zeros((0, 6)),
-            np.concatenate(nbr).reshape(-1, 3) if nbr else np.zeros((0, 3), np.int64))
+            np.concatenate(nbr).reshape(-1, 3) if nbr else np.zeros((0, 3), np.int64),
+            np.concatenate(enrm).reshape(-1, 6) if enrm else np.zeros((0, 6)))
 
 
 def empty_contacts() -> tuple:
@@ -184,4 +196,4 @@ def empty_contacts() -> tuple:
             z((0, 4)), z((0, 2), i), z((0, 11)), z((0, NREC)), z(1, i), z((0, 6)), z(1, i), z((0, 2), i),
             z((0, 12)), z((0, 6)), z((3, 0), i), z(4, i), z((0, 4), i), z((0, 3), i), z((0, 6)), z((0, 3), i),
             z((0, 5)), z((0, 2), i), z((0, 6)), z((0, 4), i), z((0, 9)), z(0, i), z((0, 2), i), z((0, 2), i),
-            z(0, i), z((0, 6)), z((0, 3), i))
+            z(0, i), z((0, 6)), z((0, 3), i), z((0, 6)))
