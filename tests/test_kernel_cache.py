@@ -107,6 +107,10 @@ def test_compile_note_one_line_after_the_delay(tmp_path, monkeypatch):
     seconds, count = json.loads((tmp_path / "compile-times.json").read_text())["solvers.fastdop.run"]
     assert 0.2 < seconds < 5.0 and count == 2   # the next estimate: this machine's last time
     assert f"about {_compilenote.ESTIMATE_S:.0f} s" in lines[0]   # no record yet: the default
+    note.on_start(outer)          # a later compilation of fewer kernels (its callees cached) keeps the record
+    time.sleep(0.06)
+    note.on_end(outer)
+    assert json.loads((tmp_path / "compile-times.json").read_text())["solvers.fastdop.run"] == [seconds, 2]
 
 
 def test_cache_info_and_clear(tmp_path, monkeypatch):

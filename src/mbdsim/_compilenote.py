@@ -9,7 +9,7 @@ kernels: when a compilation (with the kernels it calls) is still going after DEL
 
 (once per process) and, where `mbdsim._progress.interactive()` (a terminal or a Jupyter kernel), shows a
 transient bar of the kernels compiled while each compilation lasts. The estimate is that of the last
-compilation of the same kernel on this machine (kept in `base_dir()/compile-times.json`, whatever the
+compilation of the same kernel on this machine that compiled the most kernels (kept in `base_dir()/compile-times.json`, whatever the
 version), else ESTIMATE_S. Set MBDSIM_QUIET_COMPILE=1 to silence it. Nothing is printed for loads from the
 cache (a fraction of a second).
 """
@@ -44,8 +44,13 @@ def _load_times() -> dict:
 
 
 def _save_time(name: str, seconds: float, count: int) -> None:
+    """Record the compilation of `name` that compiled `count` kernels in `seconds`, unless an earlier one
+    compiled more (a compilation whose callees were cached is no estimate for a full one: it said
+    "about 3 s" before minutes of compiling after an edit of the kernels)."""
     try:
         times = _load_times()
+        if count < times.get(name, (0.0, 0))[1]:
+            return
         times[name] = [round(seconds, 1), count]
         path = _times_file()
         path.parent.mkdir(parents=True, exist_ok=True)
