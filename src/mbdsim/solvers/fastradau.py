@@ -31,6 +31,7 @@ from .._jit import entry, kernel
 from .fastdop import CHECKPOINTS_FULL, _project
 from .fastdopstep import initial_step
 from .fastdyn import CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, read_state, rhs, write_state
+from .kkt_tree import lu_factor, lu_solve
 from .fastswitch import dense, friction_event, start, stop_at  # noqa: F401  (dense: the steps' polynomial, also HHT's)
 
 S6 = 6.0 ** 0.5
@@ -68,49 +69,15 @@ N_ST = 10
 
 @kernel(_nrt=False)
 def _lu(A, piv):
-    """In-place LU factorisation with partial pivoting (real or complex A, n x n); piv: row swaps.
-    False when a pivot is zero or not finite."""
-    n = A.shape[0]
-    for k in range(n):
-        p = k
-        amax = abs(A[k, k])
-        for i in range(k + 1, n):
-            a = abs(A[i, k])
-            if a > amax:
-                amax, p = a, i
-        piv[k] = p
-        if not (amax > 0.0 and np.isfinite(amax)):
-            return False
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-        inv = 1.0 / A[k, k]
-        for i in range(k + 1, n):
-            A[i, k] *= inv
-            m = A[i, k]
-            for j in range(k + 1, n):
-                A[i, j] -= m * A[k, j]
-    return True
+    """In-place LU factorisation with partial pivoting of A (n x n, real or complex: `kkt_tree.lu_factor`,
+    the project's one LU); piv: row swaps. False when a pivot is zero or not finite."""
+    return lu_factor(A, A.shape[0], piv, 0.0)
 
 
 @kernel(_nrt=False)
 def _lu_solve(A, piv, b):
-    """Solve with the factors of `_lu` in place of b (real or complex)."""
-    n = A.shape[0]
-    for k in range(n):
-        p = piv[k]
-        if p != k:
-            b[k], b[p] = b[p], b[k]
-    for i in range(n):
-        acc = b[i]
-        for j in range(i):
-            acc -= A[i, j] * b[j]
-        b[i] = acc
-    for i in range(n - 1, -1, -1):
-        acc = b[i]
-        for j in range(i + 1, n):
-            acc -= A[i, j] * b[j]
-        b[i] = acc / A[i, i]
+    """Solve with the factors of `_lu` in place of b (real or complex: `kkt_tree.lu_solve`)."""
+    lu_solve(A, piv, A.shape[0], b)
 
 
 @kernel(_nrt=False)

@@ -345,7 +345,8 @@ def dense_factor(Jc, bi, bj, M6, active, KD, piv):
 def lu_factor(A, n, piv, rel_tol):
     """LU with partial pivoting of the leading n x n block of A in place (L unit lower below the diagonal,
     U on and above it), the row swaps in piv[:n]; False when a pivot is not above rel_tol times the
-    largest entry (singular to that tolerance). Used by `dense_factor` and `kkt_square.square_factor`."""
+    largest entry (singular to that tolerance). Used by `dense_factor`, `kkt_square.square_factor` and the
+    implicit steppers (fastradau._lu: real and complex)."""
     scale = 0.0
     for i in range(n):
         for j in range(n):

@@ -20,7 +20,7 @@ force frame (nt,) and point (nt, 3) of body_j (where a slide's load pair acts), 
 index (m,) (-1: a coupler row; else a motion driver's row X - g(t), one term, with g, g', g'' taken from
 fastdyn.drivers_at into cw[15] by `take_drivers`) and its wrap flag (m,) (1: an angle, wrapped to +-pi).
 cw = wk[49]: x, stack, X (nt), Xd (nt), Av (nt), fv (m), gam (m), nu (m), MiAT (m, nj), Smat (m, m),
-lam (m), b (m), ydot (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3).
+lam (m), b (m), ydot (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3), LU row swaps (m,).
 """
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
+from .kkt_tree import lu_factor, lu_solve
 from ..system.exprvm import eval_program
 from . import fasttree
 
@@ -146,33 +147,12 @@ def unit_pass(tree, tw, r, tau, out):
 
 
 @kernel(_nrt=False)
-def _gauss(Mt, b, n):
-    """Solve Mt x = b (n x n, partial pivoting) in place (x into b, Mt destroyed); False if singular."""
-    big = 0.0
-    for i in range(n):
-        for j in range(n):
-            big = max(big, abs(Mt[i, j]))
-    for k in range(n):
-        piv, at = 0.0, k
-        for i in range(k, n):
-            if abs(Mt[i, k]) > piv:
-                piv, at = abs(Mt[i, k]), i
-        if not piv > 1e-13 * big:
-            return False
-        if at != k:
-            for j in range(n):
-                Mt[k, j], Mt[at, j] = Mt[at, j], Mt[k, j]
-            b[k], b[at] = b[at], b[k]
-        for i in range(k + 1, n):
-            g = Mt[i, k] / Mt[k, k]
-            for j in range(k, n):
-                Mt[i, j] -= g * Mt[k, j]
-            b[i] -= g * b[k]
-    for k in range(n - 1, -1, -1):
-        acc = b[k]
-        for j in range(k + 1, n):
-            acc -= Mt[k, j] * b[j]
-        b[k] = acc / Mt[k, k]
+def _gauss(cw, b, n):
+    """b <- S^-1 b for S = cw[9] (n x n; destroyed) by `kkt_tree.lu_factor` (partial pivoting, the row
+    swaps in cw[16]); False if singular."""
+    if not lu_factor(cw[9], n, cw[16], 1e-13):
+        return False
+    lu_solve(cw[9], cw[16], n, b)
     return True
 
 
@@ -214,14 +194,14 @@ def constrain(co, cw, tree, tw, t, y, r, ydot):
     values(co, cw, t, y, nj, True)
     _metric(co, cw, tree, tw, r, nj)
     _schur(co, cw)
-    Av, gam, MiAT, Sm, lam = cw[4], cw[6], cw[8], cw[9], cw[10]
+    Av, gam, MiAT, lam = cw[4], cw[6], cw[8], cw[10]
     m = ptr.shape[0] - 1
     for i in range(m):
         s = -gam[i]
         for j in range(ptr[i], ptr[i + 1]):
             s += Av[j] * ydot[nj + q[j]]
         lam[i] = s
-    if not _gauss(Sm, lam, m):
+    if not _gauss(cw, lam, m):
         return False
     for i in range(m):
         li = lam[i]
@@ -259,7 +239,7 @@ def newton(co, cw, t, y, tol):
     nj = y.shape[0] // 2
     q, ptr = co[0], co[3]
     m = ptr.shape[0] - 1
-    Av, fv, nu, MiAT, Sm, b = cw[4], cw[5], cw[7], cw[8], cw[9], cw[11]
+    Av, fv, nu, MiAT, b = cw[4], cw[5], cw[7], cw[8], cw[11]
     done = False
     for it in range(12):
         fmax, xmax = values(co, cw, t, y, nj, False)
@@ -271,7 +251,7 @@ def newton(co, cw, t, y, tol):
         _schur(co, cw)
         for i in range(m):
             b[i] = fv[i]
-        if not _gauss(Sm, b, m):
+        if not _gauss(cw, b, m):
             return 2
         for i in range(m):
             row = MiAT[i]
@@ -285,7 +265,7 @@ def newton(co, cw, t, y, tol):
         for j in range(ptr[i], ptr[i + 1]):
             s += Av[j] * y[nj + q[j]]
         b[i] = s
-    if not _gauss(Sm, b, m):
+    if not _gauss(cw, b, m):
         return 2
     for i in range(m):
         row = MiAT[i]

@@ -196,14 +196,15 @@ class Work:
 
 def _coord_work(cm, nf) -> tuple:
     """Work of solvers.treecoord: x, stack, X, X', A (nt), f, gamma, nu (m), Minv A^T (m, nj), S (m, m),
-    lambda, b (m), a joint-state derivative (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3)."""
+    lambda, b (m), a joint-state derivative (2 nj), tau (nj), zero loads (nf, 6), driver values (m, 3), the
+    LU row swaps of S (m,)."""
     co = cm.coords or jointtree.empty_coords()
     m, nt = len(co[3]) - 1, len(co[0])
     nj = int(np.count_nonzero(cm.tree[7] >= 0)) if m else 0
     width = int(np.max(np.diff(co[3]))) if m else 0
     z = np.zeros
     return (z(1 + width), z(cm.coord_stack), z(nt), z(nt), z(nt), z(m), z(m), z(m), z((m, nj)), z((m, m)), z(m),
-            z(m), z(2 * nj), z(nj), z((nf, 6)), z((m, 3)))
+            z(m), z(2 * nj), z(nj), z((nf, 6)), z((m, 3)), z(m, np.int64))
 
 
 def _friction(sys) -> tuple:
