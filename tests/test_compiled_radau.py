@@ -51,7 +51,12 @@ def test_stiff_two_mass_chain_hands_over_to_compiled_radau_and_keeps_the_slow_mo
     res = simulate_quietly(m, T, output_step=T / 100)
     st = res.stats
     assert res.success and "stiffness detected" in st["method"] and f"then {RADAU}" in st["method"]
-    assert st["order_history"][-1][1:] == ("Radau", 5) and st["order_history"][0][1] == "DOP853 (compiled)"
+    hist = [h[1:] for h in st["order_history"]]
+    assert hist[0][0] == "DOP853 (compiled)" and hist[1] == ("Radau", 5)
+    if shape == "equal":   # the fast mode excited above the tolerance: Radau's trial needs more evaluations
+        assert hist[-1] == ("DOP853 (compiled)", 8) and "without the stiffness test" in st["method"]   # than DOP853
+    else:
+        assert hist[-1] == ("Radau", 5)
     assert st["rtol_reached"] == 1e-7 and st["njev"] >= 1 and st["nlu"] >= 2
     x = np.stack([res.position(p1)[:, 0] - 1.0, res.position(p2)[:, 0] - 2.0], 1)
     eta0 = V.T @ M @ x0
