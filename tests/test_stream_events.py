@@ -11,7 +11,7 @@ import mbdsim as mb
 from mbdsim.solvers import stream
 from test_compiled_friction import closed_form, spring_pulled_block
 
-ROWS, MARGIN = 40, 3
+ROWS, MARGIN = 25, 3
 
 
 @pytest.fixture
@@ -78,7 +78,7 @@ def test_sensors_stream_compiled_with_the_stop_in_the_last_part(tmp_path, small_
     assert res.success and res.message == ref.message and res.message.startswith("stopped by sensor 'back'")
     assert res.stats["method"] == "DOP853 (compiled, streamed)" and res.stats["chunks"] >= 3
     assert [(e.name, e.time) for e in res.sensor_events] == [(e.name, e.time) for e in ref.sensor_events]
-    assert len(res.sensor_events) == 3   # bottom, bottom, back
+    assert [e.name for e in res.sensor_events] == ["bottom", "back"]
     assert res.stats["samples"] == len(ref.time) and res.time[-1] == ref.time[-1]
     assert np.array_equal(res.q[-1], ref.q[-1]) and np.array_equal(res.v[-1], ref.v[-1])
     assert _same_table(tmp_path / "run.parquet", ref) < 1e-10

@@ -239,7 +239,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     else:
         chunk, i0, st, y, f, stats, ylast, prev_row, events = state
         run.stats[:] = stats
-        _restore_events(run, events)
+        _restore_events(run, events, float(st[0]))
     n, ns = len(y0), len(y)
     K, F, sc = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns))
     SY, ST, nsv = np.zeros((0, ns)), np.zeros((0, 2)), np.zeros(1, np.int64)
@@ -402,8 +402,9 @@ def _events(run) -> str:
     return json.dumps(out)
 
 
-def _restore_events(run, text) -> None:
-    """The event state of `_events` back into the run (its System's histories, the kernel's arrays)."""
+def _restore_events(run, text, t) -> None:
+    """The event state of `_events` back into the run at the carried time t [s] (its System's histories,
+    the kernel's arrays)."""
     from .sensors import SensorEvent
     if text is None:   # a checkpoint of an older mbdsim: a run without events
         return
@@ -417,6 +418,7 @@ def _restore_events(run, text) -> None:
             st.modes[:] = [(m, float(d), float(x)) for m, d, x in modes]
         run.friction.groups_at = [(float(t), np.array(g, np.int64), np.array(c, float).reshape(len(g), len(g)))
                                   for t, g, c in ev["groups"]]
+        run.friction.set_modes(float(t))   # the modes in force at the carried time, into wk[50]
     w[50][2][:] = ev["friction_g"]
     w[44][2][:] = ev["sensor_g"]
 
