@@ -82,3 +82,31 @@ def test_sensors_stream_compiled_with_the_stop_in_the_last_part(tmp_path, small_
     assert res.stats["samples"] == len(ref.time) and res.time[-1] == ref.time[-1]
     assert np.array_equal(res.q[-1], ref.q[-1]) and np.array_equal(res.v[-1], ref.v[-1])
     assert _same_table(tmp_path / "run.parquet", ref) < 1e-10
+
+
+def test_held_group_streams_and_resumes_between_its_stop_and_breakaway(tmp_path, small_chunks):
+    """The five-bar held by five pins (tests/test_friction_held_loop.py) streamed in parts and stopped while
+    held: the resumed run carries the held group (its shares of the capacity) and breaks away as the
+    in-memory run does, bit-identical to an uninterrupted stream."""
+    from test_friction_held_loop import PINS, coasting_five_bar
+    end, step = 1.3, 0.005
+    ref = mb.simulate(coasting_five_bar(), end, step)
+    full = mb.simulate(coasting_five_bar(), end, step, out=tmp_path / "full.parquet")
+    assert full.success and full.stats["method"] == "DOP853 (compiled, streamed)"
+    assert _same_table(tmp_path / "full.parquet", ref) < 1e-10
+    out = tmp_path / "cut.parquet"
+
+    def stop_held(t):
+        if t > 0.95:   # stopped at 0.38 s, breaks away at 1.12 s
+            raise RuntimeError("stopped by the test")
+    cut = mb.simulate(coasting_five_bar(), end, step, out=out, progress=stop_held)
+    assert not cut.success
+    with np.load(out / stream.CHECKPOINT) as z:   # the run resumes from a part that ended while held
+        assert 0.4 < float(z["st"][0]) < 1.1
+    res = mb.simulate(coasting_five_bar(), end, step, out=out, resume=True)
+    assert res.success, res.message
+    for n in PINS:
+        e = res.friction_events("f_" + n)
+        assert e == full.friction_events("f_" + n) == ref.friction_events("f_" + n)
+        assert e[-1][1] == ("stick" if n == "C" else "slip")   # broken away, C left at rest
+    assert pd.read_parquet(out).equals(pd.read_parquet(tmp_path / "full.parquet"))

@@ -258,6 +258,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         t_part = time.monotonic()
         # the kernels' work arrays at the carried state exactly as the step loop leaves them (the output
         # projection reuses the factorisation there): same whether the previous chunk ran in this process
+        if run.friction is not None:   # the modes in force (the previous part's outputs set theirs)
+            run.friction.set_modes(float(st[0]))
         fastdop.rhs(a, w, st[0], y, np.zeros(ns), True)
         try:
             while status == 0 and iout < min(CHUNK_ROWS + 1, L):
@@ -267,12 +269,14 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                                           run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
                                           run.stats, K, F, sc, stiff_check and chunk == 0 and state is None, SY,
                                           ST, nsv, watch)
-                if status == 0 and got == L and g0 + L < nout and \
+                if status in (0, fastdop.FRICTION_EVENT, fastdop.SENSOR_STOP) and got == L and g0 + L < nout and \
                         times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
-                    # the last step covered outputs beyond the window: redo it from the saved state into a
-                    # larger window, so that every step writes all of its outputs (chunks end at step ends)
+                    # the last step (or the run up to an event) covered outputs beyond the window: redo it from
+                    # the saved state into a larger window, so that every step writes all of its outputs
+                    # (chunks end at step ends)
                     st[:], y[:], f[:], run.stats[:] = saved[:4]
                     _set_event_state(run, saved[4])
+                    status = 0
                     L = min(2 * L, nout - g0)
                     Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
                     continue
@@ -378,27 +382,31 @@ def _sensor_stop(run, t_stop, y, Y, iout, g0, times):
 
 
 def _event_state(run):
-    """What the kernel's event watch carries from one accepted step to the next: the friction switching
-    values (wk[50][2]) and the sensors' values and event count (wk[44][2], [5]), copied."""
+    """What the kernel carries from one accepted step to the next besides the state: the friction switching
+    values (wk[50][2]), the sensors' values and event count (wk[44][2], [5]) and the loop rows in use with
+    their re-selection threshold (wk[46], [47]; solvers.fastsolve._reselect), copied."""
     w = run.work.arrays()
-    return w[50][2].copy(), w[44][2].copy(), w[44][5].copy()
+    return w[50][2].copy(), w[44][2].copy(), w[44][5].copy(), w[46].copy(), w[47].copy()
 
 
 def _set_event_state(run, saved):
     w = run.work.arrays()
-    w[50][2][:], w[44][2][:], w[44][5][:] = saved
+    w[50][2][:], w[44][2][:], w[44][5][:], w[46][:], w[47][:] = saved
 
 
 def _events(run) -> str:
-    """The event state a resumed run continues from, as JSON: the kernel's watch values (`_event_state`),
-    the sensor events met, the friction elements' mode histories and held groups (solvers.friction_run)."""
-    gp, gs, _ = _event_state(run)
-    out = {"friction_g": gp.tolist(), "sensor_g": gs.tolist(),
+    """What a resumed run continues from besides the state, as JSON: the kernel's carried values
+    (`_event_state`), the sensor events met, the friction elements' mode histories and held groups
+    (solvers.friction_run)."""
+    gp, gs, _, sel, lim = _event_state(run)
+    out = {"friction_g": gp.tolist(), "sensor_g": gs.tolist(), "loop_rows": sel.tolist(), "loop_limits": lim.tolist(),
            "sensor_events": [[e.name, e.time, e.value, e.action] for e in run.sensor_events]}
     if run.friction is not None:
         sw = run.sys.switched
         out["modes"] = {n: [sw[n].times, [list(m) for m in sw[n].modes]] for n in run.friction.names}
         out["groups"] = [[t, g.tolist(), c.tolist()] for t, g, c in run.friction.groups_at]
+        base = run.sys.derived.get("friction_base_rows")   # the decisions' independent rows, chosen at their
+        out["base_rows"] = None if base is None else np.asarray(base).tolist()   # first use: kept as chosen
     return json.dumps(out)
 
 
@@ -406,7 +414,7 @@ def _restore_events(run, text, t) -> None:
     """The event state of `_events` back into the run at the carried time t [s] (its System's histories,
     the kernel's arrays)."""
     from .sensors import SensorEvent
-    if text is None:   # a checkpoint of an older mbdsim: a run without events
+    if text is None:   # a checkpoint of an older mbdsim (a run without events)
         return
     ev = json.loads(text)
     w = run.work.arrays()
@@ -419,8 +427,11 @@ def _restore_events(run, text, t) -> None:
         run.friction.groups_at = [(float(t), np.array(g, np.int64), np.array(c, float).reshape(len(g), len(g)))
                                   for t, g, c in ev["groups"]]
         run.friction.set_modes(float(t))   # the modes in force at the carried time, into wk[50]
+        if ev.get("base_rows") is not None:
+            run.sys.derived["friction_base_rows"] = np.array(ev["base_rows"], dtype=np.int64)
     w[50][2][:] = ev["friction_g"]
     w[44][2][:] = ev["sensor_g"]
+    w[46][:], w[47][:] = ev["loop_rows"], ev["loop_limits"]
 
 
 def _discard(path, csv) -> None:
