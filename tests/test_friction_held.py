@@ -101,8 +101,8 @@ def test_four_bar_stopped_with_friction_in_every_pin_is_held_as_one_group_compil
 
 def five_bar(torque=0.005):
     """Five-bar (2 DOF: cranks 0.1 m on ground pivots 0.3 m apart, two 0.25 m couplers) at rest without
-    gravity, pin friction with a preload of 0.02 N m in all five pins, a torque below their capacity on
-    the first crank."""
+    gravity, pin friction with a preload of 0.02 N m in all five pins, a torque [N m] (None: none) on the first
+    crank, by default below their capacity."""
     m = mb.Model("five_bar", gravity=(0, 0, 0))
     O1, O5 = np.zeros(3), np.array([0.3, 0.0, 0.0])
     A, C = O1 + 0.1 * np.array([np.cos(1.8), np.sin(1.8), 0]), O5 + 0.1 * np.array([np.cos(1.3), np.sin(1.3), 0])
@@ -118,7 +118,8 @@ def five_bar(torque=0.005):
               m.add_revolute("O5", m.ground, links[3], O5, z)]
     for jt in joints:
         m.add_friction("f_" + jt.name, jt, MU_S, MU_D, pin_radius=0.01, preload=0.02)
-    m.add_torque("drive", links[0], (0, 0, torque))
+    if torque is not None:
+        m.add_torque("drive", links[0], (0, 0, torque))
     return m
 
 

@@ -108,3 +108,27 @@ def test_five_bar_held_by_five_pins_breaks_away_at_the_closed_form_load_compiled
     for n, e_ref in events(ref).items():
         assert [x[1:] for x in e_ref] == [x[1:] for x in ev[n]]
         assert np.allclose([x[0] for x in e_ref], [x[0] for x in ev[n]], rtol=1e-7, atol=0)
+
+
+def test_five_bar_held_group_on_the_compiled_radau():
+    """The same group on Radau IIA (fastswitch: the switching functions on its collocation polynomial),
+    coasting without the torque: DOP853's stick/slip history to 1e-8, at rest after it, kinetic energy +
+    dissipation constant to 1e-6 of the initial energy."""
+    def coasting():
+        m = five_bar(None)
+        m.joints["O1"].initial_velocity = [-1.0]
+        m.joints["O5"].initial_velocity = [0.6]
+        return m
+    runs = {m: mb.simulate(coasting(), 0.6, output_step=0.005, method=m, rtol=1e-9) for m in ("radau", "dop853")}
+    res = runs["radau"]
+    assert res.success, res.message
+    assert res.stats["method"] == "Radau IIA (compiled)"
+    for n, ev in events(res).items():
+        ev_ref = events(runs["dop853"])[n]
+        assert [x[1:] for x in ev] == [x[1:] for x in ev_ref] and ev[-1][1] == "stick"
+        assert np.allclose([x[0] for x in ev], [x[0] for x in ev_ref], rtol=1e-8, atol=0)
+    t_stop = max(ev[-1][0] for ev in events(res).values())
+    for n in PINS:
+        assert np.max(np.abs(res.joint_velocity(n)[res.time > t_stop + 1e-9])) < 1e-10
+    E = res.kinetic_energy()
+    assert np.max(np.abs(E + res.dissipated_energy() - E[0])) < 1e-6 * E[0]
