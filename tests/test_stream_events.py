@@ -110,3 +110,15 @@ def test_held_group_streams_and_resumes_between_its_stop_and_breakaway(tmp_path,
         assert e == full.friction_events("f_" + n) == ref.friction_events("f_" + n)
         assert e[-1][1] == ("stick" if n == "C" else "slip")   # broken away, C left at rest
     assert pd.read_parquet(out).equals(pd.read_parquet(tmp_path / "full.parquet"))
+
+
+def test_stiff_friction_model_streamed_hands_over_to_radau_in_memory(tmp_path):
+    """Stiffness found in the first part: nothing is streamed, the whole-file writer runs "auto" with its
+    hand-over to the compiled Radau (the friction modes going on): the in-memory run's table exactly."""
+    from test_friction_implicit import stiff_pulled_block
+    _, ts, _ = closed_form(m=2.01)
+    ref = mb.simulate(stiff_pulled_block()[0], ts + 0.05, 0.01)
+    res = mb.simulate(stiff_pulled_block()[0], ts + 0.05, 0.01, out=tmp_path / "run.parquet")
+    assert res.success and "then Radau IIA (compiled)" in res.stats["method"], res.stats["method"]
+    assert res.friction_events("friction") == ref.friction_events("friction")
+    assert _same_table(tmp_path / "run.parquet", ref) == 0.0

@@ -28,8 +28,20 @@ run leaves every completed part's rows (at most the last line of a part cut shor
 middle of its write). A CSV run has no checkpoint: resume needs the Parquet dataset.
 
 Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
-switch while streaming). Other methods and models run in memory and then write the same layout (no
-resume).
+switch while streaming: a model found stiff in the first part runs in memory with "auto"'s hand-over to
+the compiled Radau, joint friction's modes included). Other methods and models run in memory and then
+write the same layout (no resume).
+
+Joint friction and expression sensors stream as in memory (issue 29): the kernel locates their events
+(`fastdop.run` with its watch), the stick/slip decisions are taken between kernel calls
+(`friction_run.FrictionModes.decide`, restart at the event with h = 0), a sensor's stop ends the run
+with the state at its time as the last row, and the modes are set again before each part (the previous
+part's outputs set those in force at each output). A step, or the run up to an event, that covered
+outputs beyond a part's window is redone from the saved state into a larger one, with the kernel's
+carried values restored (`stream_events.event_state`: friction switching and sensor values, the event
+count, the loop rows in use). The checkpoint carries, besides the state, what a resumed run needs to
+continue exactly (`stream_events.events`): those values, the sensor events met, the friction elements'
+mode histories, their held groups and the decisions' independent rows.
 """
 from __future__ import annotations
 
@@ -199,7 +211,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     out stiff before the first part is written (the files made are removed: the caller's whole-file
     writer runs "auto" with its implicit hand-over instead). Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
-    from . import fastdop, pyloads
+    from . import fastdop, pyloads, stream_events
     from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
     from .fastdyn import FRICTION_FAILED, INTERRUPTED, STIFF
     from ..system.compiled import NotCompiled
@@ -239,7 +251,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     else:
         chunk, i0, st, y, f, stats, ylast, prev_row, events = state
         run.stats[:] = stats
-        _restore_events(run, events, float(st[0]))
+        stream_events.restore(run, events, float(st[0]))
     n, ns = len(y0), len(y)
     K, F, sc = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns))
     SY, ST, nsv = np.zeros((0, ns)), np.zeros((0, 2)), np.zeros(1, np.int64)
@@ -263,7 +275,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         fastdop.rhs(a, w, st[0], y, np.zeros(ns), True)
         try:
             while status == 0 and iout < min(CHUNK_ROWS + 1, L):
-                saved = (st.copy(), y.copy(), f.copy(), run.stats.copy(), _event_state(run))
+                saved = (st.copy(), y.copy(), f.copy(), run.stats.copy(), stream_events.event_state(run))
                 tout = np.asarray(times[g0:g0 + L], float)
                 status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
                                           run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
@@ -275,7 +287,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                     # the saved state into a larger window, so that every step writes all of its outputs
                     # (chunks end at step ends)
                     st[:], y[:], f[:], run.stats[:] = saved[:4]
-                    _set_event_state(run, saved[4])
+                    stream_events.set_event_state(run, saved[4])
                     status = 0
                     L = min(2 * L, nout - g0)
                     Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
@@ -303,7 +315,7 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         if status == FRICTION_FAILED:   # name the element whose coupled solve failed
             run.run_error = run.friction.failure(st[0], y)
         if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the run's last output
-            iout, Y, extra = _sensor_stop(run, st[0], y, Y, iout, g0, times)
+            iout, Y, extra = stream_events.sensor_stop(run, st[0], y, Y, iout, g0, times)
             stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
             stopped, status = f"stopped by sensor '{stop.name}' at t = {st[0]:.12g} s", 0
         tout = np.asarray(times[g0:g0 + iout], float) if stopped is None or not extra else \
@@ -339,7 +351,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
         if csv is None and stopped is None:
-            _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row, _events(run))
+            _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row,
+                             stream_events.events(run))
     ts, rows, acc = last
     if kept is not None and state is None and len(kept) > 1:   # every output fits: the Result holds them all
         ts, rows = np.concatenate([k[0] for k in kept]), np.concatenate([k[1] for k in kept])
@@ -361,77 +374,6 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     if run.sensors:
         res.sensor_events = run.sensor_events
     return res
-
-
-def _sensor_stop(run, t_stop, y, Y, iout, g0, times):
-    """(outputs, Y, whether a row was added) after a sensor's stop at t_stop [s] with the integrator's
-    state y there: that state (absolute coordinates) as the part's last row unless an output is at t_stop
-    (as in memory, compiled_run.integrate_compiled); Y grown by a row when full."""
-    from . import fastdyn
-    ya = np.zeros(Y.shape[1])
-    if run.joint_space:
-        fastdyn.write_state(run.cm.arrays(), run.work.arrays(), y.copy(), ya, Y[iout - 1] if iout else ya[:0])
-    else:
-        ya[:] = y
-    if iout and t_stop <= times[g0 + iout - 1] + 1e-14 * max(1.0, abs(t_stop)):
-        return iout, Y, False
-    if iout >= len(Y):
-        Y = np.concatenate([Y, np.zeros((1, Y.shape[1]))])
-    Y[iout] = ya
-    return iout + 1, Y, True
-
-
-def _event_state(run):
-    """What the kernel carries from one accepted step to the next besides the state: the friction switching
-    values (wk[50][2]), the sensors' values and event count (wk[44][2], [5]) and the loop rows in use with
-    their re-selection threshold (wk[46], [47]; solvers.fastsolve._reselect), copied."""
-    w = run.work.arrays()
-    return w[50][2].copy(), w[44][2].copy(), w[44][5].copy(), w[46].copy(), w[47].copy()
-
-
-def _set_event_state(run, saved):
-    w = run.work.arrays()
-    w[50][2][:], w[44][2][:], w[44][5][:], w[46][:], w[47][:] = saved
-
-
-def _events(run) -> str:
-    """What a resumed run continues from besides the state, as JSON: the kernel's carried values
-    (`_event_state`), the sensor events met, the friction elements' mode histories and held groups
-    (solvers.friction_run)."""
-    gp, gs, _, sel, lim = _event_state(run)
-    out = {"friction_g": gp.tolist(), "sensor_g": gs.tolist(), "loop_rows": sel.tolist(), "loop_limits": lim.tolist(),
-           "sensor_events": [[e.name, e.time, e.value, e.action] for e in run.sensor_events]}
-    if run.friction is not None:
-        sw = run.sys.switched
-        out["modes"] = {n: [sw[n].times, [list(m) for m in sw[n].modes]] for n in run.friction.names}
-        out["groups"] = [[t, g.tolist(), c.tolist()] for t, g, c in run.friction.groups_at]
-        base = run.sys.derived.get("friction_base_rows")   # the decisions' independent rows, chosen at their
-        out["base_rows"] = None if base is None else np.asarray(base).tolist()   # first use: kept as chosen
-    return json.dumps(out)
-
-
-def _restore_events(run, text, t) -> None:
-    """The event state of `_events` back into the run at the carried time t [s] (its System's histories,
-    the kernel's arrays)."""
-    from .sensors import SensorEvent
-    if text is None:   # a checkpoint of an older mbdsim (a run without events)
-        return
-    ev = json.loads(text)
-    w = run.work.arrays()
-    run.sensor_events = [SensorEvent(n, float(t), float(v), a) for n, t, v, a in ev["sensor_events"]]
-    if run.friction is not None:
-        for n, (ts, modes) in ev["modes"].items():
-            st = run.sys.switched[n]
-            st.times[:] = [float(t) for t in ts]
-            st.modes[:] = [(m, float(d), float(x)) for m, d, x in modes]
-        run.friction.groups_at = [(float(t), np.array(g, np.int64), np.array(c, float).reshape(len(g), len(g)))
-                                  for t, g, c in ev["groups"]]
-        run.friction.set_modes(float(t))   # the modes in force at the carried time, into wk[50]
-        if ev.get("base_rows") is not None:
-            run.sys.derived["friction_base_rows"] = np.array(ev["base_rows"], dtype=np.int64)
-    w[50][2][:] = ev["friction_g"]
-    w[44][2][:] = ev["sensor_g"]
-    w[46][:], w[47][:] = ev["loop_rows"], ev["loop_limits"]
 
 
 def _discard(path, csv) -> None:
