@@ -258,8 +258,10 @@ def switching(fc, fw, Jc, bi, bj, A, lam, v6, g):
             g[e] = sdir[e] * _row_dot(Jc, bi, bj, lock[e], v6) + 0.5 * V_TOL
         elif mode[e] == 2 and fw[20][e] < 0:   # a lone stick
             g[e] = cap[e] - abs(lam[lock[e]]) + STICK_TOL * (1.0 + cap[e])
-        elif mode[e] == 2:
+        elif mode[e] == 2 and fw[20][e] == e:   # the group's first sticking member: its value
             g[e] = group_margin(fw, lock, lam, e)
+        elif mode[e] == 2:   # the others share it (the group's id is its first member: computed above)
+            g[e] = g[fw[20][e]]
         else:
             g[e] = 1.0
 

@@ -45,8 +45,8 @@ def events(run) -> str:
     (`event_state`), the sensor events met, the friction elements' mode histories and held groups
     (solvers.friction_run)."""
     gp, gs, _, sel, lim = event_state(run)
-    out = {"friction_g": gp.tolist(), "sensor_g": gs.tolist(), "loop_rows": sel.tolist(), "loop_limits": lim.tolist(),
-           "sensor_events": [[e.name, e.time, e.value, e.action] for e in run.sensor_events]}
+    out = {"friction_g": gp.tolist(), "sensor_g": gs.tolist(), "loop_rows": sel.tolist(),
+           "loop_limits": lim.tolist(), "sensor_events": [[e.name, e.time, e.value, e.action] for e in run.sensor_events]}
     if run.friction is not None:
         sw = run.sys.switched
         out["modes"] = {n: [sw[n].times, [list(m) for m in sw[n].modes]] for n in run.friction.names}
@@ -56,25 +56,27 @@ def events(run) -> str:
     return json.dumps(out)
 
 
-def restore(run, text, t) -> None:
-    """The event state of `events` back into the run at the carried time t [s] (its System's histories,
-    the kernel's arrays)."""
+def restore(run, text, t_now) -> None:
+    """The event state of `events` back into the run at the carried time t_now [s] (its System's
+    histories, the kernel's arrays)."""
     from .sensors import SensorEvent
     if text is None:   # a checkpoint of an older mbdsim (a run without events)
         return
     ev = json.loads(text)
     w = run.work.arrays()
-    run.sensor_events = [SensorEvent(n, float(t), float(v), a) for n, t, v, a in ev["sensor_events"]]
-    if run.friction is not None:
+    run.sensor_events = [SensorEvent(n, float(t), float(v), a) for n, t, v, a in ev.get("sensor_events", ())]
+    if run.friction is not None and "modes" in ev:
         for n, (ts, modes) in ev["modes"].items():
             st = run.sys.switched[n]
             st.times[:] = [float(t) for t in ts]
             st.modes[:] = [(m, float(d), float(x)) for m, d, x in modes]
         run.friction.groups_at = [(float(t), np.array(g, np.int64), np.array(c, float).reshape(len(g), len(g)))
                                   for t, g, c in ev["groups"]]
-        run.friction.set_modes(float(t))   # the modes in force at the carried time, into wk[50]
+        run.friction.set_modes(float(t_now))   # the modes in force at the carried time, into wk[50]
         if ev.get("base_rows") is not None:
             run.sys.derived["friction_base_rows"] = np.array(ev["base_rows"], dtype=np.int64)
-    w[50][2][:] = ev["friction_g"]
-    w[44][2][:] = ev["sensor_g"]
-    w[46][:], w[47][:] = ev["loop_rows"], ev["loop_limits"]
+    for (i, j), key in (((50, 2), "friction_g"), ((44, 2), "sensor_g")):
+        if key in ev:
+            w[i][j][:] = ev[key]
+    if "loop_rows" in ev:
+        w[46][:], w[47][:] = ev["loop_rows"], ev["loop_limits"]
