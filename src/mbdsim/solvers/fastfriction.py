@@ -22,12 +22,14 @@ Switching functions (`switching`, located on the step's dense output by `fastdop
 (zero when the joint has come to rest); stick: C - |lambda_f| + STICK_TOL (1 + C) with the static
 capacity C = mu_static N (zero when static friction cannot hold it); 1 otherwise.  A held group (joints
 of a loop stopped together whose lock rows depend on each other, `friction_run`): only the sticking
-element's lock acts, its held members h (mode 0, fw[20][h] = that element) add their capacities in the
-ratio c_h of their joint rates to its (fw[21][h], on the motions the other rows allow):
-C = mu_s N_e + sum_h |c_h| mu_s,h N_h, the closed form of the reference's least-load distribution
-(`force_elements.friction_lcp.group_load`) when each held lock row depends on one sticking lock; the
-tolerance is then n_g STICK_TOL (1 + C) for a group of n_g joints, so that at its zero the reference's
-per-member margins reject sticking (the decision at the event is the reference's).
+elements' locks act; the held members h (mode 0, fw[20][h] = the group's id, as for its sticking
+members) share the capacity through their lock rows in the sticking ones', c_h = fw[21][h] (on the
+motions the other rows allow): the group holds while the sticking locks' multipliers lie in the
+zonotope of the members' capacities (`group_margin`, the closed form of the reference's least-load
+distribution `force_elements.friction_lcp.group_load`; one sticking member: C = mu_s N_a +
+sum_h |c_h| mu_s,h N_h). Its tolerance is n_g STICK_TOL (1 + C) for a group of n_g joints, so that at
+its zero the reference's per-member margins reject sticking (the decision at the event is the
+reference's).
 
 cm[48] (system.compiled._friction), per element e of k:
   0 lock (k,) int64: its lock row;  1 jrows (k, R) int64: the joint's rows (-1 padding);
@@ -41,7 +43,9 @@ scratch (nf, 6), 6 zeros (nc), 7 S (k, k), 8 right-hand side (k,), 9 f (k,), 10 
 11 frozen term directions (k, 4, 3), 12 vd (nv), 13 lambda (nc) and 14 v (nf, 6) of the switching
 functions, 15 [failed element + 1, iterations] int64, 16 new switching values (k,), 17 reaction
 scratch (3, 3), 18 switching scratch (k,), 19 combined multipliers (nc), 20 held group (k,) int64 (the
-sticking element whose capacity a held element shares, -1: none), 21 its joint-rate ratio c_h (k,).
+group's id, its first sticking element, for its sticking and held members; -1: none), 21 the held
+members' lock rows in the sticking ones' c_h (k, k) (row h, column a), 22 static capacities (k,),
+23 generators (k, k), 24 orthonormal basis (k, k), 25 members (k,) int64, 26 subset indices (k,) int64.
 """
 from __future__ import annotations
 
@@ -241,23 +245,120 @@ def couple(fc, fw, Jc, bi, bj, A, gamma, x6, lam):
 def switching(fc, fw, Jc, bi, bj, A, lam, v6, g):
     """Switching function of each element (module docstring) into g, from the rows Jc, orientations A,
     multipliers lam (the coupled solve's) and velocities v6 (nf, 6) at one state."""
-    mode, sdir, R = fw[0], fw[1], fw[17]
+    mode, sdir, R, cap = fw[0], fw[1], fw[17], fw[22]
     lock = fc[0]
-    for e in range(mode.shape[0]):
+    k = mode.shape[0]
+    for e in range(k):   # the static capacities mu_s N of the stuck elements (sticking, or held in a group)
+        cap[e] = 0.0
+        if mode[e] == 2 or (mode[e] == 0 and fw[20][e] >= 0):
+            reaction(fc, e, Jc, bi, bj, A, lam, R)
+            cap[e] = fc[4][e, 0] * normal_load(fc, e, A, R, fw[11], False, False)
+    for e in range(k):
         if mode[e] == 1:
             g[e] = sdir[e] * _row_dot(Jc, bi, bj, lock[e], v6) + 0.5 * V_TOL
-        elif mode[e] == 2:
-            reaction(fc, e, Jc, bi, bj, A, lam, R)
-            cap = fc[4][e, 0] * normal_load(fc, e, A, R, fw[11], False, False)
-            n_g = 1.0
-            for h in range(mode.shape[0]):   # the held members of its group share the capacity
-                if fw[20][h] == e:
-                    reaction(fc, h, Jc, bi, bj, A, lam, R)
-                    cap += abs(fw[21][h]) * fc[4][h, 0] * normal_load(fc, h, A, R, fw[11], False, False)
-                    n_g += 1.0
-            g[e] = cap - abs(lam[lock[e]]) + n_g * STICK_TOL * (1.0 + cap)
+        elif mode[e] == 2 and fw[20][e] < 0:   # a lone stick
+            g[e] = cap[e] - abs(lam[lock[e]]) + STICK_TOL * (1.0 + cap[e])
+        elif mode[e] == 2 and fw[20][e] == e:   # the group's first sticking member: its value
+            g[e] = group_margin(fw, lock, lam, e)
+        elif mode[e] == 2:   # the others share it (the group's id is its first member: computed above)
+            g[e] = g[fw[20][e]]
         else:
             g[e] = 1.0
+
+
+@kernel(_nrt=False)
+def group_margin(fw, lock, lam, e):
+    """Switching function of the held group of sticking element e (fw[20] = its id): the group holds while
+    its sticking locks' multipliers x = lam[lock[a]] (a in the group's n_a sticking elements) lie in the
+    zonotope of its generators cap_a e_a (sticking a) and cap_h c_h (held h, c_h = fw[21][h]: its lock row
+    in the sticking ones', on the null space of the other rows), the set of the loads the group's
+    capacities can carry (every distribution |lambda_k| <= mu_s N_k of the least-load programme
+    `friction_lcp.group_load`). The zonotope's facets are normal to n_a - 1 independent generators; with
+    the unit normal n of each, H(n) = sum_i |n . gen_i| (its support), the value is
+    min over facets of H(n) - |n . x| + n_g STICK_TOL (1 + H(n)) (n_g the group's joints): zero where
+    the group's least load beta reaches 1 (just past it), for n_a = 1 the closed form C - |lambda_a| +
+    n_g eps with C = cap_a + sum_h |c_h| cap_h. fw[22]: the capacities (`switching`); scratch fw[23]
+    generators (k, k), fw[24] orthonormal basis (k, k), fw[25] members and fw[26] subset indices (k,)."""
+    mode, grp, C, cap = fw[0], fw[20], fw[21], fw[22]
+    G, Q, mem, idx = fw[23], fw[24], fw[25], fw[26]
+    k = mode.shape[0]
+    gid = grp[e]
+    na = 0
+    for a in range(k):   # the sticking members: the coordinates of x
+        if mode[a] == 2 and grp[a] == gid:
+            mem[na] = a
+            na += 1
+    ng = 0
+    for i in range(k):   # the generators, rows of G (n_a columns)
+        if grp[i] != gid or not (mode[i] == 2 or mode[i] == 0):
+            continue
+        for p in range(na):
+            a = mem[p]
+            G[ng, p] = (cap[i] if a == i else 0.0) if mode[i] == 2 else cap[i] * C[i, a]
+        ng += 1
+    r = na - 1   # generators spanning a facet
+    best = np.inf
+    for p in range(r):
+        idx[p] = p
+    while True:
+        ok = True   # the unit normal n (into Q[r]) to the generators idx[:r]: Gram-Schmidt
+        for p in range(r):
+            nrm0 = 0.0
+            for c in range(na):
+                Q[p, c] = G[idx[p], c]
+                nrm0 += Q[p, c] * Q[p, c]
+            for m in range(p):
+                d = 0.0
+                for c in range(na):
+                    d += Q[m, c] * Q[p, c]
+                for c in range(na):
+                    Q[p, c] -= d * Q[m, c]
+            nrm = 0.0
+            for c in range(na):
+                nrm += Q[p, c] * Q[p, c]
+            if not nrm > 1e-20 * nrm0 or nrm0 == 0.0:
+                ok = False
+                break
+            nrm = np.sqrt(nrm)
+            for c in range(na):
+                Q[p, c] /= nrm
+        if ok:
+            big, jb = -1.0, 0
+            for j in range(na):   # the unit vector least in their span, less its projection
+                s = 1.0
+                for m in range(r):
+                    s -= Q[m, j] * Q[m, j]
+                if s > big:
+                    big, jb = s, j
+            for c in range(na):
+                Q[r, c] = 1.0 if c == jb else 0.0
+            for m in range(r):
+                d = Q[m, jb]
+                for c in range(na):
+                    Q[r, c] -= d * Q[m, c]
+            nrm = 0.0
+            for c in range(na):
+                nrm += Q[r, c] * Q[r, c]
+            nrm = np.sqrt(nrm)
+            H, nx = 0.0, 0.0
+            for c in range(na):
+                Q[r, c] /= nrm
+                nx += Q[r, c] * lam[lock[mem[c]]]
+            for i in range(ng):
+                d = 0.0
+                for c in range(na):
+                    d += Q[r, c] * G[i, c]
+                H += abs(d)
+            best = min(best, H - abs(nx) + ng * STICK_TOL * (1.0 + H))
+        p = r - 1   # the next subset of r generators (lexicographic)
+        while p >= 0 and idx[p] == ng - r + p:
+            p -= 1
+        if p < 0:
+            break
+        idx[p] += 1
+        for m in range(p + 1, r):
+            idx[m] = idx[m - 1] + 1
+    return best
 
 
 @kernel(_nrt=False)

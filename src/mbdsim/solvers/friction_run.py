@@ -9,12 +9,12 @@ Coulomb friction), records them in the System's mode histories (sys.switched, wh
 `res.friction_events` and the reference evaluators read) and writes them into wk[50]; the run restarts
 there. Outputs and dense output after the run use the modes in force at each time (`groups`,
 `set_modes`). A "held" group (a loop stopped with friction in several joints, whose lock rows depend on
-each other) sticks as one: the kernel enforces the sticking member's lock only, and its switching
-function carries the group's shared capacity (`held_groups`: each held member's share in the ratio of
-its joint rate to the sticking member's, wk[50][20], [21]; fastfriction). A held lock row that depends
-on several sticking locks at once (a loop of several degrees of freedom stopped with more joints than
-that) is not carried: the run raises NotCompiled and the analysis is redone on the event-driven
-reference path.
+each other) sticks as one: the kernel enforces the sticking members' locks only, and their switching
+function carries the group's shared static capacity (`held_groups`: each held member's lock row in the
+sticking ones', wk[50][20], [21]; `fastfriction.group_margin`), for a loop of any number of degrees of
+freedom. A held lock row outside the sticking ones' span (not expected: `decide_all` keeps an
+independent subset) is not carried: the run raises NotCompiled and the analysis is redone on the
+event-driven reference path.
 """
 from __future__ import annotations
 
@@ -33,7 +33,7 @@ class FrictionModes:
         self.sys, self.cm, self.work = sys, cm, work
         self.names = list(sys.switched)
         self.fw = work.arrays()[50]
-        self.groups_at = []   # [(decision time [s], held group (k,), ratio (k,))] (fastfriction wk[50][20], [21])
+        self.groups_at = []   # [(decision time [s], held group (k,), ratio (k, k))] (fastfriction wk[50][20], [21])
 
     def decide(self, t, y):
         """Decide the modes at the state y = [q, v] at t [s] (an event or the start), write them to wk[50];
@@ -43,7 +43,7 @@ class FrictionModes:
         nq = sys.nq
         decide_all(sys, float(t), np.array(y[:nq], dtype=float), np.array(y[nq:], dtype=float))
         held = [n for n in self.names if (sys.switched[n].at(t) or ("",))[0] == "held"]
-        grp, ratio = np.full(len(self.names), -1, np.int64), np.zeros(len(self.names))
+        grp, ratio = np.full(len(self.names), -1, np.int64), np.zeros((len(self.names),) * 2)
         if held:
             unsupported = held_groups(sys, self.names, float(t), y, grp, ratio)
             if unsupported:
@@ -97,11 +97,13 @@ class FrictionModes:
 
 def held_groups(sys, names, t, y, grp, ratio, tol=1e-8):
     """The held groups decided at t [s], state y = [q, v]: for each held element h (index into `names`),
-    the sticking element a whose lock row its own depends on, into grp[h], and the ratio c_h of the joint
-    rates xd_h = c_h xd_a on the motions the joint and driver rows allow (their null space), into
-    ratio[h]; with it the group's static capacity is mu_s N_a + sum_h |c_h| mu_s N_h, the reference's
-    least-load distribution (`friction_lcp.group_load`) in closed form.  Returns the names of the held
-    elements whose lock row depends on several sticking locks (not carried by the kernel)."""
+    its lock row in the sticking elements' on the motions the joint and driver rows allow (their null
+    space N): N^T J_h^T = sum_a c_ha N^T J_a^T, c_ha into ratio[h, a] (for one sticking a, the ratio of the
+    joint rates xd_h = c_ha xd_a); sticking and held elements connected through nonzero c_ha form a
+    group, its id (its first sticking element) into grp of each member. With them the kernel carries the
+    group's shared static capacity (`fastfriction.group_margin`, the reference's least-load distribution
+    `friction_lcp.group_load` in closed form). Returns the names of the held elements whose lock row is
+    not in the sticking ones' span (not carried by the kernel)."""
     from ..system.equations import constraint_terms
     from ..system.force_elements.friction import _base_rows
     from ..system.force_elements.friction_lcp import _lock, null_basis
@@ -113,17 +115,31 @@ def held_groups(sys, names, t, y, grp, ratio, tol=1e-8):
     sticks = [e for e, m in enumerate(mode) if m == "stick"]
     GA = Nb.T @ J[[_lock(sys, names[e]) for e in sticks]].T if sticks else np.zeros((Nb.shape[1], 0))
     norms = np.linalg.norm(GA, axis=0)
-    bad = []
+    parent = {a: a for a in sticks}   # union-find over the sticking elements
+
+    def root(a):
+        while parent[a] != a:
+            a = parent[a]
+        return a
+    bad, shares = [], {}
     for h, m in enumerate(mode):
         if m != "held":
             continue
         gh = Nb.T @ J[_lock(sys, names[h])]
         scale = max(float(np.linalg.norm(gh)), 1e-300)
         c = np.linalg.lstsq(GA, gh, rcond=None)[0] if sticks else np.zeros(0)
-        share = np.abs(c) * norms > tol * scale
-        if not sticks or np.linalg.norm(GA @ c - gh) > tol * scale or np.count_nonzero(share) != 1:
+        share = np.flatnonzero(np.abs(c) * norms > tol * scale)
+        if not sticks or np.linalg.norm(GA @ c - gh) > tol * scale or not len(share):
             bad.append(names[h])
             continue
-        j = int(np.flatnonzero(share)[0])
-        grp[h], ratio[h] = sticks[j], float(c[j])
+        shares[h] = [(sticks[j], float(c[j])) for j in share]
+        for a, _ in shares[h][1:]:
+            parent[root(a)] = root(shares[h][0][0])
+    ids = {}
+    for h, sh in shares.items():
+        gid = ids.setdefault(root(sh[0][0]), min(a for a in sticks if root(a) == root(sh[0][0])))
+        grp[h] = gid
+        for a, c in sh:
+            ratio[h, a] = c
+            grp[a] = gid
     return bad

@@ -28,8 +28,20 @@ run leaves every completed part's rows (at most the last line of a part cut shor
 middle of its write). A CSV run has no checkpoint: resume needs the Parquet dataset.
 
 Streaming needs the compiled DOP853 (method "auto" or "dop853", a model the kernels carry; no stiffness
-switch while streaming). Other methods and models run in memory and then write the same layout (no
-resume).
+switch while streaming: a model found stiff in the first part runs in memory with "auto"'s hand-over to
+the compiled Radau, joint friction's modes included). Other methods and models run in memory and then
+write the same layout (no resume).
+
+Joint friction and expression sensors stream as in memory (issue 29): the kernel locates their events
+(`fastdop.run` with its watch), the stick/slip decisions are taken between kernel calls
+(`friction_run.FrictionModes.decide`, restart at the event with h = 0), a sensor's stop ends the run
+with the state at its time as the last row, and the modes are set again before each part (the previous
+part's outputs set those in force at each output). A step, or the run up to an event, that covered
+outputs beyond a part's window is redone from the saved state into a larger one, with the kernel's
+carried values restored (`stream_events.event_state`: friction switching and sensor values, the event
+count, the loop rows in use). The checkpoint carries, besides the state, what a resumed run needs to
+continue exactly (`stream_events.events`): those values, the sensor events met, the friction elements'
+mode histories, their held groups and the decisions' independent rows.
 """
 from __future__ import annotations
 
@@ -199,13 +211,15 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     out stiff before the first part is written (the files made are removed: the caller's whole-file
     writer runs "auto" with its implicit hand-over instead). Returns a Result holding the last chunk
     (res.stats["out"] names the dataset, res.stats["samples"] counts every output written)."""
-    from . import fastdop, pyloads
+    from . import fastdop, pyloads, stream_events
     from .compiled_run import _MESSAGES, CHUNK, PROGRESS_FAILED, CompiledRun, _full_multipliers, initial_step
-    from .fastdyn import INTERRUPTED, STIFF
-    if getattr(sys.model, "sensors", None):   # a stop mid-part is not streamed: the whole-file writer runs
-        from ..system.compiled import NotCompiled
-        raise NotCompiled("sensors are not streamed in parts")
-    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v))
+    from .fastdyn import FRICTION_FAILED, INTERRUPTED, STIFF
+    from ..system.compiled import NotCompiled
+    if sys.derived.get("friction not compiled"):   # a held group met by an earlier try (solvers.friction_run)
+        raise NotCompiled(sys.derived["friction not compiled"])
+    run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=False, state=(rep.q, rep.v),
+                      friction=len(sys.lock_rows) > 0)
+    watch = bool(run.sensors) or run.friction is not None   # events located by the kernel (fastdop.run)
     csv = CsvFile(out) if str(out).lower().endswith(".csv") else None
     path = csv.path if csv is not None else prepare(out, resume)
     a, w = run.cm.arrays(), run.work.arrays()
@@ -220,16 +234,24 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             p.unlink()
         y = run.state_of(y0)
         f = np.zeros(len(y))
-        status = fastdop.rhs(a, w, times[0], y, f, True)
-        if status != 0:
-            raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start", time=float(times[0]))
-        st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol, run.max_step)])
+        if watch:   # as in memory: the initial modes, then the kernel's own start (h = 0: f, the starting
+            if run.friction is not None:   # step and the switching values there)
+                run.friction.decide(float(times[0]), y)
+            st = np.array([times[0], 0.0])
+        else:
+            status = fastdop.rhs(a, w, times[0], y, f, True)
+            if status != 0:
+                raise SolverError(_MESSAGES.get(status, "integration failed") + " at the start",
+                                  time=float(times[0]))
+            st = np.array([times[0], initial_step(a, w, float(times[0]), y, f, run.rtol, run.atol,
+                                                  run.max_step)])
         chunk, i0, ylast, prev_row = 0, 1, y0.copy(), None
         if csv is None:
             _write_meta(path, fp, times, rtol, atol, digests)
     else:
-        chunk, i0, st, y, f, stats, ylast, prev_row = state
+        chunk, i0, st, y, f, stats, ylast, prev_row, events = state
         run.stats[:] = stats
+        stream_events.restore(run, events, float(st[0]))
     n, ns = len(y0), len(y)
     K, F, sc = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns))
     SY, ST, nsv = np.zeros((0, ns)), np.zeros((0, 2)), np.zeros(1, np.int64)
@@ -238,7 +260,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
     diag = None
     kept = [] if nout * n * 8 <= STREAM_KEEP else None   # a long run keeps nothing but the current part
     status, error, last = 0, None, (np.asarray(times[i0 - 1:i0], float), ylast[None, :], None)
-    while i0 < nout:
+    stopped = None   # the message of a sensor's stop
+    while i0 < nout and stopped is None:
         g0 = i0 - 1                                # global index of row 0 (the previous chunk's last output)
         L = min(CHUNK_ROWS + MARGIN + 1, nout - g0)
         Y = np.zeros((L, n))
@@ -247,24 +270,35 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         t_part = time.monotonic()
         # the kernels' work arrays at the carried state exactly as the step loop leaves them (the output
         # projection reuses the factorisation there): same whether the previous chunk ran in this process
+        if run.friction is not None:   # the modes in force (the previous part's outputs set theirs)
+            run.friction.set_modes(float(st[0]))
         fastdop.rhs(a, w, st[0], y, np.zeros(ns), True)
         try:
             while status == 0 and iout < min(CHUNK_ROWS + 1, L):
-                saved = (st.copy(), y.copy(), f.copy(), run.stats.copy())
+                saved = (st.copy(), y.copy(), f.copy(), run.stats.copy(), stream_events.event_state(run))
                 tout = np.asarray(times[g0:g0 + L], float)
                 status, got = fastdop.run(a, w, fastdop.COEFFS, st, y, f, t_end, tout, iout, Y, run.rtol, run.atol,
                                           run.max_step, run.max_steps, max(1, min(CHUNK, CHUNK_ROWS + 1 - iout)), 1e-12,
                                           run.stats, K, F, sc, stiff_check and chunk == 0 and state is None, SY,
-                                          ST, nsv, False)
-                if status == 0 and got == L and g0 + L < nout and \
+                                          ST, nsv, watch)
+                if status in (0, fastdop.FRICTION_EVENT, fastdop.SENSOR_STOP) and got == L and g0 + L < nout and \
                         times[g0 + L] <= st[0] + 1e-14 * max(1.0, abs(st[0])):
-                    # the last step covered outputs beyond the window: redo it from the saved state into a
-                    # larger window, so that every step writes all of its outputs (chunks end at step ends)
-                    st[:], y[:], f[:], run.stats[:] = saved
+                    # the last step (or the run up to an event) covered outputs beyond the window: redo it from
+                    # the saved state into a larger window, so that every step writes all of its outputs
+                    # (chunks end at step ends)
+                    st[:], y[:], f[:], run.stats[:] = saved[:4]
+                    stream_events.set_event_state(run, saved[4])
+                    status = 0
                     L = min(2 * L, nout - g0)
                     Y = np.concatenate([Y, np.zeros((L - len(Y), n))])
                     continue
                 iout = got
+                if status == fastdop.FRICTION_EVENT and st[1] > 0.0:   # decide there, restart (h = 0), as in
+                    run.friction.decide(st[0], y)                       # memory (CompiledRun.integrate)
+                    st[1], status = 0.0, 0
+                elif status == fastdop.EVENTS_FULL:
+                    run._take_events()
+                    status = 0
                 results_stream.notify(progress, st[0])
                 if iout > 1 and time.monotonic() - t_part >= results_stream.WRITE_INTERVAL:
                     break   # a part every WRITE_INTERVAL s of wall time too (at a step end, as any part, with
@@ -274,11 +308,18 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         except results_stream.ProgressError as exc:   # the user's callback raised: the run ends, outputs kept
             status, run.run_error = PROGRESS_FAILED, exc
         status, run.run_error = pyloads.settle(run.pyloads, status, run.run_error)
-        if status == STIFF and chunk == 0:   # nothing written yet: the in-memory run hands over to HHT
-            _discard(path, csv)
-            from ..system.compiled import NotCompiled
+        if status == STIFF and chunk == 0:   # nothing written yet: the in-memory run hands over to the
+            _discard(path, csv)               # implicit method (Radau IIA, joint friction's modes included)
             raise NotCompiled("the model is stiff: run in memory with the implicit hand-over")
-        tout = np.asarray(times[g0:g0 + iout], float)
+        run._take_events()
+        if status == FRICTION_FAILED:   # name the element whose coupled solve failed
+            run.run_error = run.friction.failure(st[0], y)
+        if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the run's last output
+            iout, Y, extra = stream_events.sensor_stop(run, st[0], y, Y, iout, g0, times)
+            stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
+            stopped, status = f"stopped by sensor '{stop.name}' at t = {st[0]:.12g} s", 0
+        tout = np.asarray(times[g0:g0 + iout], float) if stopped is None or not extra else \
+            np.append(np.asarray(times[g0:g0 + iout - 1], float), st[0])
         i1 = g0 + iout
         rows = Y[:iout]
 
@@ -309,8 +350,9 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
             kept.append((tout[1:] if prev_row is not None else tout, rows[1:] if prev_row is not None else rows))
         prev_row, ylast = last_row(cols), rows[-1].copy()
         chunk, i0 = chunk + 1, i1
-        if csv is None:
-            _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row)
+        if csv is None and stopped is None:
+            _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, run.stats, ylast, prev_row,
+                             stream_events.events(run))
     ts, rows, acc = last
     if kept is not None and state is None and len(kept) > 1:   # every output fits: the Result holds them all
         ts, rows = np.concatenate([k[0] for k in kept]), np.concatenate([k[1] for k in kept])
@@ -318,9 +360,10 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
         def acc(ts=ts, Yc=rows):
             VD, LAM = run.outputs(ts, Yc)
             return VD, _full_multipliers(sys, rep.rows, ts, Yc, VD, LAM)
-    written = (i0 - 1 + len(ts)) if error is not None else nout
+    written = (i0 - 1 + len(ts)) if error is not None else (i0 if stopped is not None else nout)
     success = error is None
-    message = "ok" if success else f"{error}; last good output at t = {ts[-1]:.9g} s (written to {path})"
+    message = (stopped or "ok") if success else \
+        f"{error}; last good output at t = {ts[-1]:.9g} s (written to {path})"
     res = Result(sys, ts, rows[:, :sys.nq], rows[:, sys.nq:], None, None, success=success,
                  status=0 if success else -1, message=message, accelerations=acc,
                  stats={"steps": int(run.stats[0]), "rejected": int(run.stats[1]), "nfev": int(run.stats[2]),
@@ -328,6 +371,8 @@ def stream_compiled(sys, rep, times, rtol, atol, max_step, progress, out, resume
                         "samples": int(written), "chunks": chunk + (0 if success else 1), "assembly": rep})
     res.error = error
     res.diagnostics = diag
+    if run.sensors:
+        res.sensor_events = run.sensor_events
     return res
 
 
@@ -348,12 +393,13 @@ def _write_meta(path, fp, times, rtol, atol, digests):
     _atomic(path / META, lambda p: p.write_text(json.dumps(meta, indent=1)))
 
 
-def _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, stats, ylast, prev_row):
+def _save_checkpoint(path, fp, digests, chunk, i0, st, y, f, stats, ylast, prev_row, events="{}"):
     def write(p):
         with open(p, "wb") as fh:
             np.savez(fh, fingerprint=np.array(fp), model=np.array(json.dumps(digests, sort_keys=True)), chunk=chunk,
                      i0=i0, st=st, y=y, f=f, stats=stats, ylast=ylast,
-                     row=np.array(list(prev_row.values()), float), columns=np.array(list(prev_row)))
+                     row=np.array(list(prev_row.values()), float), columns=np.array(list(prev_row)),
+                     events=np.array(events))
     _atomic(path / CHECKPOINT, write)
 
 
@@ -373,8 +419,9 @@ def _load_checkpoint(path, fp, digests):
             raise ModelError("simulate", "resume", f"the checkpoint in {str(path)!r} belongs to another run (times, "
                              "tolerances, initial state or marker columns differ); run without resume to start afresh")
         prev = dict(zip((str(c) for c in z["columns"]), (float(x) for x in z["row"])))
+        events = str(z["events"]) if "events" in z.files else None
         return (int(z["chunk"]), int(z["i0"]), z["st"].copy(), z["y"].copy(), z["f"].copy(), z["stats"].copy(),
-                z["ylast"].copy(), prev)
+                z["ylast"].copy(), prev, events)
 
 
 def _differences(theirs, ours) -> str:

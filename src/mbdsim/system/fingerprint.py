@@ -128,6 +128,8 @@ def _walk(root, model_attrs, refs=None, portable=False) -> tuple[bytes, bool]:
             items = sorted(obj, key=repr)
             add(b"S%d" % len(items))
             extend(reversed(items))
+        elif isinstance(obj, types.ModuleType):   # a module (e.g. numpy in a closure): by its name
+            add(b"M" + obj.__name__.encode())
         elif t.__module__.startswith("numba.") and isinstance(getattr(obj, "py_func", None), types.FunctionType):
             add(b"J")                       # a numba.njit dispatcher: as the Python function it compiles
             push(obj.py_func)               # (its own fields are numba's caches: megabytes of objects)
