@@ -87,6 +87,7 @@ PROBE = textwrap.dedent("""
     res = mb.simulate(m, END, 0.001, out=sys.argv[1], progress=progress)
     from numba.core.registry import CPUDispatcher
     import gc
+    gc.unfreeze()   # the kernels' dispatchers, made at import, are in the collector's permanent generation
     kernels = [o for o in gc.get_objects() if isinstance(o, CPUDispatcher) and o.overloads]
     loaded = sorted(f"{o.py_func.__module__}.{o.py_func.__name__}" for o in kernels)
     compiled = sum(sum(o.stats.cache_misses.values()) for o in kernels)   # not loaded from numba's cache
