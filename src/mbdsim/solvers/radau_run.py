@@ -212,7 +212,7 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     fast modes oscillate with an amplitude above the tolerance (lightly damped contact, an excited stiff
     spring), every method must resolve them and the explicit eighth-order one does it with fewer
     evaluations (a box sliding on four contact corners: Radau 7,900 steps against DOP853's 1,200). So
-    (absolute coordinates, no joint friction) Radau first runs over PROBE_STEPS of DOP853's mean step, to
+    (absolute coordinates, no joint friction, no sensors) Radau first runs over PROBE_STEPS of DOP853's mean step, to
     the next output time, and when it needed more right-hand-side evaluations per unit of time than
     DOP853 did before t_s, DOP853 continues from there without the stiffness test (`_after_probe`)."""
     from .autoswitch import _align_quaternions, _Joined, join, merge_stats
@@ -227,7 +227,8 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     rest = np.concatenate([[t_s], np.asarray(times, float)[len(tp):]])
     rr = RadauRun.sharing(run, rtol, atol, max_step)
     y_start = getattr(run, "last_state", None) if run.joint_space else None
-    t_p = None if run.joint_space or len(sys.lock_rows) else _probe_end(pre["stats"], float(times[0]), t_s, rest)
+    trial = not (run.joint_space or len(sys.lock_rows) or getattr(sys.model, "sensors", None))
+    t_p = _probe_end(pre["stats"], float(times[0]), t_s, rest) if trial else None
     second = _integrate(sys, rep_s, rr, rest if t_p is None else rest[rest <= t_p],
                         None if progress is None else _Joined(progress, first, t_s),
                         None if y_start is None else np.array(y_start))
