@@ -196,10 +196,9 @@ def _switching_check(sys):
 
 # auto's hand-over tries Radau over this many of DOP853's mean accepted steps, or this share of the time
 # left, whichever is longer, first (`_probe_end`: Radau's steps take a while to grow from its start), and
-# keeps it when its steps under way are at least PAY_STEP times DOP853's mean step (an implicit step costs
-# several explicit ones: its Newton iterations, and LU factorisations that grow as n^3 with the state)
-# with fewer right-hand-side evaluations per second of model time
-PROBE_STEPS, PROBE_SHARE, PAY_STEP = 50, 0.1, 4.0
+# keeps it when it needed at most 1 / PAY of DOP853's right-hand-side evaluations per second of model
+# time (an implicit step also factorises and solves: LU factorisations that grow as n^3 with the state)
+PROBE_STEPS, PROBE_SHARE, PAY = 50, 0.1, 2.0
 
 
 def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):
@@ -256,12 +255,11 @@ def _probe_end(stats, t0, t_s, rest):
 
 
 def _radau_under_way(probe, rr):
-    """(step [s], right-hand-side evaluations per second of model time) of Radau once under way: the
-    largest step of the trial's second half (its first steps start small and grow) and its evaluations per
-    accepted step (its finite-difference Jacobians included: contact recomputes them every few steps)
-    over that step; None without the steps' record, or while its steps still grow at the trial's end (the
-    last above twice the median of the second half: an undamped fast mode that the explicit run left
-    excited at its error's level, which Radau resolves until its steps damp it; Radau continues)."""
+    """(largest step [s] of the trial's second half, right-hand-side evaluations per second of model time
+    over the trial, its finite-difference Jacobians included: contact recomputes them every few steps)
+    of Radau's trial; None without the steps' record, or while its steps still grow at the trial's end
+    (the last above twice the median of the second half: an undamped fast mode that the explicit run left
+    excited at its error's level, which Radau resolves until its growing steps damp it; Radau continues)."""
     cp = rr.checkpoints
     if cp is None or len(cp[1]) < 2:
         return None
@@ -269,15 +267,14 @@ def _radau_under_way(probe, rr):
     late = h[len(h) // 2:]
     if h[-1] > 2.0 * float(np.median(late)):
         return None
-    h_r = float(np.max(late))
-    return h_r, probe.stats["nfev"] / max(probe.stats["steps"], 1) / h_r
+    return float(np.max(late)), probe.stats["nfev"] / (float(probe.time[-1]) - float(probe.time[0]))
 
 
 def _after_probe(sys, rep, res, probe, rest, explicit, rr, tol, progress, reason):
     """`res` (the run up to the probe's end t_p = rest[0]) continued over `rest`: by Radau when, under way
-    (`_radau_under_way`), its step is at least PAY_STEP times DOP853's mean step before the switch and it
-    needs fewer right-hand-side evaluations per second of model time (explicit = (step, rate) of DOP853),
-    else by DOP853 without the stiffness test; joined, statistics summed."""
+    (`_radau_under_way`), it needed at most 1 / PAY of the right-hand-side evaluations per second of model
+    time of DOP853 before the switch (explicit = (mean step, rate) of DOP853), else by DOP853 without the
+    stiffness test; joined, statistics summed."""
     from .autoswitch import _Joined, join
     from .compiled_run import integrate_compiled
     t_p = float(rest[0])
@@ -285,7 +282,7 @@ def _after_probe(sys, rep, res, probe, rest, explicit, rr, tol, progress, reason
     way = _radau_under_way(probe, rr)
     prog = None if progress is None else _Joined(progress, res, t_p)
     h_d, rate_d = explicit
-    explicit = way is not None and (way[0] < PAY_STEP * h_d or way[1] > rate_d)
+    explicit = way is not None and PAY * way[1] > rate_d
     third = integrate_compiled(sys, rep_p, rest, *tol, progress=prog) if explicit else \
         _integrate(sys, rep_p, RadauRun.sharing(rr, *tol), rest, prog)
     out = join(res, third, t_p)
