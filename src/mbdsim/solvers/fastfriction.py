@@ -45,7 +45,8 @@ functions, 15 [failed element + 1, iterations] int64, 16 new switching values (k
 scratch (3, 3), 18 switching scratch (k,), 19 combined multipliers (nc), 20 held group (k,) int64 (the
 group's id, its first sticking element, for its sticking and held members; -1: none), 21 the held
 members' lock rows in the sticking ones' c_h (k, k) (row h, column a), 22 static capacities (k,),
-23 generators (k, k), 24 orthonormal basis (k, k), 25 members (k,) int64, 26 subset indices (k,) int64.
+23 generators (k, k), 24 orthonormal basis (k, k), 25 members (k,) int64, 26 subset indices (k,) int64,
+27 the LU row swaps of S (k,) int64.
 """
 from __future__ import annotations
 
@@ -53,7 +54,7 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .kkt_tree import _row_dot
+from .kkt_tree import _row_dot, lu_factor, lu_solve
 
 V_TOL = 1e-9        # |xd| [m/s or rad/s] below which a joint counts as at rest at an event
 STICK_TOL = 1e-10   # relative tolerance on the static friction limit
@@ -133,35 +134,15 @@ def normal_load(fc, e, A, R, U, freeze, linear):
 
 
 @kernel(_nrt=False)
-def _small_solve(S, b, x):
-    """x = S^-1 b by Gaussian elimination with partial pivoting (S, b overwritten); False if singular."""
+def _small_solve(fw, S, b, x):
+    """x = S^-1 b (k x k) by `kkt_tree.lu_factor` (partial pivoting, the row swaps in fw[27]; S
+    overwritten); False if singular."""
     k = b.shape[0]
-    big = 0.0
+    if not lu_factor(S, k, fw[27], 1e-14):
+        return False
     for i in range(k):
-        for j in range(k):
-            big = max(big, abs(S[i, j]))
-    for c in range(k):
-        p = c
-        for i in range(c + 1, k):
-            if abs(S[i, c]) > abs(S[p, c]):
-                p = i
-        if not abs(S[p, c]) > 1e-14 * big:
-            return False
-        if p != c:
-            for j in range(k):
-                S[c, j], S[p, j] = S[p, j], S[c, j]
-            b[c], b[p] = b[p], b[c]
-        for i in range(c + 1, k):
-            m = S[i, c] / S[c, c]
-            if m != 0.0:
-                for j in range(c, k):
-                    S[i, j] -= m * S[c, j]
-                b[i] -= m * b[c]
-    for c in range(k - 1, -1, -1):
-        s = b[c]
-        for j in range(c + 1, k):
-            s -= S[c, j] * x[j]
-        x[c] = s / S[c, c]
+        x[i] = b[i]
+    lu_solve(S, fw[27], k, x)
     return True
 
 
@@ -212,7 +193,7 @@ def couple(fc, fw, Jc, bi, bj, A, gamma, x6, lam):
                         S[e, m] -= c * normal_load(fc, e, A, R, U, False, True)
         for e in range(k):
             fp[e] = f[e]
-        if not _small_solve(S, rhs, f):
+        if not _small_solve(fw, S, rhs, f):
             info[0], info[1] = 1, it + 1
             return False
         big, change, worst = 0.0, 0.0, 0
@@ -380,7 +361,7 @@ def stick_rates(fc, fw, Jc, bi, bj, v6):
             if mode[m] == 2:
                 S[e, m] = _row_dot(Jc, bi, bj, lock[e], E6[m])
         rhs[e] = -_row_dot(Jc, bi, bj, lock[e], v6)
-    if not _small_solve(S, rhs, f):
+    if not _small_solve(fw, S, rhs, f):
         return False
     for m in range(k):
         if mode[m] == 2:

@@ -234,7 +234,7 @@ def _friction_work(fc, nf, nc, nv) -> tuple:
     return (np.zeros(k, np.int64), z(k), z(k), z((k, nf, 6)), z((k, nc)), z((nf, 6)), z(nc), z((k, k)), z(k), z(k),
             z(k), z((k, 4, 3)), z(nv), z(nc), z((nf, 6)), np.zeros(2, np.int64), z(k), z((3, 3)), z(k), z(nc),
             np.full(k, -1, np.int64), z((k, k)), z(k), z((k, k)), z((k, k)), np.zeros(k, np.int64),
-            np.zeros(k, np.int64))
+            np.zeros(k, np.int64), np.zeros(k, np.int64))
 
 
 def _contacts(sys) -> tuple:
