@@ -7,10 +7,11 @@ then the sensors: program, direction, stop flag and value, slots 18-21); `work(e
 (slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
 count and scratch; `solvers.fastdop.run` watches them).
 A Python-callable sensor is a program calling its ctypes callback (solvers.pyloads.sensor_callback) with t.
-A Python-callable load, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
-event-driven reference path), raises NotCompiled with the reason. On the joint-coordinate path a joint
+A Python-callable load raises NotCompiled with the reason. On the joint-coordinate path a joint
 measure reads the tree's own coordinate: angle = angle at assembly + sign theta (sign -1 when the
-joint's body_i is the child in the tree).
+joint's body_i is the child in the tree). In absolute coordinates (closed loops) a joint angle is read
+from the frames and continued beyond +-pi from the angle at the last accepted step (work slot 7; the step
+loops move it, `exprloads_kernel.accept_angles`).
 """
 from __future__ import annotations
 
@@ -80,10 +81,13 @@ EVENT_CAPACITY = 64   # sensor events a run holds (at least two steps' worth) be
 def work(ex, stack_size) -> tuple:
     """Scratch of `expr_loads`: the variable vector x (1 + measures) and the interpreter's stack; of the
     sensors: their values (minus the threshold) at the last accepted step and at the new one, the events
-    found (time [s], sensor index), their count, and the values at a probed time."""
+    found (time [s], sensor index), their count, and the values at a probed time; of the joint angles read
+    from the frames (absolute coordinates): their references [rad] (slot 7: the continued angle at the last
+    accepted state, 0 at the start: the first angle in (-pi, pi], as on the reference path)."""
     ns = len(ex[18])
     return (np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4)), np.zeros(ns), np.zeros(ns),
-            np.zeros((max(EVENT_CAPACITY, 2 * ns) if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns))
+            np.zeros((max(EVENT_CAPACITY, 2 * ns) if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns),
+            np.zeros(len(ex[0])))
 
 
 def _target(sys, name):
@@ -107,9 +111,10 @@ def _joint_measure(sys, m, mode, tree, fr):
         jq = int(qadr[child])
         ang, _, sl, _ = joint_coordinate(sys, fr, jt)
         jc = (float((ang if rot else sl)[0]), sign)
-    elif rot and not m.rate:
-        raise _NotCompiled(f"the angle of joint '{jt.name}' (continued beyond +-pi by events on the "
-                           "reference path, or the joint-coordinate state)")
+    elif rot and not m.rate and g.particle_j:
+        raise _NotCompiled(f"the angle of joint '{jt.name}' (its body_j is a particle)")
+    # absolute coordinates: the angle from the frames, continued from the angle at the last accepted step
+    # (system.exprloads_kernel.continued, accept_angles)
     return kind, (g.bi, g.bj, 0), v, jq, jc
 
 
