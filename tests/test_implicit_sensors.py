@@ -1,0 +1,78 @@
+"""Sensors on the compiled implicit steppers (issue 29): Radau IIA and HHT-alpha watch the model's sensors
+after every accepted step and locate a crossing on the step's polynomial (Radau's collocation polynomial,
+HHT's Hermite cubic) with DOP853's sensor machinery; a "stop" ends the run exactly there. Closed form: a
+1 kg particle on a stiff spring-damper (k = 1e8 N/m, c = 1e6 N s/m: eigenvalues -100 and -1e6 1/s, a
+stiffness ratio of 1e4) released u0 from its equilibrium: u(t) = a e^(r1 t) + b e^(r2 t); the sensor
+stops the run when u falls to u0 / 2 (the time by brentq on the closed form)."""
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import mbdsim as mb
+
+K, C, U0 = 1e8, 1e6, 1e-3
+
+
+def u(t):
+    r1, r2 = (-C + np.sqrt(C * C - 4 * K)) / 2, (-C - np.sqrt(C * C - 4 * K)) / 2
+    a = -r2 * U0 / (r1 - r2)
+    return a * np.exp(r1 * t) + (U0 - a) * np.exp(r2 * t)
+
+
+def stiff(signal, action="stop", direction=-1):
+    """The particle (x = 1 + u on a translational joint, no gravity) with a sensor on `signal`."""
+    m = mb.Model("stiff spring", gravity=(0, 0, 0))
+    p = m.add_particle("p", 1.0, position=(1.0 + U0, 0, 0))
+    m.add_translational("slide", m.ground, p, (1.0, 0, 0), (1, 0, 0))
+    m.add_spring_damper("k", m.ground, p, K, C, 1.0)
+    m.add_sensor("half", signal, value=1.0 + U0 / 2, direction=direction, action=action)
+    return m
+
+
+T_HALF = brentq(lambda t: u(t) - U0 / 2, 1e-6, 0.1)
+
+
+@pytest.mark.parametrize("method, rtol, tol", [("radau", 1e-10, 1e-8), ("hht", 1e-8, 1e-5), ("auto", 1e-9, 1e-8)])
+def test_stop_sensor_on_the_implicit_steppers_at_the_closed_form_time(method, rtol, tol):
+    """("auto": DOP853 detects the stiffness and the compiled Radau IIA continues, watching the sensor.)"""
+    res = mb.simulate(stiff("DX(p)"), 0.05, output_step=1e-3, method=method, rtol=rtol)
+    if method == "auto":
+        assert "then Radau IIA (compiled)" in res.stats["method"], res.stats["method"]
+    assert res.success and "compiled" in res.stats["method"], res.stats["method"]
+    assert "stopped by sensor 'half'" in res.message
+    (ev,) = res.sensor_events
+    assert abs(ev.time - T_HALF) < tol * T_HALF, (ev.time, T_HALF)
+    assert res.time[-1] == ev.time and np.all(np.diff(res.time) > 0)
+    assert abs(res.position("p")[-1, 0] - (1.0 + U0 / 2)) < 1e-6 * U0   # the state on the crossing
+    assert res.stats["steps"] < 400   # stiff: the implicit steppers take long steps (the fast mode decays)
+
+
+def test_record_and_callable_sensors_on_radau():
+    """A "record" sensor lets the run go on (its event at the closed-form time), a rising one never fires,
+    and a Python-callable signal (called back from the Radau step loop) stops at the same time."""
+    m = stiff("DX(p)", action="record")
+    m.add_sensor("rising", "DX(p)", value=1.0 + U0 / 2, direction=+1, action="record")
+    res = mb.simulate(m, 0.02, output_step=1e-3, method="radau", rtol=1e-10)
+    assert res.success and res.time[-1] == pytest.approx(0.02)
+    assert [e.name for e in res.sensor_events] == ["half"]
+    assert abs(res.sensor_events[0].time - T_HALF) < 1e-8 * T_HALF
+    cb = mb.simulate(stiff(lambda t, s: s.position("p")[0]), 0.05, output_step=1e-3, method="radau", rtol=1e-10)
+    assert "compiled" in cb.stats["method"] and "stopped by sensor 'half'" in cb.message
+    assert abs(cb.sensor_events[0].time - T_HALF) < 1e-8 * T_HALF
+
+
+@pytest.mark.parametrize("method", ["radau", "hht"])
+def test_failing_callable_sensor_ends_an_implicit_run_at_once(method):
+    """A sensor callable that raises at t > 5 ms ends the run there (success False, the error naming the
+    sensor and the time), with the outputs before it kept."""
+    from mbdsim.errors import EvaluationError
+
+    def signal(t, s):
+        if t > 0.005:
+            raise RuntimeError("probe lost")
+        return s.position("p")[0]
+    res = mb.simulate(stiff(signal, action="record"), 0.05, output_step=1e-3, method=method)
+    assert not res.success and isinstance(res.error, EvaluationError)
+    assert "sensor 'half'" in str(res.error) and "probe lost" in str(res.error)
+    assert 0.005 < res.error.time < 0.01
+    assert 0.003 <= res.time[-1] <= 0.005 + 1e-12
