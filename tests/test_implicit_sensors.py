@@ -32,9 +32,12 @@ def stiff(signal, action="stop", direction=-1):
 T_HALF = brentq(lambda t: u(t) - U0 / 2, 1e-6, 0.1)
 
 
-@pytest.mark.parametrize("method, rtol, tol", [("radau", 1e-10, 1e-8), ("hht", 1e-8, 1e-5), ("auto", 1e-9, 1e-8)])
+@pytest.mark.parametrize("method, rtol, tol", [("radau", 1e-10, 1e-9), ("hht", 1e-8, 3e-5), ("auto", 1e-9, 1e-9)])
 def test_stop_sensor_on_the_implicit_steppers_at_the_closed_form_time(method, rtol, tol):
-    """("auto": DOP853 detects the stiffness and the compiled Radau IIA continues, watching the sensor.)"""
+    """The crossing is exact on the stepper's own solution (its state at the stop on the level to 1e-9 of
+    u0); against the closed form: Radau 7e-12 relative at rtol 1e-10, HHT (second order) 1.1e-5 at rtol
+    1e-8, its solution's own error there (3.4e-6 u0, over a slope of 50 u0 / s). "auto": DOP853 detects the
+    stiffness and the compiled Radau IIA continues, watching the sensor."""
     res = mb.simulate(stiff("DX(p)"), 0.05, output_step=1e-3, method=method, rtol=rtol)
     if method == "auto":
         assert "then Radau IIA (compiled)" in res.stats["method"], res.stats["method"]
@@ -43,8 +46,8 @@ def test_stop_sensor_on_the_implicit_steppers_at_the_closed_form_time(method, rt
     (ev,) = res.sensor_events
     assert abs(ev.time - T_HALF) < tol * T_HALF, (ev.time, T_HALF)
     assert res.time[-1] == ev.time and np.all(np.diff(res.time) > 0)
-    assert abs(res.position("p")[-1, 0] - (1.0 + U0 / 2)) < 1e-6 * U0   # the state on the crossing
-    assert res.stats["steps"] < 400   # stiff: the implicit steppers take long steps (the fast mode decays)
+    assert abs(res.position("p")[-1, 0] - (1.0 + U0 / 2)) < 1e-9 * U0   # the state on the crossing
+    assert res.stats["steps"] < 600   # long steps over the decayed fast mode (DOP853's stability: > 2000)
 
 
 def test_record_and_callable_sensors_on_radau():

@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 
 import mbdsim as mb
 
+pytestmark = pytest.mark.filterwarnings("ignore::mbdsim.RedundantConstraintWarning")   # (3D revolutes: redundant)
 G = 9.81
 A_, B_, C_, D_ = 0.1, 0.3, 0.25, 0.3          # crank, coupler, rocker, ground link [m] (Grashof crank-rocker)
 MASS = np.array([0.5, 1.2, 0.9])
@@ -121,7 +122,7 @@ def test_coupler_pin_spring_in_the_loop_runs_compiled_against_the_planar_ode(met
     ref, _ = reference(springs, 0.0, 1.0, res.time)
     err = np.max(np.abs(crank_angle(res) - ref))
     assert err < (1e-8 if method == "auto" else 1e-7), err
-    assert np.ptp(ref) > 0.3   # the mechanism moves
+    assert np.ptp(ref) > 0.1   # the mechanism moves
 
 
 def test_crank_turning_several_revolutions_winds_the_loop_springs_beyond_pi():
