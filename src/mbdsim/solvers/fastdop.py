@@ -36,6 +36,8 @@ EVENTS_FULL = 10       # run status: the sensor event buffer is full (hand the e
 FRICTION_EVENT = 13    # run status: a joint-friction switching function crossed zero; y is the state at st[0]
 SENSOR_FAILED = 14     # run status: a sensor's value is not finite (a Python-callable sensor raised); y, st[0]:
 #                        the last accepted state before it (every stepper: fastdop, fasthht, fastradau)
+SWITCH_EVENT = 15      # run status (implicit steppers): a stop's clearance or a contact's gap crossed zero; y is
+#                        the state at st[0] (restart there: solvers.fastswitch)
 
 # Hairer's stiffness test flags h |df|/|dy| above this; dop853.f uses 6.1, but stability-limited steps of an
 # overdamped 1e9 N/m spring hovered at 5.7 and were never flagged (0.74 s against HHT's 0.08 s): 5.0 is
@@ -99,7 +101,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     With `watch`, the model's expression sensors (cm[43] slots 18-21) are evaluated after every accepted
     step (`_watch`): events go to the buffer wk[44][4] (EVENTS_FULL when it may not hold the next step's:
     hand them over, reset the count wk[44][5] and call again), and a "stop" event ends the run with
-    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time. With `watch` and
+    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time; a sensor value
+    that is not finite (a Python-callable sensor that raised) ends it with SENSOR_FAILED at the step's start.
+    After every accepted step the joint angles read from the frames take their continued values there as
+    references (`fastdyn.accept_state`). With `watch` and
     joint friction (cm[48]), its switching functions are watched the same way (`_watch_friction`; their values
     at the start computed here, with the modes the caller set in wk[50]): the first zero ends the run with
     FRICTION_EVENT, the outputs up to its time written and y the projected state at st[0] = that time (the

@@ -412,10 +412,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             t_ev = friction_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])
             if t_ev < np.inf:
                 return stop_at(cm, wk, Q, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo)
-        if n_sensors > 0:   # the sensors' crossings in the step (fastswitch): a "stop" ends the run there
-            t_stop = sensor_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])
-            if t_stop < np.inf:
-                return sensor_stop(cm, wk, Q, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo)
+        if n_sensors > 0:   # the sensors' crossings in the step (fastswitch): a "stop" ends the run there,
+            t_stop, t_cut = sensor_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])   # a switching zero the step
+            if t_stop < np.inf or t_cut < np.inf:
+                return sensor_stop(cm, wk, Q, y, t, h, t_stop, t_cut, tout, iout, proj_tol, st, stats, yo)
         for i in range(n):
             yq[i] = y[i]
             y[i] = ynew[i]

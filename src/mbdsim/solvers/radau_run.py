@@ -86,9 +86,11 @@ class RadauRun(CompiledRun):
         if self.friction is not None:   # the initial modes (all joints at rest decided together)
             self.friction.decide(t0, y)
         try:
-            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL, fastdop.FRICTION_EVENT) and iout < nout:
-                if status == fastdop.FRICTION_EVENT:   # a stick/slip event at st[0]: decide, restart there
-                    self.friction.decide(st[0], y)     # (the one decision of every stepper: friction_run)
+            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL, fastdop.FRICTION_EVENT,
+                             fastdop.SWITCH_EVENT) and iout < nout:
+                if status in (fastdop.FRICTION_EVENT, fastdop.SWITCH_EVENT):   # restart at the event st[0]: a
+                    if status == fastdop.FRICTION_EVENT:   # stick/slip event decided first (the one decision of
+                        self.friction.decide(st[0], y)     # every stepper: friction_run); a stop's or contact's zero
                     st[1:] = 0.0
                     if tout[-1] - st[0] <= 1e-14 * max(1.0, abs(st[0])):   # at the end time: its state is the
                         Y[iout:] = y                                         # last output (absolute coordinates)
@@ -101,6 +103,7 @@ class RadauRun(CompiledRun):
                         keep, SY, ST, SQ = False, SY[:0], ST[:0], SQ[:0]
                 self._take_events()
                 status, iout = self._step_loop(a, w, st, y, f, tout, iout, Y, scratch, SY, ST, SQ, ns, start_row)
+                start_row = False   # (a restart at an event starts from the stepper's own state y)
                 if st[1] == 0.0:   # the start failed (a restart after a friction event keeps the outputs before it)
                     if st[0] == t0:
                         iout = 0

@@ -143,11 +143,15 @@ def _compile(expr, slots, inputs, found):
                           np.array(em.tables, dtype=float), max(em.max_depth, 1))
 
 
-def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
+def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None, switches=False):
     """(ex, stack size) of the expression loads `elems` and the Sensors `sensors` (expression signals);
     NotCompiled (from system.compiled) when one cannot be compiled. Model inputs read by the expressions are
     constants of the packed programs: with `input_slots` (a list), (input name, index into ex[14], the
-    packed constants) is appended for each place an input is read."""
+    packed constants) is appended for each place an input is read. With `switches`, the switching
+    functions of the stops in `elems` (clearances x - lower, upper - x) and of the model's sphere/plane
+    contacts (signed gaps, `_contact_gap`) follow the sensors as entries with action 2 ("cut": the
+    compiled implicit steppers end their step at a zero and restart there, as the reference path cuts its
+    steps at these events; DOP853 ignores them)."""
     from . import exprvm
     from .compiled import NotCompiled
     from .frames import body_frames
@@ -219,6 +223,19 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
             le = parse_load(sys.model, sensor.text, f"sensor '{sensor.name}'", "signal")
             p = program(sensor, le, "sensor")
         sn.append((p, sensor.direction, int(sensor.action == "stop"), sensor.value))
+    if switches:
+        for e in elems:
+            if isinstance(e, Stop):
+                walls = ([f"x - {float(e.lower)!r}"] if e.lower is not None else []) + \
+                        ([f"{float(e.upper)!r} - x"] if e.upper is not None else [])
+                for text in walls:
+                    sn.append((program(e, _coordinate_expression(text, e.joint, e.dof), "stop"), 0, 2, 0.0))
+        from ..expressions import parse
+        for row, radius in _contact_gaps(sys):
+            ms.append(row)
+            measures[("contact gap", len(ms))] = len(ms) - 1   # (x[len(ms)]: this measure's value)
+            progs.append(_compile(parse(f"g - {radius!r}", ("t", "g")), {"t": 0, "g": len(ms)}, {}, []))
+            sn.append((len(progs) - 1, 0, 2, 0.0))
     if not loads and not sn:
         return empty(), 4
     pk = exprvm.pack(progs)
@@ -237,6 +254,32 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
           pk.code, pk.consts, pk.tables, pk.start, pk.end,
           *(np.array([x[c] for x in sn], dt).reshape(len(sn)) for c, dt in enumerate((i, i, i, float))))
     return ex, int(pk.stack_size)
+
+
+def _contact_gaps(sys):
+    """(measure row, radii) of each sphere-sphere and sphere-plane contact (system.compiled._contacts): the
+    distance of the centres (DM) or the centre's height over the plane along its normal (DZ in axes whose
+    z is the normal), the gap [m] being that minus the radii."""
+    from .compiled import _contacts
+    ct_f, ct_kind, ct_s, ct_n, ct_par = _contacts(sys)
+    out = []
+    eye3 = np.broadcast_to(np.eye(3), (3, 3, 3))
+    for c in range(len(ct_kind)):
+        fi, fj = int(ct_f[c, 0]), int(ct_f[c, 1])
+        if ct_kind[c] == 0:
+            out.append(((3, (fi, fj, 0), np.array([ct_s[c, 0], ct_s[c, 1]]), eye3, np.zeros((3, 3)), -1, (0.0, 1.0)),
+                        float(ct_par[c, 0] + ct_par[c, 1])))
+            continue
+        fs, fp, R, ss, sp = (fj, fi, ct_par[c, 1], ct_s[c, 1], ct_s[c, 0]) if ct_kind[c] == 1 else \
+            (fi, fj, ct_par[c, 0], ct_s[c, 0], ct_s[c, 1])
+        n = np.asarray(ct_n[c], float) / np.linalg.norm(ct_n[c])
+        a = np.eye(3)[int(np.argmin(np.abs(n)))]
+        x = np.cross(a, n)
+        x /= np.linalg.norm(x)
+        Rk = np.column_stack([x, np.cross(n, x), n])   # body axes of the plane: z along its normal
+        out.append(((2, (fs, fp, fp), np.array([ss, sp]), np.stack([np.eye(3), np.eye(3), Rk]), np.zeros((3, 3)), -1,
+                     (0.0, 1.0)), float(R)))
+    return out
 
 
 def _measure_row(sys, m, mode, tree, fr):
