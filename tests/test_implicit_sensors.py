@@ -109,3 +109,17 @@ def test_radau_cuts_its_steps_at_the_stop_and_contact_zeros():
     assert res.success and "compiled" in res.stats["method"]
     t_on = res.crossings(lambda r: r.position(ball)[:, 1], 0.1)[0]
     assert abs(t_on - np.sqrt(2 * 0.9 / 9.81)) < 1e-12
+
+
+@pytest.mark.parametrize("method", ["radau", "hht"])
+def test_implicit_sensor_events_beyond_the_buffer(method):
+    """sin(40 t) crosses zero at k pi / 40, 127 times in 10 s, more than the kernel's event buffer holds
+    (handed to Python when full, EVENTS_FULL): every crossing at its time to 1e-12 s."""
+    from mbdsim.system import exprloads_pack
+    m = mb.Model("drop", gravity=(0, 0, -9.81))
+    m.add_body("ball", 0.5, inertia=(0.01, 0.01, 0.01), position=(0, 0, 1e3))
+    m.add_sensor("wave", "sin(40*t)", action="record")
+    res = mb.simulate(m, 10.0, 0.1, method=method, rtol=1e-8, max_step=0.01, monitor=False)
+    t = np.array([e.time for e in res.sensor_events])
+    assert len(t) == 127 > exprloads_pack.EVENT_CAPACITY
+    assert np.max(np.abs(t - np.arange(1, 128) * np.pi / 40)) < 1e-12
