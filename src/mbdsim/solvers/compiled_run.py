@@ -18,7 +18,7 @@ from ..results.stream import ProgressError, notify
 from ..system.compiled import NotCompiled, Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
-from . import fastdop, fastdyn, minnorm, pyloads
+from . import anglerefs, fastdop, fastdyn, minnorm, pyloads
 from .sensors import SensorEvent
 from .fastdyn import (CALLBACK_FAILED, FRICTION_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR,
                       STIFF, TINY_STEP)
@@ -169,61 +169,13 @@ class CompiledRun:
                 VD[sel], LAM[sel] = VDs, LAMs
         return VD, LAM
 
-    def _angle_columns(self):
-        """The measures of cm.exprloads that are joint angles read from the frames (absolute coordinates),
-        as a boolean mask (None when there are none)."""
-        ex = self.cm.exprloads
-        if self.joint_space or not len(ex) or not len(ex[0]):
-            return None
-        sel = (ex[0] == 20) & (ex[5] < 0)
-        return sel if sel.any() else None
-
     def angle_refs(self, times, Y, steps=False):
-        """Absolute coordinates: the references [rad] of the joint angles that loads and sensors read from
-        the frames (one column per measure of cm.exprloads; the kernels continue each angle to within pi of
-        its reference) at the output rows Y (at `times` [s]), or with `steps` at the run's accepted steps:
-        the angles at the run's step starts (checkpoints) continued from the start's references
-        (`angle_ref0`), each row taking that of the last step before it; without checkpoints the rows'
-        own angles continued from row to row, anchored at the run's current references (the last accepted
-        state, just after the last row). None when the model has no such angle."""
-        sel = self._angle_columns()
-        if sel is None:
-            return None
-        a, w = self.cm.arrays(), self.work.arrays()
-        cp = getattr(self, "checkpoints", None)
-        ref0 = getattr(self, "angle_ref0", np.zeros(len(sel)))
-
-        def wrapped(rows):
-            out = np.zeros((len(rows), len(sel)))
-            fastdyn.angle_rows(a, w, np.ascontiguousarray(rows, dtype=float), out)
-            return out
-        if cp is not None and len(cp[1]):
-            SY, ST = cp
-            C = np.unwrap(np.vstack([ref0, wrapped(SY)]), axis=0)[1:]
-            if steps:
-                return np.where(sel, C, 0.0)
-            k = np.clip(np.searchsorted(ST[:, 0], np.asarray(times, float), side="right") - 1, 0, len(ST) - 1)
-            return np.where(sel, C[k], 0.0)
-        if not len(Y):
-            return np.zeros((0, len(sel)))
-        back = np.unwrap(np.vstack([w[44][7], wrapped(Y)[::-1]]), axis=0)[1:]
-        return np.where(sel, back[::-1], 0.0)
+        """The joint angles' references at the rows Y (solvers.anglerefs.angle_refs)."""
+        return anglerefs.angle_refs(self, times, Y, steps)
 
     def kept_angle_refs(self):
-        """A context that restores the run's joint-angle references (work slot 44[7]) after evaluations at
-        other states (outputs, dense output, re-integration), so that a run continued later goes on from
-        its own."""
-        import contextlib
-        ref = self.work.arrays()[44][7]
-
-        @contextlib.contextmanager
-        def keep():
-            saved = ref.copy()
-            try:
-                yield
-            finally:
-                ref[:] = saved
-        return keep()
+        """A context keeping the run's joint-angle references (solvers.anglerefs.kept)."""
+        return anglerefs.kept(self.work.arrays()[44][7])
 
     def joint_states(self, times, Y):
         """Tree path: the joint state [theta, theta_dot] of each output row Y[k] at times[k] with continuous
