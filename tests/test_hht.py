@@ -86,14 +86,17 @@ def test_redundant_four_bar_runs_with_hht():
 
 
 def test_hht_locates_contact_onset_and_follows_torsion_spring_past_half_turns():
-    """Events work under the default method: contact onset at the free-fall time, and a torsion
-    spring spun through many half turns agrees with the high-accuracy method."""
+    """Contact onset at the free-fall time, and a torsion spring spun through many half turns agrees with
+    the high-accuracy method. The compiled HHT cuts its step at the gap's zero located on the Hermite cubic
+    of the step that crossed it, which is not the free-fall parabola there: the onset is 2.3e-8 s off (5e-8
+    relative, within its default rtol 1e-5; the reference HHT, redoing the step up to the event, 1e-9)."""
     m = mb.Model(gravity=(0, -9.81, 0))
     ball = m.add_body("ball", 1.0, (0.004, 0.004, 0.004), position=(0, 1.0, 0))
     m.add_contact("c", mb.Sphere(ball, 0.1), mb.Plane(m.ground, (0, 0, 0), (0, 1, 0)), 1e5, 1.5, 10.0, 1e-3)
     res = mb.simulate(m, 0.6, 0.01, method="hht")
     t_on = res.crossings(lambda r: r.position(ball)[:, 1], 0.1)[0]
-    assert abs(t_on - np.sqrt(2 * 0.9 / 9.81)) < 1e-9
+    assert "compiled" in res.stats["method"]
+    assert abs(t_on - np.sqrt(2 * 0.9 / 9.81)) < 1e-7
     m = mb.Model()
     disk = m.add_body("d", 2.0, (0.3, 0.3, 0.5), angular_velocity=(0, 0, 20))
     jt = m.add_revolute("r", m.ground, disk, (0, 0, 0), (0, 0, 1))

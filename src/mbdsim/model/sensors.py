@@ -48,7 +48,10 @@ class SensorsMixin:
         notes it.  The times are in `Result.sensor_events`.  The signal is watched inside the compiled
         DOP853's step loop (method "auto" or "dop853"): an expression as a compiled program, a callable
         through a callback from that loop (solvers.pyloads; its crossing located on the dense output the
-        same way); a named scipy method runs the reference path; HHT does not stop on sensors."""
+        same way); the compiled Radau IIA and HHT watch them on their steps' polynomials (method "radau",
+        "hht", and the automatic method's stiff continuation); a named scipy method runs the reference path.
+        A callable that raises ends the run at once (success False, the error naming the sensor and the
+        time, the outputs before it kept)."""
         entity = f"sensor '{name}'"
         self._claim(name, "sensor")
         try:

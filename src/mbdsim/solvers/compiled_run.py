@@ -18,7 +18,7 @@ from ..results.stream import ProgressError, notify
 from ..system.compiled import NotCompiled, Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
-from . import fastdop, fastdyn, minnorm, pyloads
+from . import anglerefs, fastdop, fastdyn, minnorm, pyloads
 from .sensors import SensorEvent
 from .fastdyn import (CALLBACK_FAILED, FRICTION_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR,
                       STIFF, TINY_STEP)
@@ -32,7 +32,8 @@ _MESSAGES = {SINGULAR: "singular equations of motion (lock-up or singular config
              MAX_STEPS: "step budget exhausted (max_steps)",
              STIFF: "the model is stiff for an explicit method",
              INTERRUPTED: "interrupted (KeyboardInterrupt)", CALLBACK_FAILED: "a load or driver written as a Python callable failed",
-             FRICTION_FAILED: "the coupled joint-friction solve does not converge"}
+             FRICTION_FAILED: "the coupled joint-friction solve does not converge",
+             fastdop.SENSOR_FAILED: "a sensor's value is not finite"}
 PROGRESS_FAILED = 100   # run status (Python side): the progress callback raised (CompiledRun.run_error)
 CHUNK = 256
 CHECKPOINT_BUDGET = 256 * 2**20   # bytes of step checkpoints a run keeps for dense output on demand
@@ -64,6 +65,7 @@ class CompiledRun:
         CHECKPOINT_BUDGET bytes, else None) for dense output on demand. After each chunk of outputs,
         `notify(progress, t, build)` with build() = partial(Y, n_written) when `partial` is given."""
         a, w = self.cm.arrays(), self.work.arrays()
+        self.angle_ref0 = w[44][7].copy()   # the continued joint angles' references at the start
         nout = len(tout)
         y = np.zeros(self.state_size) if self.joint_space else np.array(y0, dtype=float)  # trees: set by run
         n = len(y)
@@ -153,16 +155,27 @@ class CompiledRun:
         sys = self.sys
         VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
         YJ = self.joint_states(times, Y)
+        if YJ is None:   # absolute coordinates: the references of the joint angles read from the frames
+            YJ = self.angle_refs(times, Y)
         times = np.asarray(times, float)
-        for sel in ([slice(None)] if self.friction is None else self.friction.groups(times)):   # the modes then
-            YJs = np.zeros((len(times), 0)) if YJ is None else YJ
-            VDs, LAMs = np.zeros_like(VD[sel]), np.zeros_like(LAM[sel])
-            done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), times[sel], np.ascontiguousarray(Y[sel]),
-                                      np.ascontiguousarray(YJs[sel]), VDs, LAMs)
-            if done < len(VDs):
-                raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[sel][done]))
-            VD[sel], LAM[sel] = VDs, LAMs
+        with self.kept_angle_refs():
+            for sel in ([slice(None)] if self.friction is None else self.friction.groups(times)):   # the modes then
+                YJs = np.zeros((len(times), 0)) if YJ is None else YJ
+                VDs, LAMs = np.zeros_like(VD[sel]), np.zeros_like(LAM[sel])
+                done = fastdop.outputs_at(self.cm.arrays(), self.work.arrays(), times[sel],
+                                          np.ascontiguousarray(Y[sel]), np.ascontiguousarray(YJs[sel]), VDs, LAMs)
+                if done < len(VDs):
+                    raise SolverError(_MESSAGES[SINGULAR] + " at an output time", time=float(times[sel][done]))
+                VD[sel], LAM[sel] = VDs, LAMs
         return VD, LAM
+
+    def angle_refs(self, times, Y, steps=False):
+        """The joint angles' references at the rows Y (solvers.anglerefs.angle_refs)."""
+        return anglerefs.angle_refs(self, times, Y, steps)
+
+    def kept_angle_refs(self):
+        """A context keeping the run's joint-angle references (solvers.anglerefs.kept)."""
+        return anglerefs.kept(self.work.arrays()[44][7])
 
     def joint_states(self, times, Y):
         """Tree path: the joint state [theta, theta_dot] of each output row Y[k] at times[k] with continuous
@@ -211,12 +224,25 @@ class CompiledRun:
         a, w = self.cm.arrays(), self.work.arrays()
         ns = len(self.state_of(Y[0]))
         YJ0 = self.joint_states(times, Y)   # a tree's continuous joint states to restart from
+        R0 = self.angle_refs(times, Y)      # (absolute coordinates: the joint angles' references there)
         K, F, sc, f = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns)), np.zeros(ns)
+        with self.kept_angle_refs():
+            self._spans(times, Y, ts, YJ0, R0, Ys, VD, LAM, K, F, sc, f)
+        nq = self.sys.nq
+        return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
+
+    def _spans(self, times, Y, ts, YJ0, R0, Ys, VD, LAM, K, F, sc, f):
+        """`states_at` without checkpoints: one short re-integration (`fastdop.span`) per time in ts from the
+        output at or before it, into Ys, VD, LAM."""
+        a, w = self.cm.arrays(), self.work.arrays()
+        n, ns = Y.shape[1], len(f)
         for j, t in enumerate(ts):
             k = max(int(np.searchsorted(times, t, side="right")) - 1, 0)
             tout = np.array([t]) if abs(times[k] - t) <= 1e-14 * max(1.0, abs(t)) else np.array([times[k], t])
             Yk, VDk, LAMk = np.zeros((len(tout), n)), np.zeros((len(tout), self.sys.nv)), np.zeros((len(tout), self.sys.nc))
             y0 = self.state_of(Y[k]) if YJ0 is None else YJ0[k].copy()
+            if R0 is not None:
+                w[44][7][:] = R0[k]
             if self.friction is not None:   # the modes at the restart sample (the run's steps are not kept)
                 self.friction.set_modes(float(times[k]))
             YJk = np.zeros((len(tout), 0 if YJ0 is None else ns))
@@ -225,8 +251,6 @@ class CompiledRun:
             if m < len(tout):
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(t))
             Ys[j], VD[j], LAM[j] = Yk[-1], VDk[-1], LAMk[-1]
-        nq = self.sys.nq
-        return Ys[:, :nq], Ys[:, nq:], VD, _full_multipliers(self.sys, self.rows, ts, Ys, VD, LAM)
 
 
     def step_states(self, t_last, y_last):
@@ -257,9 +281,23 @@ class CompiledRun:
         a, w = self.cm.arrays(), self.work.arrays()
         K, F, sc, f = np.zeros((16, ns)), np.zeros((7, ns)), np.zeros((4, ns)), np.zeros(ns)
         step = np.clip(np.searchsorted(ST[:, 0], ts, side="right") - 1, 0, len(ST) - 1)
+        R = self.angle_refs(ST[:, 0], SY, steps=True)   # the joint angles' references at the steps
+        with self.kept_angle_refs():
+            self._redo_steps(SY, ST, ts, step, R, Ys, VD, LAM, K, F, sc, f)
+        nq = sys.nq
+        return Ys[:, :nq], Ys[:, nq:], VD, (_full_multipliers(sys, self.rows, ts, Ys, VD, LAM) if full else LAM)
+
+    def _redo_steps(self, SY, ST, ts, step, R, Ys, VD, LAM, K, F, sc, f):
+        """The outputs at ts of the run's steps `step` redone from their checkpoints (`fastdop.from_checkpoint`)
+        into Ys, VD, LAM; R: the joint angles' references at the steps (or None)."""
+        sys = self.sys
+        n = sys.nq + sys.nv
+        a, w = self.cm.arrays(), self.work.arrays()
         for j in np.unique(step):
             sel = np.flatnonzero(step == j)
             t0, h = ST[j]
+            if R is not None:
+                w[44][7][:] = R[j]
             if self.friction is not None:   # the modes in force during that step
                 self.friction.set_modes(float(t0))
             tq = np.clip(ts[sel], t0, t0 + h)
@@ -269,8 +307,6 @@ class CompiledRun:
             if status != 0:
                 raise SolverError(_MESSAGES.get(status, "integration failed"), time=float(ts[sel[0]]))
             Ys[sel], VD[sel], LAM[sel] = Yk, VDk, LAMk
-        nq = sys.nq
-        return Ys[:, :nq], Ys[:, nq:], VD, (_full_multipliers(sys, self.rows, ts, Ys, VD, LAM) if full else LAM)
 
 
 class Stiff(Exception):
@@ -307,11 +343,9 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
     if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the last sample
-        if not n or t_fail > times[n - 1] + 1e-14 * max(1.0, abs(t_fail)):
-            times, Y = np.append(times[:n], t_fail), np.vstack([Y[:n], y_fail])
-            n += 1
-        stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
-        message, status = f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s", 0
+        from .radau_run import sensor_stop
+        times, Y, n, message = sensor_stop(run, times, Y, n, t_fail, y_fail)
+        status = 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed",
                                  run.run_error)
@@ -359,7 +393,7 @@ def _stats(run, rep) -> dict:
             "factorizations": 0 if run.joint_space else int(run.stats[2] + 2 * run.stats[3]),
             "projections": int(run.stats[3]) if not run.joint_space or len(run.cm.coords[3]) > 1 else 0,
             "order": 8,   # (a tree projects only onto its coordinate constraints: solvers.treecoord)
-            "method": "DOP853 (compiled)",
+            "method": "DOP853 (compiled)", "called_back": tuple(run.cm.python_loads),
             "formulation": "joint coordinates (articulated body)" if run.joint_space else
             "absolute coordinates (tree elimination)", "assembly": rep}
 

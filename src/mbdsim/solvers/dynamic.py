@@ -63,9 +63,8 @@ def simulate(model: Model, end_time: float, output_step: float | None = None, me
     the target relative error of the outputs: the step control uses rtol / 20 (local error) so that the
     accumulated (global) error stays near rtol. Named methods: "dop853" (high accuracy,
     index-1 with projection; compiled when the model allows), "hht" (implicit HHT-alpha with numerical
-    damping), "rk45", "radau" (implicit Radau IIA; compiled when the model allows, has no sensors and no
-    contacts or stops),
-    "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
+    damping; compiled when the model allows, sensors watched on its steps), "rk45", "radau" (implicit
+    Radau IIA; compiled when the model allows, sensors watched on its steps), "bdf". rtol/atol: integrator tolerances (relative; absolute in SI units of
     the coordinates and velocities); atol follows a given rtol in the method's default ratio.
     `res.stats` reports the method used, steps, rejected steps, function and Jacobian evaluations
     (nfev, njev), factorisations, the order and "order_history": (t_start [s], method, order) segments.
@@ -196,7 +195,7 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
             reason = str(exc)
         except Stiff as exc:
             reason = f"stiffness detected at t = {exc.time:.6g} s"
-            if exc.prefix is not None and not getattr(model, "sensors", None):   # the compiled Radau IIA continues
+            if exc.prefix is not None:   # the compiled Radau IIA continues (sensors watched on its steps too)
                 from .radau_run import continue_radau   # from there, at auto's tolerance (joint friction too: its
                 #                                         events on Radau's steps, the same modes)
                 res = continue_radau(sys, rep, times, exc, AUTO_LOCAL * rt, AUTO_LOCAL * at, max_step, progress,
@@ -261,9 +260,6 @@ def _with_history(res, t0) -> Result:
 def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) -> Result:
     if method == "hht":
         from .hht import integrate_hht
-        if getattr(sys.model, "sensors", None):
-            raise ModelError(f"sensor '{next(iter(sys.model.sensors))}'", "method", "sensors are located by "
-                             "the index-1 methods (method='auto', 'dop853', 'rk45', 'radau' or 'bdf'), not HHT")
         names = [e.name for e in sys.model.forces.values() if getattr(evaluator(e), "needs_lambda", False)]
         reason = "the compiled core is off (USE_COMPILED)"
         if USE_COMPILED:   # the compiled HHT-alpha (mbdsim.solvers.hht_run; joint friction included)
@@ -272,7 +268,11 @@ def _run_method(sys, rep, times, method, rtol, atol, max_step, progress=None) ->
             try:
                 return integrate_hht_compiled(sys, rep, times, rtol, atol, max_step, ALPHA, progress)
             except NotCompiled as exc:
-                reason = str(exc)   # sensors, switching elements: the reference HHT locates their events
+                reason = str(exc)
+        if getattr(sys.model, "sensors", None):   # (the compiled HHT watches them on its steps' polynomials)
+            raise ModelError(f"sensor '{next(iter(sys.model.sensors))}'", "method", "sensors are located by the "
+                             f"compiled HHT, which cannot run this model ({reason}), and the index-1 methods "
+                             "(method='auto', 'dop853', 'rk45', 'radau' or 'bdf'), not the reference HHT")
         if names:   # the reference HHT has no stick/slip events
             raise ModelError(f"friction '{names[0]}'", "method", "joint friction with stick/slip runs on the "
                              f"compiled HHT, which cannot run this model ({reason}); use method='dop853', "

@@ -25,14 +25,19 @@ from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that 
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
 from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _end_at, _friction_g, _project,  # noqa: F401
-                          _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, initial_step)
-from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows,
-                      project, read_state, rhs, tree_project, write_state)
+                          _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, drop_after,
+                          initial_step, locate_sensors, sensor_crossings)
+from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations,
+                      accept_state, joint_rows, project, read_state, rhs, tree_project, write_state)
 
 CHECKPOINTS_FULL = 8   # run status: the checkpoint arrays are full (grow them and call again)
 SENSOR_STOP = 9        # run status: a sensor with action "stop" was met; y is the state at its time st[0]
 EVENTS_FULL = 10       # run status: the sensor event buffer is full (hand the events over and call again)
 FRICTION_EVENT = 13    # run status: a joint-friction switching function crossed zero; y is the state at st[0]
+SENSOR_FAILED = 14     # run status: a sensor's value is not finite (a Python-callable sensor raised); y, st[0]:
+#                        the last accepted state before it (every stepper: fastdop, fasthht, fastradau)
+SWITCH_EVENT = 15      # run status (implicit steppers): a stop's clearance or a contact's gap crossed zero; y is
+#                        the state at st[0] (restart there: solvers.fastswitch)
 
 # Hairer's stiffness test flags h |df|/|dy| above this; dop853.f uses 6.1, but stability-limited steps of an
 # overdamped 1e9 N/m spring hovered at 5.7 and were never flagged (0.74 s against HHT's 0.08 s): 5.0 is
@@ -56,10 +61,15 @@ def outputs_at(cm, wk, times, Y, YJ, VD, LAM):
     """Accelerations VD and multipliers LAM at the output states Y (rows at `times`), computed after the
     run and only when a result asks for them; returns the number of rows done (< len on failure).
     YJ: on the tree path the joint-coordinate state of each row (continuous angles: what joint loads
-    read), else empty (0 columns)."""
+    read); in absolute coordinates the references of the joint angles read from the frames at each row
+    (wk[44][7]: one column per measure, within pi of the row's continued angle), or empty (0 columns)."""
     nq = cm[31][0]
+    tree = cm[31][5] == 1
     for k in range(times.shape[0]):
-        y = YJ[k] if YJ.shape[1] else Y[k, :nq]
+        y = YJ[k] if tree and YJ.shape[1] else Y[k, :nq]
+        if not tree and YJ.shape[1]:   # the references of the joint angles read from the frames
+            for m in range(YJ.shape[1]):
+                wk[44][7][m] = YJ[k, m]
         if accelerations(cm, wk, times[k], Y[k, :nq], Y[k, nq:], y, VD[k], LAM[k], bool(True)) != OK:
             return k
     return times.shape[0]
@@ -91,7 +101,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     With `watch`, the model's expression sensors (cm[43] slots 18-21) are evaluated after every accepted
     step (`_watch`): events go to the buffer wk[44][4] (EVENTS_FULL when it may not hold the next step's:
     hand them over, reset the count wk[44][5] and call again), and a "stop" event ends the run with
-    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time. With `watch` and
+    SENSOR_STOP, the outputs up to its time written and y the state at st[0] = that time; a sensor value
+    that is not finite (a Python-callable sensor that raised) ends it with SENSOR_FAILED at the step's start.
+    After every accepted step the joint angles read from the frames take their continued values there as
+    references (`fastdyn.accept_state`). With `watch` and
     joint friction (cm[48]), its switching functions are watched the same way (`_watch_friction`; their values
     at the start computed here, with the modes the caller set in wk[50]): the first zero ends the run with
     FRICTION_EVENT, the outputs up to its time written and y the projected state at st[0] = that time (the
@@ -231,6 +244,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             t_stop, have_F = _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale)
             if have_F and not computed:
                 stats[2] += 3
+            if t_stop == -np.inf:   # a sensor's value is not finite (a Python-callable sensor failed): the run
+                st[0], st[1] = t, h   # ends at the step's start, the outputs up to it kept
+                return SENSOR_FAILED, drop_after(tout, iout, t)
             if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
                 return _end_at(cm, wk, F, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(False), SENSOR_STOP)
@@ -256,6 +272,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return s_, iout
             s_ = rhs(cm, wk, t_new, y, f, bool(False))   # the projection's factorisation is at these positions
             stats[2] += 1
+            accept_state(cm, wk)   # joint angles read from the frames: continued from this state on
         for i in range(n):
             if not np.isfinite(y[i]):
                 st[0], st[1] = t, h

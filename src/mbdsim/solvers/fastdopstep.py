@@ -140,8 +140,7 @@ def _end_at(cm, wk, F, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo, cubi
     step's polynomial) at t_ev projected onto the constraints (`_project` with `exact`), st = (t_ev, h);
     (`status`, or the projection's failure, and the next iout). Shared by DOP853's friction events and
     stop sensors (solvers.fastdop) and the implicit steppers' friction events (solvers.fastswitch)."""
-    while iout > 0 and tout[iout - 1] > t_ev + 1e-14 * max(1.0, abs(t_ev)):
-        iout -= 1
+    iout = drop_after(tout, iout, t_ev)
     _at(F, y, t0, h, t_ev, yo, cubic)
     s_ = _project(cm, wk, t_ev, yo, proj_tol, exact)
     stats[3] += 1
@@ -208,26 +207,64 @@ def _sensor_time(cm, wk, F, y0, t0, h, k, yd, yo, g, which, cubic, right):
 
 @kernel(_nrt=False, inline="always")
 def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
-    """Sensors after the accepted step (t, h) from y to ynew: each sign change of a sensor's value since the
-    last accepted step is located on the step's dense output (F, computed here unless have_F); a crossing
-    in the sensor's direction is an event, appended (time [s], sensor) to the event buffer unless it comes
-    after the step's first "stop" event. The values at ynew become the last accepted ones (the sign after
-    the event where a value is exactly zero). Returns (the time [s] of the first "stop" event, np.inf if
-    none; whether F holds the step's dense output)."""
+    """Sensors after the accepted step (t, h) from y to ynew (DOP853): `sensor_crossings`, located on the
+    step's dense output (F, computed here unless have_F, only when a value changed sign) by
+    `locate_sensors`. Returns (the time [s] of the first "stop" event, np.inf if none, -np.inf when a
+    sensor's value is not finite; whether F holds the step's dense output)."""
+    crossed = sensor_crossings(cm, wk, t + h, ynew, scale, False)
+    if crossed < 0:
+        return -np.inf, have_F
+    if crossed > 0 and not have_F:
+        _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+        have_F = True
+    return locate_sensors(cm, wk, F, y, t, h, ys, scale, False, False)[0], have_F
+
+
+@kernel(_nrt=False)
+def sensor_crossings(cm, wk, t_new, ynew, yo, cut):
+    """The sensors' values at the end t_new [s] of an accepted step (state ynew; yo: scratch) into wk[44][3];
+    the number of them whose sign differs from the last accepted values wk[44][2] (the switching entries,
+    action 2, only with `cut`), or -1 when a value there or here is not finite (a Python-callable sensor
+    that failed, a signal that is not a number)."""
+    ew = wk[44]
+    g_prev, g_new, action = ew[2], ew[3], cm[43][20]
+    _sensor_g(cm, wk, t_new, ynew, yo, g_new)
+    n = 0
+    for k in range(g_new.shape[0]):
+        gp, gn = g_prev[k], g_new[k]
+        if not (np.isfinite(gp) and np.isfinite(gn)):
+            return -1
+        if gp != 0.0 and (gn == 0.0 or (gn > 0.0) != (gp > 0.0)) and (cut or action[k] != 2):
+            n += 1
+    return n
+
+
+@kernel(_nrt=False, inline="always")
+def locate_sensors(cm, wk, F, y, t, h, ys, scale, cubic, cut):
+    """After `sensor_crossings` of the accepted step (t, h) from y: each sign change is located on the step's
+    interpolant (F, y: DOP853's dense output, or with `cubic` an implicit step's polynomial; `_sensor_time`);
+    a crossing in the sensor's direction is an event, appended (time [s], sensor) to the event buffer unless
+    it comes after the step's first "stop" event or, with `cut`, after its first zero of a switching entry
+    (action 2: stops' clearances and contact gaps, located on the crossed side). The values at the step's
+    end become the last accepted ones (the sign after the event where a value is exactly zero). Returns
+    (the time [s] of the first "stop" event, of the first switching zero; np.inf if none: a "stop" after
+    the switching zero is dropped too, the restart there finds it again). ys, scale: scratch (n)."""
     ex, ew = cm[43], wk[44]
     g_prev, g_new, EVT, nev, g_tmp = ew[2], ew[3], ew[4], ew[5], ew[6]
     n_s = g_new.shape[0]
-    _sensor_g(cm, wk, t + h, ynew, scale, g_new)
-    t_stop = np.inf
+    t_stop, t_cut = np.inf, np.inf
     n0 = nev[0]
     for k in range(n_s):
         gp, gn = g_prev[k], g_new[k]
         if gp == 0.0 or (gn != 0.0 and (gn > 0.0) == (gp > 0.0)):
             continue
-        if not have_F:
-            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
-            have_F = True
-        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0, False, False)
+        if ex[20][k] == 2:   # a switching entry: the step is cut at its zero (implicit steppers only)
+            if cut:
+                tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0, cubic, True)
+                if tk > t:
+                    t_cut = min(t_cut, tk)
+            continue
+        tk = _sensor_time(cm, wk, F, y, t, h, k, ys, scale, g_tmp, 0, cubic, False)
         rising = gn > gp
         if tk <= t or (ex[19][k] != 0 and (ex[19][k] > 0) != rising):
             continue
@@ -236,10 +273,13 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
         nev[0] += 1
         if ex[20][k] == 1:
             t_stop = min(t_stop, tk)
-    if t_stop < np.inf:   # events after the stop did not happen
+    if t_cut <= t_stop:
+        t_stop = np.inf
+    t_end = min(t_stop, t_cut)
+    if t_end < np.inf:   # events after the stop or the cut did not happen (yet)
         m = n0
         for e in range(n0, nev[0]):
-            if EVT[e, 0] <= t_stop + 1e-12 * max(1.0, abs(t_stop)):
+            if EVT[e, 0] <= t_end + 1e-12 * max(1.0, abs(t_end)):
                 EVT[m, 0], EVT[m, 1] = EVT[e, 0], EVT[e, 1]
                 m += 1
         nev[0] = m
@@ -248,7 +288,15 @@ def _watch(cm, wk, co, t, h, y, ynew, K, F, have_F, ys, scale):
             g_prev[k] = g_new[k]
         elif g_prev[k] != 0.0:   # exactly at the threshold: the sign after the crossing
             g_prev[k] = -g_prev[k]
-    return t_stop, have_F
+    return t_stop, t_cut
+
+
+@kernel(_nrt=False)
+def drop_after(tout, iout, t):
+    """The next output index once the outputs after t [s] are dropped (a run that ends at t)."""
+    while iout > 0 and tout[iout - 1] > t + 1e-14 * max(1.0, abs(t)):
+        iout -= 1
+    return iout
 
 
 @kernel(_nrt=False)

@@ -25,7 +25,7 @@ except ImportError:   # pragma: no cover - transitional, until system.exprvm lan
     @kernel(_nrt=False)
     def eval_program(code, consts, tables, start, end, x, stack):
         return 0.0
-from ..system.exprloads_kernel import expr_loads
+from ..system.exprloads_kernel import accept_angles, expr_loads, wrapped_angles
 from ..system.kernels import frames_into, quat_step, rows_kernel
 from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
@@ -96,6 +96,27 @@ def _python_loads(F_ext, ctl, t, F):
     for f in range(1, F.shape[0]):
         for k in range(6):
             F[f, k] += F_ext[f, k]
+
+
+@kernel(_nrt=False)
+def accept_state(cm, wk):
+    """After an accepted step, with the frames of its state in wk[0:4] (the evaluation there): the joint
+    angles that loads and sensors read from the frames (absolute coordinates) take their continued values
+    there as their references (system.exprloads_kernel.accept_angles), so that they continue beyond +-pi."""
+    if cm[43][0].shape[0]:
+        accept_angles(cm[43], wk[44], wk[0], wk[1], wk[2], wk[3])
+
+
+@entry(_nrt=False)
+def angle_rows(cm, wk, Y, out):
+    """The joint angles [rad] in (-pi, pi] that loads and sensors read from the frames (absolute
+    coordinates) at each row Y[k] = [q, v] into out[k] (one column per measure of cm[43], 0 for the
+    others): what `solvers.compiled_run` continues over a run's steps for the outputs' references."""
+    nq = cm[31][0]
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    for k in range(Y.shape[0]):
+        frames_into(Y[k, :nq], Y[k, nq:], cm[0], cm[1], cm[2], cm[3], cm[4], r, A, rd, w)
+        wrapped_angles(cm[43], r, A, rd, w, out[k])
 
 
 @kernel(_nrt=False)

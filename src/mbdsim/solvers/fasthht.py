@@ -32,11 +32,11 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel
-from .fastdop import CHECKPOINTS_FULL, _project
-from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, _to6, increment_into, read_state,
+from .fastdop import CHECKPOINTS_FULL, EVENTS_FULL, _project
+from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, _to6, accept_state, increment_into, read_state,
                       rhs, write_state)
 from .fastradau import _lu, _lu_solve
-from .fastswitch import dense, friction_event, start, stop_at
+from .fastswitch import dense, friction_event, sensor_event, sensor_stop, start, stop_at
 
 NEWTON_MAXITER = 8
 STAGNATION = 0.9        # as fastradau: corrections that stop contracting below the tolerance are converged
@@ -282,6 +282,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             st[k] = 0.0
         st[8] = 1.0
         start(cm, wk, t, y, S[9])   # joint friction: the switching values at the (re)start
+    n_sensors = wk[44][2].shape[0]
     eps = 2.220446049250313e-16
     newton_tol = max(10.0 * eps / rtol, min(0.03, np.sqrt(rtol)))
     budget = max(EVALS_PER_RETURN // max(n, 1), 200)
@@ -301,6 +302,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if SY.shape[0] > 0 and ns[0] >= SY.shape[0]:
             st[0], st[1] = t, h
             return CHECKPOINTS_FULL, iout
+        if n_sensors > 0 and wk[44][5][0] + n_sensors > wk[44][4].shape[0]:
+            st[0], st[1] = t, h
+            return EVENTS_FULL, iout
         hmin = 10.0 * eps * max(abs(t), 1.0)
         h = min(h, max_step, t_end - t, _rotation_step(cm, y, m))
         if h < hmin:
@@ -380,6 +384,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if s_ != OK:
             st[0], st[1] = t_new, h
             return s_, iout
+        accept_state(cm, wk)   # joint angles read from the frames: continued from this state on
         _slope(y, fn, a0, m, slope)   # the step's Hermite polynomial: rates [qdot, a] at both ends
         _slope(ynew, f, a, m, yo)
         _hermite(y, slope, ynew, yo, h, Q)
@@ -407,6 +412,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             t_ev = friction_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])
             if t_ev < np.inf:
                 return stop_at(cm, wk, Q, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo)
+        if n_sensors > 0:   # the sensors' crossings in the step (fastswitch): a "stop" ends the run there,
+            t_stop, t_cut = sensor_event(cm, wk, Q, y, t, h, ynew, S[9], S[17])   # a switching zero the step
+            if t_stop < np.inf or t_cut < np.inf:
+                return sensor_stop(cm, wk, Q, y, t, h, t_stop, t_cut, tout, iout, proj_tol, st, stats, yo)
         for i in range(n):
             yq[i] = y[i]
             y[i] = ynew[i]

@@ -29,7 +29,7 @@ from numba import njit
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
-from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, increment_into, newton_positions,
+from .fastdyn import (OK, PROJECTION, SINGULAR, _to6, accelerations, accept_state, increment_into, newton_positions,
                       project_velocities, rows_dropped)
 from .kkt_square import square_min_norm
 
@@ -102,6 +102,7 @@ def advance(cm, wk, st, t1, q, v, vd, lam, tol, stats, S, dx6, a6, p6):
             status = accelerations(cm, wk, t + h, q, v, q, vd, lam, bool(False))
         if status == OK and (size <= CORR_REL * inc + CORR_ABS or h <= hmin):
             forced = 0 if size <= CORR_REL * inc + CORR_ABS else forced + 1
+            accept_state(cm, wk)   # joint angles read from the frames: continued from this state on
             t += h
             stats[1] += 1
             for f in range(a6.shape[0]):

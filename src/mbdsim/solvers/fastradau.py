@@ -28,11 +28,12 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel
-from .fastdop import CHECKPOINTS_FULL, _project
+from .fastdop import CHECKPOINTS_FULL, EVENTS_FULL, _project
 from .fastdopstep import initial_step
-from .fastdyn import CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, read_state, rhs, write_state
+from .fastdyn import CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, TINY_STEP, accept_state, read_state, rhs, write_state
 from .kkt_tree import lu_factor, lu_solve
-from .fastswitch import dense, friction_event, start, stop_at  # noqa: F401  (dense: the steps' polynomial, also HHT's)
+from .fastswitch import (dense, friction_event, sensor_event, sensor_stop, start,  # noqa: F401  (dense: the steps'
+                         stop_at)                                                   # polynomial, also HHT's)
 
 S6 = 6.0 ** 0.5
 C = np.array([(4.0 - S6) / 10.0, (4.0 + S6) / 10.0, 1.0])
@@ -245,6 +246,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         start(cm, wk, t, y, S[17])   # joint friction: the switching values at the (re)start
         for k in range(2, N_ST):
             st[k] = 0.0
+    n_sensors = wk[44][2].shape[0]
     eps = 2.220446049250313e-16
     newton_tol = max(10.0 * eps / rtol, min(0.03, np.sqrt(rtol)))
     budget = max(EVALS_PER_RETURN // max(n, 1), 200)
@@ -264,6 +266,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if SY.shape[0] > 0 and ns[0] >= SY.shape[0]:
             st[0], st[1] = t, h
             return CHECKPOINTS_FULL, iout
+        if n_sensors > 0 and wk[44][5][0] + n_sensors > wk[44][4].shape[0]:
+            st[0], st[1] = t, h
+            return EVENTS_FULL, iout
         hmin = 10.0 * eps * max(abs(t), 1.0)
         h = min(h, max_step, t_end - t)
         if h < hmin:
@@ -367,6 +372,10 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             t_ev = friction_event(cm, wk, Q, y, t, h, ynew, S[17], S[18])
             if t_ev < np.inf:
                 return stop_at(cm, wk, Q, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo)
+        if n_sensors > 0:   # the sensors' crossings in the step (fastswitch): a "stop" ends the run there,
+            t_stop, t_cut = sensor_event(cm, wk, Q, y, t, h, ynew, S[17], S[18])   # a switching zero the step
+            if t_stop < np.inf or t_cut < np.inf:
+                return sensor_stop(cm, wk, Q, y, t, h, t_stop, t_cut, tout, iout, proj_tol, st, stats, yo)
         for i in range(n):
             yq[i] = y[i]
             y[i] = ynew[i]
@@ -386,6 +395,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         if s_ != OK:
             st[0], st[1] = t_new, h
             return s_, iout
+        accept_state(cm, wk)   # joint angles read from the frames: continued from this state on
         while iout < tout.shape[0] and tout[iout] <= t_new + tol_end:   # outputs at the step's end
             write_state(cm, wk, y, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])
             iout += 1

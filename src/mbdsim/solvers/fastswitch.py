@@ -10,7 +10,12 @@ on that polynomial by the Illinois variant of regula falsi (to fastdop.SENSOR_XT
 and sensor events on its own dense output). The stepper then ends the step there and returns
 fastdop.FRICTION_EVENT with the state at the event; the caller (`solvers.radau_run`, `solvers.friction_run`)
 decides the modes (one decision for every stepper: `FrictionModes.decide`) and restarts the stepper at
-the event.
+the event. The model's sensors are watched the same way (`sensor_event`: DOP853's `sensor_crossings` and
+`locate_sensors` on the implicit step's polynomial): a "stop" ends the step at its time (SENSOR_STOP), a
+sensor whose value is not finite ends the run at the step's start (SENSOR_FAILED), and a zero of a
+switching entry (the clearances of stops, the gaps of sphere/plane contacts: system.exprloads_pack, action
+2) ends the step there (SWITCH_EVENT): the caller restarts the stepper at that state, as the reference
+path cuts its steps at these events, so that no step integrates across the kink of the contact law.
 """
 from __future__ import annotations
 
@@ -18,8 +23,8 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastdop import FRICTION_EVENT, _friction_g
-from .fastdopstep import _dense_cubic, _end_at, _sensor_time
+from .fastdop import FRICTION_EVENT, SENSOR_FAILED, SENSOR_STOP, SWITCH_EVENT, _friction_g
+from .fastdopstep import _dense_cubic, _end_at, _sensor_g, _sensor_time, drop_after, locate_sensors, sensor_crossings
 
 
 dense = _dense_cubic   # the step's polynomial (fastdopstep)
@@ -27,10 +32,41 @@ dense = _dense_cubic   # the step's polynomial (fastdopstep)
 
 @kernel(_nrt=False)
 def start(cm, wk, t, y, yo):
-    """The switching values at the stepper's (re)start (t [s], state y) as the last accepted ones
-    (wk[50][2]); yo: scratch (n)."""
+    """The switching values (wk[50][2]) and the sensors' values (wk[44][2]) at the stepper's (re)start
+    (t [s], state y) as the last accepted ones; yo: scratch (n)."""
     if cm[48][0].shape[0]:
         _friction_g(cm, wk, t, y, yo, wk[50][2])
+    if wk[44][2].shape[0]:
+        _sensor_g(cm, wk, t, y, yo, wk[44][2])
+
+
+@kernel(_nrt=False)
+def sensor_event(cm, wk, Q, y0, t0, h, ynew, yd, yo):
+    """After the accepted step (t0, h) from y0 to ynew (polynomial Q): the sensors' crossings since the last
+    accepted step located on the polynomial and recorded (`fastdopstep.sensor_crossings`, `locate_sensors`:
+    DOP853's sensor machinery on the implicit step's interpolant), and the first zero of a switching entry
+    (stops, contacts). Returns (the time [s] of the first "stop" event, of the first switching zero; np.inf
+    if none; (-np.inf, np.inf) when a sensor's value is not finite). yd, yo: scratch (n)."""
+    crossed = sensor_crossings(cm, wk, t0 + h, ynew, yo, True)
+    if crossed < 0:
+        return -np.inf, np.inf
+    return locate_sensors(cm, wk, Q, y0, t0, h, yd, yo, True, True)
+
+
+@kernel(_nrt=False, inline="always")
+def sensor_stop(cm, wk, Q, y, t0, h, t_ev, t_cut, tout, iout, proj_tol, st, stats, yo):
+    """End the step (t0, h) from y at a sensor's time: a switching zero t_cut [s] (finite: the state there
+    on the step's polynomial, projected exactly; SWITCH_EVENT, the caller restarts there), a "stop" t_ev
+    (finite: the state there, projected; SENSOR_STOP), or a sensor whose value is not finite (t_ev = -inf:
+    the run ends at the step's start t0, the outputs up to it kept; SENSOR_FAILED). (status, next iout)."""
+    if t_ev == -np.inf:
+        st[0], st[1] = t0, h
+        return SENSOR_FAILED, drop_after(tout, iout, t0)
+    if t_cut < np.inf:
+        return _end_at(cm, wk, Q, y, t0, h, t_cut, tout, iout, proj_tol, st, stats, yo, bool(True), bool(True),
+                       SWITCH_EVENT)
+    return _end_at(cm, wk, Q, y, t0, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(True), bool(False),
+                   SENSOR_STOP)
 
 
 @kernel(_nrt=False)

@@ -3,9 +3,9 @@ kernels carry.
 
 `HHTRun` is a `RadauRun` (the same compiled model, work arrays, outputs, failure reports, checkpoints and
 dense output between outputs: each accepted step's start state, (t, h) and the coefficients of its cubic
-Hermite polynomial, in the form `fastradau.dense` evaluates) whose step loop is `fasthht.run`. Models with
-expression sensors or switching force elements (contacts, stops) stay on the reference HHT (`solvers.hht`),
-which locates their events (`NotCompiled`). Joint friction with stick/slip runs here: the step loop stops at
+Hermite polynomial, in the form `fastradau.dense` evaluates) whose step loop is `fasthht.run`. Sensors are
+watched on the steps' Hermite polynomials (solvers.fastswitch), as on Radau; contacts and stops are
+integrated through. Joint friction with stick/slip runs here: the step loop stops at
 each switching event located on the step's polynomial (solvers.fastswitch) and the run restarts there with
 the modes decided by `friction_run.FrictionModes` (as on DOP853 and Radau).
 """
@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..system.compiled import NotCompiled
 from . import fasthht
 from .compiled_run import CHUNK
 from .radau_run import RadauRun, _integrate, _switching_check
@@ -48,11 +47,8 @@ class HHTRun(RadauRun):
 
 def integrate_hht_compiled(sys, rep, times, rtol, atol, max_step, alpha, progress=None):
     """Dynamic analysis with the compiled HHT-alpha (method "hht"); NotCompiled when the model needs the
-    reference path, has expression sensors or force elements with switching functions (contacts, stops,
-    the reference HHT cuts its steps at their events, mbdsim.solvers.events). Joint friction runs compiled:
-    its stick/slip events are located on the steps' Hermite polynomials (solvers.fastswitch)."""
-    if getattr(sys.model, "sensors", None):
-        raise NotCompiled("expression sensors are watched by the compiled DOP853 only")
+    reference path. Sensors and joint friction's stick/slip events are located on the steps' Hermite
+    polynomials (solvers.fastswitch)."""
     _switching_check(sys)
     run = HHTRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v), friction=len(sys.lock_rows) > 0)
     run.alpha = float(alpha)

@@ -21,7 +21,9 @@ exprloads_pack) that call a ctypes callback `double f(double t)` (`sensor_callba
 address a constant of the program: exprvm's USER op) wherever the step loop evaluates the sensors, at the
 accepted steps and at the probes of the event location on the dense output (solvers.fastdop, as for
 expression sensors): the callback hands the sensor's callable the light State of the frames the kernel has
-just computed for that time and returns the signal. User functions compiled with numba (mbdsim.userfunctions)
+just computed for that time and returns the signal (nan once it has failed: the step loops then end the run
+at the start of that step, fastdop.SENSOR_FAILED, and `settle` reports the error naming the sensor and the
+time). User functions compiled with numba (mbdsim.userfunctions)
 need no callback; a run whose user function returned a non-finite value ends with the EvaluationError
 naming it (`settle`).
 

@@ -5,9 +5,9 @@ compiled kernels carry, and the automatic method's continuation after DOP853 fla
 states) whose step loop is `fastradau.run`. It keeps, for every accepted step, its start state, (t, h)
 and the coefficients of its collocation polynomial (within CHECKPOINT_BUDGET bytes), so that `Result.at`
 between outputs is the run's own dense output (projected onto the constraints, accelerations and
-multipliers from the compiled kernel), nothing integrated again. For method "radau", models with expression
-sensors or switching force elements (contact onset, stops) stay on the reference path (`NotCompiled`),
-which locates their events; the automatic method's continuation runs them compiled, as its DOP853 part.
+multipliers from the compiled kernel), nothing integrated again. Sensors are watched on the steps'
+polynomials (solvers.fastswitch: DOP853's sensor machinery; a "stop" ends the run at its time, its state
+the last sample); contacts and stops are integrated through as on DOP853.
 Joint friction with stick/slip runs here (and on HHT): the step loop stops at each switching event,
 located on the step's polynomial (solvers.fastswitch), and `integrate` restarts it there with the modes
 `friction_run.FrictionModes.decide` takes (the decision of every stepper).
@@ -64,6 +64,7 @@ class RadauRun(CompiledRun):
         """As CompiledRun.integrate, stepping with Radau IIA; y_start: the integrator's state at t0 (a
         tree's joint state with continuous angles) when known, else taken from y0 (absolute [q, v])."""
         a, w = self.cm.arrays(), self.work.arrays()
+        self.angle_ref0 = w[44][7].copy()   # the continued joint angles' references at the start
         nout = len(tout)
         start_row = y_start is None and self.joint_space
         if y_start is not None:
@@ -85,9 +86,11 @@ class RadauRun(CompiledRun):
         if self.friction is not None:   # the initial modes (all joints at rest decided together)
             self.friction.decide(t0, y)
         try:
-            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.FRICTION_EVENT) and iout < nout:
-                if status == fastdop.FRICTION_EVENT:   # a stick/slip event at st[0]: decide, restart there
-                    self.friction.decide(st[0], y)     # (the one decision of every stepper: friction_run)
+            while status in (0, fastdop.CHECKPOINTS_FULL, fastdop.EVENTS_FULL, fastdop.FRICTION_EVENT,
+                             fastdop.SWITCH_EVENT) and iout < nout:
+                if status in (fastdop.FRICTION_EVENT, fastdop.SWITCH_EVENT):   # restart at the event st[0]: a
+                    if status == fastdop.FRICTION_EVENT:   # stick/slip event decided first (the one decision of
+                        self.friction.decide(st[0], y)     # every stepper: friction_run); a stop's or contact's zero
                     st[1:] = 0.0
                     if tout[-1] - st[0] <= 1e-14 * max(1.0, abs(st[0])):   # at the end time: its state is the
                         Y[iout:] = y                                         # last output (absolute coordinates)
@@ -98,7 +101,9 @@ class RadauRun(CompiledRun):
                         SY, ST, SQ = (np.concatenate([x, np.zeros_like(x)]) for x in (SY, ST, SQ))
                     else:
                         keep, SY, ST, SQ = False, SY[:0], ST[:0], SQ[:0]
+                self._take_events()
                 status, iout = self._step_loop(a, w, st, y, f, tout, iout, Y, scratch, SY, ST, SQ, ns, start_row)
+                start_row = False   # (a restart at an event starts from the stepper's own state y)
                 if st[1] == 0.0:   # the start failed (a restart after a friction event keeps the outputs before it)
                     if st[0] == t0:
                         iout = 0
@@ -109,11 +114,12 @@ class RadauRun(CompiledRun):
         except ProgressError as exc:
             status, self.run_error = PROGRESS_FAILED, exc
         status, self.run_error = pyloads.settle(self.pyloads, status, self.run_error)
+        self._take_events()
         self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
         self.dense_q = SQ[:ns[0]].copy() if keep else None
-        if self.joint_space and status != 0:
+        if self.joint_space and status != 0:   # (a sensor's stop: continuous with the last output)
             ymax = np.zeros(len(y0))
-            fastdyn.write_state(a, w, y, ymax, ymax[:0])
+            fastdyn.write_state(a, w, y, ymax, Y[iout - 1] if status == fastdop.SENSOR_STOP and iout else ymax[:0])
             y = ymax
         return Y, iout, status, st[0], y
 
@@ -144,6 +150,7 @@ def _stats(run: RadauRun, rep) -> dict:
     return {"steps": int(s[0]), "rejected": int(s[1]), "nfev": int(s[2]), "njev": int(s[4]), "nlu": nlu,
             "factorizations": nlu + (0 if run.joint_space else int(s[2] + 2 * s[3])),
             "projections": 0 if run.joint_space else int(s[3]), "order": run.ORDER, "method": run.METHOD,
+            "called_back": tuple(run.cm.python_loads),
             "formulation": "joint coordinates (articulated body)" if run.joint_space else
             "absolute coordinates (tree elimination)", "assembly": rep}
 
@@ -159,39 +166,47 @@ def _integrate(sys, rep, run, times, progress=None, y_start=None):
     success, message, error = True, "ok", None
     if status == fastdyn.FRICTION_FAILED:   # name the element whose coupled solve failed
         run.run_error = run.friction.failure(t_fail, y_fail)
+    if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the last sample
+        times, Y, n, message = sensor_stop(run, times, Y, n, t_fail, y_fail)
+        status = 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed", run.run_error)
         success = False
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=_stats(run, rep))
     res.error = error
     res.stats["order_history"] = [(float(times[0]),) + run.HISTORY]
+    if run.sensors:
+        res.sensor_events = run.sensor_events
     return res
 
 
 def integrate_radau(sys, rep, times, rtol, atol, max_step, progress=None):
     """Dynamic analysis with the compiled Radau IIA (method "radau"); NotCompiled when the model needs the
-    reference path, has expression sensors (watched by DOP853's step loop only) or force elements with
-    switching functions (contacts, stops, friction: scipy's Radau on the reference path cuts its steps at
-    their events, mbdsim.solvers.events; joint friction runs compiled, its stick/slip events located
-    on the steps' polynomials: solvers.fastswitch)."""
-    if getattr(sys.model, "sensors", None):
-        raise NotCompiled("expression sensors are watched by the compiled DOP853 only")
+    reference path. Sensors and joint friction's stick/slip events are located on the steps' polynomials
+    (solvers.fastswitch)."""
     _switching_check(sys)
     run = RadauRun(sys, rep.rows, rtol, atol, max_step, state=(rep.q, rep.v), friction=len(sys.lock_rows) > 0)
     return _integrate(sys, rep, run, times, progress)
 
 
 def _switching_check(sys):
-    """NotCompiled when force elements other than joint friction have switching functions (contacts,
-    stops: the reference path cuts steps at their events), or a held friction group an earlier try met
-    (solvers.friction_run); joint friction's stick/slip events are located by the compiled implicit
-    steppers themselves (solvers.fastswitch)."""
-    from ..model.friction_path import JointFriction
-    from ..system.force_elements import evaluator
+    """NotCompiled for a held friction group an earlier try met (solvers.friction_run). Joint friction's
+    stick/slip events and the sensors are located by the compiled implicit steppers themselves
+    (solvers.fastswitch); contacts and stops are loads of the compiled right-hand side, integrated through
+    by the step-size control as on the compiled DOP853, and the joint angles of torsion springs, stops and
+    expression loads are continued in the kernel (no event needed)."""
     if sys.derived.get("friction not compiled"):
         raise NotCompiled(sys.derived["friction not compiled"])
-    if any(hasattr(evaluator(e), "switch") and not isinstance(e, JointFriction) for e in sys.model.forces.values()):
-        raise NotCompiled("switching elements: the reference path cuts steps at their events")
+
+
+def sensor_stop(run, times, Y, n, t_fail, y_fail):
+    """(times, Y, n, message) of a run a "stop" sensor ended at t_fail [s] in state y_fail: that state
+    appended as the last sample (unless an output is at that time already)."""
+    if not n or t_fail > times[n - 1] + 1e-14 * max(1.0, abs(t_fail)):
+        times, Y = np.append(times[:n], t_fail), np.vstack([Y[:n], y_fail])
+        n += 1
+    stop = min((e for e in run.sensor_events if e.action == "stop"), key=lambda e: e.time)
+    return times, Y, n, f"stopped by sensor '{stop.name}' at t = {t_fail:.12g} s"
 
 
 # auto's hand-over tries Radau over this many of DOP853's mean accepted steps, or this share of the time
@@ -211,8 +226,8 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     fast modes oscillate with an amplitude above the tolerance (lightly damped contact, an excited stiff
     spring), every method must resolve them and the explicit eighth-order one does it with fewer
     evaluations (a box sliding on four contact corners: Radau 7,900 steps against DOP853's 1,200). So
-    (absolute coordinates, no joint friction, no sensors) Radau first runs over PROBE_STEPS of DOP853's mean step, to
-    the next output time, and when it needed more right-hand-side evaluations per unit of time than
+    (absolute coordinates, no joint friction, no sensors) Radau first runs over a trial (`_probe_end`), and
+    when it needed more than 1 / PAY of the right-hand-side evaluations per second of model time that
     DOP853 did before t_s, DOP853 continues from there without the stiffness test (`_after_probe`)."""
     from .autoswitch import _align_quaternions, _Joined, join, merge_stats
     pre, t_s = stiff.prefix, float(stiff.time)
@@ -232,6 +247,8 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
                         None if progress is None else _Joined(progress, first, t_s),
                         None if y_start is None else np.array(y_start))
     res = join(first, second, t_s)
+    if run.sensors:   # the explicit part's sensor events, then the implicit part's
+        res.sensor_events = list(run.sensor_events) + list(getattr(second, "sensor_events", []))
     res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
     res.stats["order_history"][-1] = (t_s,) + HISTORY
     res.stats.update(assembly=rep, njev=second.stats["njev"], nlu=second.stats["nlu"], rtol_reached=rtol)

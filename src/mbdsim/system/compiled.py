@@ -453,8 +453,8 @@ def _compile_system(sys, rows, state, friction=False, tol=None) -> CompiledModel
     exl = [e for e in sys.model.forces.values() if isinstance(e, exprloads_pack.EXPR_TYPES) and e.name not in pyl]
     sensors = list(getattr(sys.model, "sensors", {}).values())   # expression sensors (callables: not_compiled)
     input_slots = []
-    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors, input_slots) if exl or sensors else \
-        (exprloads_pack.empty(), 4)
+    ex, ex_stack = exprloads_pack.pack(sys, exl, mode, tree, state, sensors, input_slots, switches=True) \
+        if exl or sensors or len(_contacts(sys)[1]) else (exprloads_pack.empty(), 4)
     topo = system_topology(sys, rows)
     return CompiledModel(sys.r_idx.astype(np.int64), sys.p_idx.astype(np.int64).reshape(-1, 4),
                          sys.rd_idx.astype(np.int64), sys.w_idx.astype(np.int64).reshape(-1, 3),

@@ -142,11 +142,13 @@ def _value(code, consts, tables, start, end, p, x, stack):
 def expr_measures(ex, ew, t, y, r, A, rd, w):
     """The variable vector x = ew[0] at one state: x[0] = t [s], x[1 + m] the value of measure m (frames
     r, A, rd, w; y: the joint-coordinate state [theta, theta_dot] on the tree path, read by joint
-    measures that have a tree coordinate, else unused)."""
+    measures that have a tree coordinate, else unused; a joint angle in absolute coordinates is continued
+    from its reference ew[7][m], the angle at the last accepted state)."""
     ms_kind, ms_f, ms_s, ms_R, ms_v, ms_jq, ms_jc = ex[0], ex[1], ex[2], ex[3], ex[4], ex[5], ex[6]
     x = ew[0]
     x[0] = t
     nj = y.shape[0] // 2
+    ref = ew[7]
     for m in range(ms_kind.shape[0]):
         k = ms_kind[m]
         q = ms_jq[m]
@@ -156,8 +158,40 @@ def expr_measures(ex, ew, t, y, r, A, rd, w):
             else:
                 x[1 + m] = ms_jc[m, 1] * y[nj + q]
             continue
+        if k == 20:   # absolute coordinates: the angle from the frames, continued from its reference
+            x[1 + m] = continued(ref[m], row_terms(5, r, A, rd, w, ms_f[m, 0], ms_f[m, 1], ms_v[m], 0.0)[0])
+            continue
         x[1 + m] = measure(k, ms_f[m, 0], ms_f[m, 1], ms_f[m, 2], ms_s[m, 0], ms_s[m, 1], ms_R[m, 0],
                            ms_R[m, 1], ms_R[m, 2], ms_v[m], r, A, rd, w)
+
+
+@kernel(_nrt=False)
+def continued(ref, theta):
+    """The angle [rad] congruent to theta (mod 2 pi) nearest to ref: ref + wrap(theta - ref)."""
+    d = theta - ref
+    return ref + (d - 2.0 * np.pi * np.floor((d + np.pi) / (2.0 * np.pi)))
+
+
+@kernel(_nrt=False)
+def accept_angles(ex, ew, r, A, rd, w):
+    """At an accepted state (frames r, A, rd, w): the reference ew[7][m] of every joint angle measure read
+    from the frames (absolute coordinates: ms_jq = -1) becomes its continued value there, so that the
+    angle continues beyond +-pi step by step (a step turns a joint by less than pi)."""
+    ms_kind, ms_f, ms_v, ms_jq, ref = ex[0], ex[1], ex[4], ex[5], ew[7]
+    for m in range(ms_kind.shape[0]):
+        if ms_kind[m] == 20 and ms_jq[m] < 0:
+            ref[m] = continued(ref[m], row_terms(5, r, A, rd, w, ms_f[m, 0], ms_f[m, 1], ms_v[m], 0.0)[0])
+
+
+@kernel(_nrt=False)
+def wrapped_angles(ex, r, A, rd, w, out):
+    """The angle [rad] in (-pi, pi] from the frames of every joint angle measure read from them
+    (absolute coordinates) into out[m] (0 for the other measures)."""
+    ms_kind, ms_f, ms_v, ms_jq = ex[0], ex[1], ex[4], ex[5]
+    for m in range(ms_kind.shape[0]):
+        out[m] = 0.0
+        if ms_kind[m] == 20 and ms_jq[m] < 0:
+            out[m] = row_terms(5, r, A, rd, w, ms_f[m, 0], ms_f[m, 1], ms_v[m], 0.0)[0]
 
 
 @kernel(_nrt=False)

@@ -7,10 +7,11 @@ then the sensors: program, direction, stop flag and value, slots 18-21); `work(e
 (slots 2-6: the sensors' values at the last accepted step and at the new one, the events found, their
 count and scratch; `solvers.fastdop.run` watches them).
 A Python-callable sensor is a program calling its ctypes callback (solvers.pyloads.sensor_callback) with t.
-A Python-callable load, or a joint angle read in absolute coordinates (its continuation beyond +-pi needs the
-event-driven reference path), raises NotCompiled with the reason. On the joint-coordinate path a joint
+A Python-callable load raises NotCompiled with the reason. On the joint-coordinate path a joint
 measure reads the tree's own coordinate: angle = angle at assembly + sign theta (sign -1 when the
-joint's body_i is the child in the tree).
+joint's body_i is the child in the tree). In absolute coordinates (closed loops) a joint angle is read
+from the frames and continued beyond +-pi from the angle at the last accepted step (work slot 7; the step
+loops move it, `exprloads_kernel.accept_angles`).
 """
 from __future__ import annotations
 
@@ -80,10 +81,13 @@ EVENT_CAPACITY = 64   # sensor events a run holds (at least two steps' worth) be
 def work(ex, stack_size) -> tuple:
     """Scratch of `expr_loads`: the variable vector x (1 + measures) and the interpreter's stack; of the
     sensors: their values (minus the threshold) at the last accepted step and at the new one, the events
-    found (time [s], sensor index), their count, and the values at a probed time."""
+    found (time [s], sensor index), their count, and the values at a probed time; of the joint angles read
+    from the frames (absolute coordinates): their references [rad] (slot 7: the continued angle at the last
+    accepted state, 0 at the start: the first angle in (-pi, pi], as on the reference path)."""
     ns = len(ex[18])
     return (np.zeros(1 + len(ex[0])), np.zeros(max(int(stack_size), 4)), np.zeros(ns), np.zeros(ns),
-            np.zeros((max(EVENT_CAPACITY, 2 * ns) if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns))
+            np.zeros((max(EVENT_CAPACITY, 2 * ns) if ns else 0, 2)), np.zeros(1, np.int64), np.zeros(ns),
+            np.zeros(len(ex[0])))
 
 
 def _target(sys, name):
@@ -107,9 +111,10 @@ def _joint_measure(sys, m, mode, tree, fr):
         jq = int(qadr[child])
         ang, _, sl, _ = joint_coordinate(sys, fr, jt)
         jc = (float((ang if rot else sl)[0]), sign)
-    elif rot and not m.rate:
-        raise _NotCompiled(f"the angle of joint '{jt.name}' (continued beyond +-pi by events on the "
-                           "reference path, or the joint-coordinate state)")
+    elif rot and not m.rate and g.particle_j:
+        raise _NotCompiled(f"the angle of joint '{jt.name}' (its body_j is a particle)")
+    # absolute coordinates: the angle from the frames, continued from the angle at the last accepted step
+    # (system.exprloads_kernel.continued, accept_angles)
     return kind, (g.bi, g.bj, 0), v, jq, jc
 
 
@@ -138,11 +143,15 @@ def _compile(expr, slots, inputs, found):
                           np.array(em.tables, dtype=float), max(em.max_depth, 1))
 
 
-def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
+def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None, switches=False):
     """(ex, stack size) of the expression loads `elems` and the Sensors `sensors` (expression signals);
     NotCompiled (from system.compiled) when one cannot be compiled. Model inputs read by the expressions are
     constants of the packed programs: with `input_slots` (a list), (input name, index into ex[14], the
-    packed constants) is appended for each place an input is read."""
+    packed constants) is appended for each place an input is read. With `switches`, the switching
+    functions of the stops in `elems` (clearances x - lower, upper - x) and of the model's sphere/plane
+    contacts (signed gaps, `_contact_gap`) follow the sensors as entries with action 2 ("cut": the
+    compiled implicit steppers end their step at a zero and restart there, as the reference path cuts its
+    steps at these events; DOP853 ignores them)."""
     from . import exprvm
     from .compiled import NotCompiled
     from .frames import body_frames
@@ -214,6 +223,19 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
             le = parse_load(sys.model, sensor.text, f"sensor '{sensor.name}'", "signal")
             p = program(sensor, le, "sensor")
         sn.append((p, sensor.direction, int(sensor.action == "stop"), sensor.value))
+    if switches:
+        for e in elems:
+            if isinstance(e, Stop):
+                walls = ([f"x - {float(e.lower)!r}"] if e.lower is not None else []) + \
+                        ([f"{float(e.upper)!r} - x"] if e.upper is not None else [])
+                for text in walls:
+                    sn.append((program(e, _coordinate_expression(text, e.joint, e.dof), "stop"), 0, 2, 0.0))
+        from ..expressions import parse
+        for row, radius in _contact_gaps(sys):
+            ms.append(row)
+            measures[("contact gap", len(ms))] = len(ms) - 1   # (x[len(ms)]: this measure's value)
+            progs.append(_compile(parse(f"g - {radius!r}", ("t", "g")), {"t": 0, "g": len(ms)}, {}, []))
+            sn.append((len(progs) - 1, 0, 2, 0.0))
     if not loads and not sn:
         return empty(), 4
     pk = exprvm.pack(progs)
@@ -232,6 +254,32 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None):
           pk.code, pk.consts, pk.tables, pk.start, pk.end,
           *(np.array([x[c] for x in sn], dt).reshape(len(sn)) for c, dt in enumerate((i, i, i, float))))
     return ex, int(pk.stack_size)
+
+
+def _contact_gaps(sys):
+    """(measure row, radii) of each sphere-sphere and sphere-plane contact (system.compiled._contacts): the
+    distance of the centres (DM) or the centre's height over the plane along its normal (DZ in axes whose
+    z is the normal), the gap [m] being that minus the radii."""
+    from .compiled import _contacts
+    ct_f, ct_kind, ct_s, ct_n, ct_par = _contacts(sys)
+    out = []
+    eye3 = np.broadcast_to(np.eye(3), (3, 3, 3))
+    for c in range(len(ct_kind)):
+        fi, fj = int(ct_f[c, 0]), int(ct_f[c, 1])
+        if ct_kind[c] == 0:
+            out.append(((3, (fi, fj, 0), np.array([ct_s[c, 0], ct_s[c, 1]]), eye3, np.zeros((3, 3)), -1, (0.0, 1.0)),
+                        float(ct_par[c, 0] + ct_par[c, 1])))
+            continue
+        fs, fp, R, ss, sp = (fj, fi, ct_par[c, 1], ct_s[c, 1], ct_s[c, 0]) if ct_kind[c] == 1 else \
+            (fi, fj, ct_par[c, 0], ct_s[c, 0], ct_s[c, 1])
+        n = np.asarray(ct_n[c], float) / np.linalg.norm(ct_n[c])
+        a = np.eye(3)[int(np.argmin(np.abs(n)))]
+        x = np.cross(a, n)
+        x /= np.linalg.norm(x)
+        Rk = np.column_stack([x, np.cross(n, x), n])   # body axes of the plane: z along its normal
+        out.append(((2, (fs, fp, fp), np.array([ss, sp]), np.stack([np.eye(3), np.eye(3), Rk]), np.zeros((3, 3)), -1,
+                     (0.0, 1.0)), float(R)))
+    return out
 
 
 def _measure_row(sys, m, mode, tree, fr):
