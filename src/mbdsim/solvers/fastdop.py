@@ -25,8 +25,9 @@ from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that 
 from ._dop853_tableau import coefficients as _c   # scipy's tableau, without importing scipy.integrate
 
 from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _end_at, _friction_g, _project,  # noqa: F401
-                          _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, energy_at,
-                          energy_dense, energy_event, energy_first, energy_step, initial_step)
+                          _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, initial_step)
+from .fastenergystep import (energy_dense, energy_event, energy_first, energy_flag, energy_output, energy_refine,
+                             energy_step)
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows,
                       project, read_state, rhs, tree_project, write_state)
 
@@ -99,8 +100,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     caller decides the modes there and restarts with h = 0).
     Energy bookkeeping (when wk[53][0][0] != 0, solvers.fastenergy): the dissipated energy D and the applied
     loads' work W [J] since the run's start, a quadrature state z = wk[53][4] integrated with the steps'
-    own stage powers (`fastdopstep.energy_step`), go to wk[53][8][iout] with each output (the dense
-    output of z inside a step); at a friction event or a sensor's stop z is the value at its time."""
+    own stage powers (`fastenergystep`: where they do not resolve the power, an adaptive quadrature on the
+    step's dense output), go to wk[53][8][iout] with each output (the dense output of z inside a step); at
+    a friction event or a sensor's stop z is the value at its time."""
     E3, E5 = co[3], co[4]
     en = wk[53]
     energy = en[0][0] != 0.0
@@ -217,16 +219,24 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                     stats[4] = 0
         have_F = False
         tol_end = 1e-14 * max(1.0, abs(t_new))
-        if tout[iout] < t_new - tol_end:   # outputs inside this step (those at its end: below)
-            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
-            stats[2] += 3
-            have_F = True
-            if energy:
+        if energy:   # z's increment over the step, refined where the stage powers do not resolve the power
+            en[1][1] = 0
+            if energy_flag(co, wk, h, rtol):
+                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
                 energy_dense(co, wk, h)
+                have_F = True
+                stats[2] += 3 + energy_refine(cm, wk, F, y, t, h, rtol, ys, scale)
+        if tout[iout] < t_new - tol_end:   # outputs inside this step (those at its end: below)
+            if not have_F:
+                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+                stats[2] += 3
+                have_F = True
+                if energy:
+                    energy_dense(co, wk, h)
             while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
                 to = tout[iout]
                 if energy and iout < ZO.shape[0]:
-                    energy_at(wk, t, h, to, ZO[iout])
+                    stats[2] += energy_output(cm, wk, F, y, t, h, to, rtol, ys, scale, ZO[iout])
                 _dense(F, y, t, h, to, yo)
                 s_ = _project(cm, wk, to, yo, proj_tol, bool(False))
                 stats[3] += 1
@@ -243,7 +253,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 stats[2] += 3
             if t_ev < np.inf:
                 if energy:
-                    energy_event(co, wk, t, h, t_ev)
+                    energy_event(cm, wk, co, F, y, t, h, t_ev, rtol, ys, scale)
                 return _end_at(cm, wk, F, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(True), FRICTION_EVENT)
         if n_sensors > 0:
@@ -253,7 +263,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 stats[2] += 3
             if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
                 if energy:
-                    energy_event(co, wk, t, h, t_stop)
+                    energy_event(cm, wk, co, F, y, t, h, t_stop, rtol, ys, scale)
                 return _end_at(cm, wk, F, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(False), SENSOR_STOP)
         for i in range(n):

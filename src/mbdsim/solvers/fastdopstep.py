@@ -16,7 +16,7 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
-from . import fastfriction, fasttree
+from . import fastenergy, fastfriction, fasttree
 from .fastdyn import OK, _to6, accelerations, normalize_into, project, rhs, tree_project
 
 N_STAGES = _c.N_STAGES
@@ -288,14 +288,14 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
             ys[i] = y[i] + h * acc
         if rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True)) != OK:
             return False
-        _stage_power(wk, s)
+        fastenergy.stage_power(wk, s)
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
     ok = rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
-    _stage_power(wk, N_STAGES)
+    fastenergy.stage_power(wk, N_STAGES)
     return ok
 
 
@@ -311,7 +311,7 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
         rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True))
-        _stage_power(wk, s)
+        fastenergy.stage_power(wk, s)
     _dense_rows(D, h, y, ynew, K, F)
 
 
@@ -329,68 +329,3 @@ def _dense_rows(D, h, y, ynew, K, F):
             for j in range(16):
                 acc += D[r, j] * K[j, i]
             F[3 + r, i] = h * acc
-
-
-# ---------------------------------------------------------------- energy bookkeeping (solvers.fastenergy)
-# wk[53] (system.compiled.energy_work): 0 pw [on, P, P_applied] of the last loads evaluation, 1 flags, 2 the
-# powers at the state of f (the next step's first stage), 3 the stage powers (16, 2), 4 z = [D, W] [J] at the
-# step's start, 5 z at its end, 6 z's dense output coefficients (7, 2), 7 scratch (2,), 8 z at the outputs
-# (nout, 2), 9-10 the shape contacts' point records. z' = [P, P_applied] is a quadrature state of the step:
-# integrated with DOP853's weights and dense output from the stage powers, not in the error norm (the
-# steps are the same with and without it).
-
-@kernel(_nrt=False, inline="always")
-def _stage_power(wk, s):
-    """The power of the loads evaluation just made (wk[53][0][1:3]) as stage s's (wk[53][3][s]), when the
-    run keeps the energy bookkeeping."""
-    en = wk[53]
-    pw = en[0]
-    if pw[0] != 0.0:
-        en[3][s, 0] = pw[1]
-        en[3][s, 1] = pw[2]
-
-
-@kernel(_nrt=False, inline="always")
-def energy_first(wk, src):
-    """The step's first stage power (wk[53][3][0]) from `src` (2,): the powers at the state of f."""
-    en = wk[53]
-    en[3][0, 0] = src[0]
-    en[3][0, 1] = src[1]
-
-
-@kernel(_nrt=False)
-def energy_step(co, wk, h):
-    """z at the end of the accepted step of size h [s]: z + h sum_j b_j P_j (wk[53][5])."""
-    B = co[1]
-    en = wk[53]
-    PK, z, zn = en[3], en[4], en[5]
-    for i in range(2):
-        acc = 0.0
-        for j in range(N_STAGES):
-            acc += B[j] * PK[j, i]
-        zn[i] = z[i] + h * acc
-
-
-@kernel(_nrt=False)
-def energy_dense(co, wk, h):
-    """z's dense output coefficients over the step (its 16 stage powers: after `_dense_coeffs`)."""
-    en = wk[53]
-    _dense_rows(co[5], h, en[4], en[5], en[3], en[6])
-
-
-@kernel(_nrt=False)
-def energy_at(wk, t0, h, t, out):
-    """z at t [s] inside the step (t0, h) into out (2,) (after `energy_dense`)."""
-    en = wk[53]
-    _dense(en[6], en[4], t0, h, t, out)
-
-
-@kernel(_nrt=False)
-def energy_event(co, wk, t0, h, t_ev):
-    """z at an event t_ev [s] inside the step (t0, h) where the run ends or restarts (its dense output
-    computed: after `_dense_coeffs`)."""
-    en = wk[53]
-    energy_dense(co, wk, h)
-    energy_at(wk, t0, h, t_ev, en[7])
-    en[4][0] = en[7][0]
-    en[4][1] = en[7][1]

@@ -61,3 +61,14 @@ def friction_power(lock, Jc, bi, bj, vadr, rigid, v, lam, pw):
             for k in range(m):
                 xd += Jc[r, side, k] * v[vadr[f] + k]
         pw[1] += lam[r] * xd
+
+
+@kernel(_nrt=False, inline="always")
+def stage_power(wk, s):
+    """The power of the loads evaluation just made (wk[53][0][1:3]) as stage s's (wk[53][3][s]), when the
+    run keeps the energy bookkeeping."""
+    en = wk[53]
+    pw = en[0]
+    if pw[0] != 0.0:
+        en[3][s, 0] = pw[1]
+        en[3][s, 1] = pw[2]
