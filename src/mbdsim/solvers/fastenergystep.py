@@ -26,8 +26,11 @@ from .fastdyn import rhs
 # adaptive Gauss-Legendre quadrature of the power on the step's dense output instead (`energy_refine`),
 # as the post-run reference does (results/energy.py).
 
-GL_X = np.array([-0.8611363115940526, -0.3399810435848563, 0.3399810435848563, 0.8611363115940526])
-GL_W = np.array([0.3478548451374538, 0.6521451548625461, 0.6521451548625461, 0.3478548451374538])
+# 5-point Gauss-Lobatto (exact to degree 7): its end points see a power that is nonzero only near an end of
+# the step (a contact that separates just after the step's start), where Gauss points may all miss it
+GL_X = np.array([-1.0, -np.sqrt(3.0 / 7.0), 0.0, np.sqrt(3.0 / 7.0), 1.0])
+GL_W = np.array([0.1, 49.0 / 90.0, 32.0 / 45.0, 49.0 / 90.0, 0.1])
+REFINE_SPLIT = 4      # a refined integral starts from this many equal pieces
 REFINE_EVALS = 4000   # power evaluations one refined integral takes at most
 
 
@@ -79,13 +82,13 @@ def energy_event(cm, wk, co, F, y, t0, h, t_ev, rtol, yq, yd):
 
 @kernel(_nrt=False)
 def _power_gl(cm, wk, F, y, t0, h, a, b, yq, yd, out):
-    """4-point Gauss-Legendre of the powers [P, P_applied] over [a, b] inside the step (t0, h) on its dense
+    """5-point Gauss-Lobatto of the powers [P, P_applied] over [a, b] inside the step (t0, h) on its dense
     output (F, y) into out (2,) [J]; rhs at each point (yq, yd: scratch of the state's size)."""
     pw = wk[53][0]
     out[0] = 0.0
     out[1] = 0.0
     half, mid = 0.5 * (b - a), 0.5 * (a + b)
-    for g in range(4):
+    for g in range(5):
         x = mid + half * GL_X[g]
         _dense(F, y, t0, h, x, yq)
         rhs(cm, wk, x, yq, yd, bool(True))
@@ -96,23 +99,27 @@ def _power_gl(cm, wk, F, y, t0, h, a, b, yq, yd, out):
 @kernel(_nrt=False)
 def _power_integral(cm, wk, F, y, t0, h, a, b, tol, yq, yd, out):
     """The integral of the powers over [a, b] inside the step (t0, h) on its dense output into out (2,) [J],
-    by adaptive bisection of `_power_gl` until halves agree to tol [J] (its share (b - a) / span of it, at
-    least 1e-3 of it: a kink is resolved to tol / 1000); returns the power evaluations made."""
+    by adaptive bisection of `_power_gl` from REFINE_SPLIT pieces until halves agree to tol [J] (its share
+    (b - a) / span of it, at least 1e-3 of it: a kink is resolved to tol / 1000); returns the power
+    evaluations made."""
     en = wk[53]
     S, g = en[11], en[12]
-    _power_gl(cm, wk, F, y, t0, h, a, b, yq, yd, g[0])
-    S[0, 0], S[0, 1], S[0, 2], S[0, 3] = a, b, g[0, 0], g[0, 1]
-    top, nev = 1, 4
+    span = b - a
+    for k in range(REFINE_SPLIT):   # pushed last piece first: the first is integrated first
+        lo = a + span * (REFINE_SPLIT - 1 - k) / REFINE_SPLIT
+        hi = b if k == 0 else a + span * (REFINE_SPLIT - k) / REFINE_SPLIT
+        _power_gl(cm, wk, F, y, t0, h, lo, hi, yq, yd, g[0])
+        S[k, 0], S[k, 1], S[k, 2], S[k, 3] = lo, hi, g[0, 0], g[0, 1]
+    top, nev = REFINE_SPLIT, 5 * REFINE_SPLIT
     out[0] = 0.0
     out[1] = 0.0
-    span = b - a
     while top > 0:
         top -= 1
         lo, hi, c0, c1 = S[top, 0], S[top, 1], S[top, 2], S[top, 3]
         mid = 0.5 * (lo + hi)
         _power_gl(cm, wk, F, y, t0, h, lo, mid, yq, yd, g[1])
         _power_gl(cm, wk, F, y, t0, h, mid, hi, yq, yd, g[2])
-        nev += 8
+        nev += 10
         f0, f1 = g[1, 0] + g[2, 0], g[1, 1] + g[2, 1]
         share = max((hi - lo) / span, 1e-3) if span > 0.0 else 1.0
         if abs(f0 - c0) + abs(f1 - c1) <= tol * share or top + 2 > S.shape[0] or nev >= REFINE_EVALS \
