@@ -122,5 +122,6 @@ def test_applied_force_work_torsion_spring_and_stop():
     ref = _agree(D, res, 1e-8)
     assert ref[-1] > 0
     theta = res.joint_coordinate("axle")
+    assert theta.max() > 0.3   # the stop was hit
     assert np.allclose(res.energy["W"], 0.05 * (theta - theta[0]), rtol=0, atol=1e-10)
     assert res.diagnostics.summary()["energy_error"] < 1e-8
