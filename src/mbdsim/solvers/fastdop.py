@@ -26,8 +26,8 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 
 from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _end_at, _friction_g, _project,  # noqa: F401
                           _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, initial_step)
-from .fastenergystep import (energy_dense, energy_event, energy_first, energy_flag, energy_output, energy_refine,
-                             energy_step)
+from .fastenergystep import (energy_dense, energy_event, energy_first, energy_flag, energy_kinetic, energy_output,
+                             energy_refine, energy_step)
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations, joint_rows,
                       project, read_state, rhs, tree_project, write_state)
 
@@ -194,7 +194,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         rejected = False
         t_new = t + h
         stats[0] += 1
-        if energy:
+        if energy:   # (the frames in wk are still the last stage's, at ynew: the energy scale from them)
+            energy_kinetic(cm, wk)
             energy_step(co, wk, h)
         if SY.shape[0] > 0:
             for i in range(n):

@@ -18,7 +18,8 @@ from .fastdyn import rhs
 # [record overflow, this step refined], 2 the powers at the state of f (the next step's first stage), 3 the
 # stage powers (16, 2), 4 z = [D, W] [J] at the step's start, 5 z at its end, 6 z's dense output coefficients
 # (7, 2), 7 scratch (2,), 8 z at the outputs (nout, 2), 9-10 the shape contacts' point records, 11 the
-# refinement's interval stack (64, 4), 12 its scratch (3, 2). z' = [P, P_applied] is a quadrature state of
+# refinement's interval stack (64, 4), 12 its scratch (3, 2), 13 [the largest kinetic energy at a step's end so
+# far [J]] (the energy scale of z's tolerance, as the monitor's). z' = [P, P_applied] is a quadrature state of
 # the step: integrated with DOP853's weights and dense output from the stage powers, not in the error norm
 # (the steps are the same with and without it). Where P is not smooth over a step (contact onset and
 # separation, a clipped damping force, a mesh facet's edge: the state's error control does not see what
@@ -134,16 +135,41 @@ def _power_integral(cm, wk, F, y, t0, h, a, b, tol, yq, yd, out):
 
 
 @kernel(_nrt=False)
+def energy_kinetic(cm, wk):
+    """The kinetic energy [J] of the frames in wk (those of the last evaluation: the step's end after
+    `_stages`) into the running maximum wk[53][13][0]: z's energy scale (the state is accurate to rtol of
+    it, so D and W need not be more)."""
+    r, A, rd, w = wk[0], wk[1], wk[2], wk[3]
+    mass, inertia, rigid = cm[9], cm[10], cm[6]
+    T = 0.0
+    for f in range(1, r.shape[0]):
+        T += 0.5 * mass[f] * (rd[f, 0] * rd[f, 0] + rd[f, 1] * rd[f, 1] + rd[f, 2] * rd[f, 2])
+        if rigid[f]:
+            b0 = A[f, 0, 0] * w[f, 0] + A[f, 1, 0] * w[f, 1] + A[f, 2, 0] * w[f, 2]   # body axes
+            b1 = A[f, 0, 1] * w[f, 0] + A[f, 1, 1] * w[f, 1] + A[f, 2, 1] * w[f, 2]
+            b2 = A[f, 0, 2] * w[f, 0] + A[f, 1, 2] * w[f, 1] + A[f, 2, 2] * w[f, 2]
+            I = inertia[f]
+            T += 0.5 * (b0 * (I[0, 0] * b0 + I[0, 1] * b1 + I[0, 2] * b2) + b1 * (I[1, 0] * b0 + I[1, 1] * b1
+                        + I[1, 2] * b2) + b2 * (I[2, 0] * b0 + I[2, 1] * b1 + I[2, 2] * b2))
+    sc = wk[53][13]
+    if T > sc[0]:
+        sc[0] = T
+
+
+@kernel(_nrt=False)
 def _energy_tol(wk, rtol, est0, est1):
-    """The refinement's tolerance [J]: rtol (at least 1e-12) of |z| plus the estimate of the increment."""
-    z = wk[53][4]
-    return 0.1 * max(rtol, 1e-12) * (abs(z[0]) + abs(z[1]) + abs(est0) + abs(est1)) + 1e-300
+    """The refinement's tolerance [J]: 0.1 rtol (at least 1e-12) of |z|, the estimate of the increment and
+    the energy scale (`energy_kinetic`)."""
+    en = wk[53]
+    z = en[4]
+    return 0.1 * max(rtol, 1e-12) * (abs(z[0]) + abs(z[1]) + abs(est0) + abs(est1) + en[13][0]) + 1e-300
 
 
 @kernel(_nrt=False)
 def energy_flag(co, wk, h, rtol):
     """Whether z's embedded error estimate over the accepted step of size h (from the stage powers, the norm
-    of the state's: scipy's DOP853) exceeds rtol of |z|: its stage powers do not resolve the power there."""
+    of the state's: scipy's DOP853) exceeds rtol of |z| or of the energy scale (`energy_kinetic`): its stage
+    powers do not resolve the power there."""
     E3, E5 = co[3], co[4]
     en = wk[53]
     PK, z, zn = en[3], en[4], en[5]
@@ -154,7 +180,7 @@ def energy_flag(co, wk, h, rtol):
             a3 += E3[j] * PK[j, i]
         if a5 == 0.0 and a3 == 0.0:
             continue
-        scale = max(rtol, 1e-12) * max(abs(z[i]), abs(zn[i]), abs(zn[i] - z[i])) + 1e-300
+        scale = max(rtol, 1e-12) * max(abs(z[i]), abs(zn[i]), abs(zn[i] - z[i]), en[13][0]) + 1e-300
         if h * a5 * a5 / np.sqrt(a5 * a5 + 0.01 * a3 * a3) > scale:
             return True
     return False

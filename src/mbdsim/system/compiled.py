@@ -204,15 +204,15 @@ def energy_work(n_outputs: int = -1, shape_contacts: bool = False) -> tuple:
     2 the powers at the state of the step's f (2,), 3 the stage powers (16, 2), 4 z = [D, W] [J] since the
     run's start at the step's start, 5 z at its end, 6 z's dense output coefficients (7, 2), 7 scratch (2,), 8 z at each output
     (n_outputs, 2), 9 the shape contacts' point records (force_elements.shape_contact.MAX_POINTS, NREC) and
-    10 their count (1,) (int64), 11 the refinement's interval stack (64, 4), 12 its scratch (3, 2)
-    (solvers.fastenergystep). Off (n_outputs < 0): empty outputs and records."""
+    10 their count (1,) (int64), 11 the refinement's interval stack (64, 4), 12 its scratch (3, 2), 13 [the
+    largest kinetic energy at a step's end [J]] (solvers.fastenergystep). Off (n_outputs < 0): empty outputs and records."""
     from ..solvers.fastcontact import NREC
     from .force_elements.shape_contact import MAX_POINTS
     on = n_outputs >= 0
     z = np.zeros
     return (np.array([1.0 if on else 0.0, 0.0, 0.0]), z(2, np.int64), z(2), z((16, 2)), z(2), z(2), z((7, 2)),
             z(2), z((max(n_outputs, 0), 2)), z((MAX_POINTS if on and shape_contacts else 0, NREC)),
-            z(1, np.int64), z((64, 4)), z((3, 2)))
+            z(1, np.int64), z((64, 4)), z((3, 2)), z(1))
 
 
 def _coord_work(cm, nf) -> tuple:
