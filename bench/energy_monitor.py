@@ -11,6 +11,7 @@ scenes (bench/contact_shapes.py: box sliding, cylinder rolling, pile of eight bo
 """
 from __future__ import annotations
 
+import os
 import sys
 import time
 import warnings
@@ -23,7 +24,7 @@ import mbdsim as mb
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent / "tests"))
 sys.path.insert(0, str(HERE))
-REPEATS = 2
+REPEATS = int(os.environ.get("REPEATS", 2))
 G = 9.81
 
 
@@ -106,7 +107,7 @@ def measure(name):
     m, opts = SCENES[name]()
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        mb.simulate(m, monitor=True, **opts)   # warm-up: compiles, assembles
+        mb.simulate(m, monitor=False, **opts)   # warm-up: compiles, assembles
         t_off, _ = _best(lambda: mb.simulate(m, monitor=False, **opts))
         t_on, res = _best(lambda: mb.simulate(m, monitor=True, **opts))
     d = res.diagnostics
