@@ -7,7 +7,7 @@ Scenes: a ball rolling in a triangle-mesh bowl (tests/test_shape_contact_mesh.py
 spring-damper on the carrier (bench/vocabulary.py's planetary plus the damper), and the contact bench's
 scenes (bench/contact_shapes.py: box sliding, cylinder rolling, pile of eight boxes, cam and follower).
 
-    PYTHONPATH=src python3 bench/energy_monitor.py [scene ...]
+    PYTHONPATH=src python3 bench/energy_monitor.py [scene ...]     (REPEATS=n, REFERENCE=0: no reference)
 """
 from __future__ import annotations
 
@@ -115,7 +115,7 @@ def measure(name):
             "energy": res.stats.get("energy", "python"), "method": res.stats.get("method"),
             "energy_error": d.summary().get("energy_error") if d is not None else None,
             "notes": d.notes if d is not None else None}
-    if res.stats.get("energy") == "compiled":
+    if res.stats.get("energy") == "compiled" and os.environ.get("REFERENCE", "1") != "0":
         from mbdsim.results.energy import dissipated_energy_reference
         t0 = time.perf_counter()
         ref = dissipated_energy_reference(res)
