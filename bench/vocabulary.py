@@ -174,8 +174,8 @@ def planetary(geared):
     r_p phi + r_r theta_c = 0 two; torque 0.02 N m on the sun. Baseline: the carrier alone (on a revolute and
     a cylindrical joint) with the planet's mass and the reflected inertia J = n^2 J_s + J_c + m_p a^2 + J_p
     (1 - r_r / r_p)^2 about its axis (n = 1 + r_r / r_s), torque n T_s: the same motion of the carrier.
-    (Gravity, not a spring: a spring-damper's dissipation check evaluates the redundant loop's multipliers in
-    Python after the run, and a torsion spring in a loop is called back through Python; either dominates.)"""
+    (Gravity, not a spring: a torsion spring in a loop is called back through Python and would dominate; a
+    spring-damper's dissipation is accumulated by the compiled run itself, bench/energy_monitor.py.)"""
     rs, rp = 0.03, 0.015
     rr, a = rs + 2 * rp, rs + rp
     Js, Jc, Jp, mp, mc, Ts = 2e-4, 5e-4, 3e-5, 0.2, 0.1, 0.02

@@ -14,7 +14,9 @@ the value; `Result.diagnostics` keeps the history.
   elements), dissipated D (damping, friction, sphere and shape contacts: `Result.dissipated_energy`, the
   dissipation power integrated on the run's dense output step by step, so that impacts and modes ringing
   faster than the output step are counted) and the work W of applied forces and torques (trapezoidal
-  rule of their power); tolerance ENERGY_TOL times the energy scale
+  rule of their power); a compiled run of simulate(monitor=True) accumulates D and W in its step loop
+  (solvers.energy_run: its own stage powers, so exact to the run's accuracy and nearly free), and those are
+  used where it kept them (joint friction's balance then too); tolerance ENERGY_TOL times the energy scale
   (the largest of T, |V - V(t0)|, D, |W| over the run, 1e-6 |V| and 1e-12 J) plus a trapezoid allowance when
   D or W are present (ENERGY_TOL_QUADRATURE). Not checked for driven models (motions do work through
   their multipliers) or unknown element types: `energy_error` is then None with the reason in `notes`.
@@ -98,10 +100,12 @@ def _constraint(res, diag, stride_limit=MAX_SAMPLES):
 
 
 def _energy_terms(res):
-    """(T + V, D, P_applied) at the samples, or (None, reason)."""
+    """(T, V, D, P_applied, W) at the samples (W: the compiled run's accumulated work, P_applied None then),
+    or (None, reason)."""
     from ..model.element_specs import Bushing
     from ..model.forces import Force, Torque
     from ..system.force_elements import evaluator
+    from .energy import run_energy
     sys = res.system
     if "HHT" in str(res.stats.get("method", "")):
         return None, "energy balance not checked: HHT dissipates high frequencies numerically by design"
@@ -112,7 +116,7 @@ def _energy_terms(res):
         ev = evaluator(e)
         if e not in applied and not (hasattr(ev, "potential") or hasattr(ev, "dissipation")):
             return None, f"energy balance not checked: element '{e.name}' has no energy bookkeeping"
-        if getattr(ev, "needs_lambda", False):
+        if getattr(ev, "needs_lambda", False) and run_energy(res, "D") is None:
             return None, f"energy balance not checked: friction '{e.name}' needs the multipliers"
         kt = np.asarray(e.stiffness, float)[3:] if isinstance(e, Bushing) else None
         if kt is not None and np.ptp(kt) > 1e-12 * np.max(kt):
@@ -123,8 +127,8 @@ def _energy_terms(res):
     # output (step-wise, to 1e-10), not the trapezoidal rule on the output samples, which misses the
     # power of contact impacts and of modes ringing faster than the output step
     D = res.dissipated_energy() if any(_can_dissipate(e) for e in sys.model.forces.values()) else None
-    P_w = None
-    if applied:
+    P_w, W = None, (run_energy(res, "W") if applied else None)
+    if applied and W is None:
         from .state import state_factory
         sf = state_factory(sys)
         P_w = np.zeros(len(res.time))
@@ -137,7 +141,7 @@ def _energy_terms(res):
                     P_w[i] += float(evaluator(e).generalized(sys, f1, e, t, st) @ res.v[i])
         except Exception as exc:  # noqa: BLE001 - a user load failing here: monitor skipped, run unaffected
             return None, f"energy balance not checked: applied load failed ({type(exc).__name__})"
-    return (T, V, D, P_w), None
+    return (T, V, D, P_w, W), None
 
 
 def _can_dissipate(e) -> bool:
@@ -183,10 +187,10 @@ def update(diag: Diagnostics, res, first: bool = True) -> Diagnostics:
         diag._carry["energy_off"] = True
         diag.energy_error = None
     else:
-        T, V, D_run, P_w = terms
+        T, V, D_run, P_w, W_run = terms
         c = diag._carry
         D = None if D_run is None else c.get("D", 0.0) + D_run   # D_run starts at 0 at the chunk's first sample
-        W = _trapz_cum(P_w, t, c.get("W", 0.0))
+        W = _trapz_cum(P_w, t, c.get("W", 0.0)) if W_run is None else c.get("W", 0.0) + W_run
         bal = T + V + (0.0 if D is None else D) - (0.0 if W is None else W)
         c.setdefault("E0", float(bal[0]))
         c.setdefault("V0", float(V[0]))
@@ -195,7 +199,7 @@ def update(diag: Diagnostics, res, first: bool = True) -> Diagnostics:
         scale = max(diag.energy_scale, float(np.max(T)), float(np.max(np.abs(V - c["V0"]))), abs(c["D"]),
                     abs(c["W"]), 1e-6 * float(np.max(np.abs(V))), 1e-12)   # round-off floor: 1e-10 |V|
         diag.energy_scale = scale
-        tol = (ENERGY_TOL_QUADRATURE if (D is not None or P_w is not None) else ENERGY_TOL) * scale
+        tol = (ENERGY_TOL_QUADRATURE if (D is not None or W is not None) else ENERGY_TOL) * scale
         diag.tolerances["energy_error"] = tol
         prev = diag.energy_error if diag.energy_error is not None else np.zeros(0)
         diag.energy_error = np.concatenate([prev, err[skip:]])

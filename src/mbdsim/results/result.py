@@ -58,6 +58,9 @@ class Result:
         # compiled runs: residual_check(idx, rows) -> (max |phi[rows]| [m or rad], its row) at the samples idx
         # in one compiled call (the run monitors use it instead of evaluating the rows sample by sample)
         self.residual_check = None
+        # compiled runs of simulate(monitor=True): {"D": dissipated energy, "W": applied loads' work} [J] at
+        # the samples since the first, accumulated in the step loop (None where not evaluated; solvers.energy_run)
+        self.energy = None
 
     # ------------------------------------------------------------ basics
     def __len__(self):
@@ -388,7 +391,9 @@ class Result:
         return V
 
     def dissipated_energy(self) -> Array:
-        """Energy dissipated by damping, friction and contact since the first sample [J], (N,)."""
+        """Energy dissipated by damping, friction and contact since the first sample [J], (N,): from the
+        compiled run's own bookkeeping where it kept one (`energy`, stats["energy"] == "compiled"), else
+        integrated on the dense output after the run (results.energy)."""
         from .energy import dissipated_energy
         return dissipated_energy(self)
 

@@ -18,7 +18,7 @@ from ..results.stream import ProgressError, notify
 from ..system.compiled import NotCompiled, Work, compile_system
 from ..system.equations import jacobians
 from ..system.reactions import keep_jacobians
-from . import anglerefs, fastdop, fastdyn, minnorm, pyloads
+from . import anglerefs, energy_run, fastdop, fastdyn, minnorm, pyloads
 from .sensors import SensorEvent
 from .fastdyn import (CALLBACK_FAILED, FRICTION_FAILED, INTERRUPTED, MAX_STEPS, NONFINITE, PROJECTION, SINGULAR,
                       STIFF, TINY_STEP)
@@ -43,10 +43,14 @@ class CompiledRun:
     """A compiled model and its work arrays for one analysis (immutable model, per-run state)."""
 
     def __init__(self, sys, rows, rtol, atol, max_step, max_steps=10_000_000, stiff_check=False, state=None,
-                 friction=False):
+                 friction=False, energy_outputs=-1):
+        """energy_outputs >= 0: the run keeps the energy bookkeeping for that many outputs when
+        `energy_run.wanted` (monitor=True, every element's power compiled)."""
         self.sys, self.rows = sys, rows
         self.cm = compile_system(sys, rows, state, friction, (rtol, atol))
-        self.work = Work.for_model(self.cm)
+        keep = energy_outputs >= 0 and energy_run.wanted(sys, self.cm)
+        self.work = Work.for_model(self.cm, energy_outputs if keep else -1)
+        self.energy = None   # after integrate: the bookkeeping's D and W at the outputs (energy_run.take)
         self.friction = friction_run.FrictionModes(sys, self.cm, self.work) if len(self.cm.friction[0]) else None
         self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.rtol, self.atol = float(rtol), float(atol)
@@ -108,6 +112,7 @@ class CompiledRun:
         except ProgressError as exc:   # the same for a raising progress callback
             status, self.run_error = PROGRESS_FAILED, exc
         status, self.run_error = pyloads.settle(self.pyloads, status, self.run_error)
+        energy_run.take(self, iout)
         self._take_events()
         if checkpoints:
             self.checkpoints = (SY[:ns[0]].copy(), ST[:ns[0]].copy()) if keep else None
@@ -332,7 +337,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
     if sys.derived.get("friction not compiled"):   # a held group met by an earlier try (solvers.friction_run)
         raise NotCompiled(sys.derived["friction not compiled"])
     run = CompiledRun(sys, rep.rows, rtol, atol, max_step, stiff_check=stiff_check, state=(rep.q, rep.v),
-                      friction=friction)
+                      friction=friction, energy_outputs=len(times))
     y0 = np.concatenate([rep.q, rep.v])
     success, message, error = True, "ok", None
     times = np.asarray(times, float)
@@ -342,9 +347,12 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
         run.run_error = run.friction.failure(t_fail, y_fail)
     if status == STIFF:
         raise Stiff(float(t_fail), dict(run=run, times=times[:n], Y=Y[:n], y=y_fail, stats=_stats(run, rep)))
+    extra = False   # the last sample is the run's end state (for its energy bookkeeping)
     if status == fastdop.SENSOR_STOP:   # the state at the sensor's time is the last sample
         from .radau_run import sensor_stop
+        n_before = n
         times, Y, n, message = sensor_stop(run, times, Y, n, t_fail, y_fail)
+        extra = n > n_before
         status = 0
     if status != 0:
         error, message = failure(sys, rep, status, t_fail, y_fail, times[:n], "integration failed",
@@ -352,6 +360,7 @@ def integrate_compiled(sys, rep, times, rtol, atol, max_step, progress=None, sti
         success = False
     stats = _stats(run, rep)
     res = _result(sys, rep, run, times[:n], Y[:n], success=success, message=message, stats=stats)
+    energy_run.attach(res, run, extra)
     res.error = error
     if run.sensors:
         res.sensor_events = run.sensor_events

@@ -171,6 +171,7 @@ def _simulate(model, end_time, output_step=None, method=None, rtol=None, atol=No
     _check_budget(model, start_time, end_time, output_step, max_step, in_memory=out is None)
     times = time_grid(start_time, end_time, output_step)
     sys = assemble_system(model)
+    sys.track_energy = bool(monitor)   # compiled runs keep the energy bookkeeping for the monitor (energy_run)
     rep = assemble_state(sys, sys.q0, sys.v0, start_time)
     check_initial_contacts(sys, rep.q, rep.v)
     if out is not None:

@@ -27,6 +27,8 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 from .fastdopstep import (N_STAGES, SENSOR_XTOL, _dense, _dense_coeffs, _end_at, _friction_g, _project,  # noqa: F401
                           _rms, _sensor_g, _sensor_time, _signal, _stages, _watch, _watch_friction, drop_after,
                           initial_step, locate_sensors, sensor_crossings)
+from .fastenergystep import (energy_dense, energy_event, energy_first, energy_flag, energy_kinetic, energy_output,
+                             energy_refine, energy_step)
 from .fastdyn import (CALLBACK_FAILED, MAX_STEPS, NONFINITE, OK, SINGULAR, STIFF, TINY_STEP, accelerations,
                       accept_state, joint_rows, project, read_state, rhs, tree_project, write_state)
 
@@ -108,8 +110,16 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
     joint friction (cm[48]), its switching functions are watched the same way (`_watch_friction`; their values
     at the start computed here, with the modes the caller set in wk[50]): the first zero ends the run with
     FRICTION_EVENT, the outputs up to its time written and y the projected state at st[0] = that time (the
-    caller decides the modes there and restarts with h = 0)."""
+    caller decides the modes there and restarts with h = 0).
+    Energy bookkeeping (when wk[53][0][0] != 0, solvers.fastenergy): the dissipated energy D and the applied
+    loads' work W [J] since the run's start, a quadrature state z = wk[53][4] integrated with the steps'
+    own stage powers (`fastenergystep`: where they do not resolve the power, an adaptive quadrature on the
+    step's dense output), go to wk[53][8][iout] with each output (the dense output of z inside a step); at
+    a friction event or a sensor's stop z is the value at its time."""
     E3, E5 = co[3], co[4]
+    en = wk[53]
+    energy = en[0][0] != 0.0
+    ZO = en[8]
     nq = cm[31][0]
     n = y.shape[0]
     ys, ynew, yo, scale = sc[0], sc[1], sc[2], sc[3]
@@ -120,6 +130,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         s_ = rhs(cm, wk, t, y, f, bool(True))
         if s_ != OK:
             return s_, iout
+        if energy:   # the powers at the state of f
+            en[2][0], en[2][1] = en[0][1], en[0][2]
         h = initial_step(cm, wk, t, y, f, rtol, atol, max_step, sc[0], sc[1], sc[2], 7)
         st[1] = h
         if watch:   # the sensors' values at the start: a sign change from them is an event
@@ -158,6 +170,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             h = t_end - t
         for i in range(n):
             K[0, i] = f[i]
+        if energy:
+            energy_first(wk, en[2])
         ok = _stages(cm, wk, co, t, h, y, K, ys, ynew)
         stats[2] += N_STAGES
         if not ok and wk[48][1][1] != 0:   # a Python-callable load failed: smaller steps reach up to
@@ -193,6 +207,9 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         rejected = False
         t_new = t + h
         stats[0] += 1
+        if energy:   # (the frames in wk are still the last stage's, at ynew: the energy scale from them)
+            energy_kinetic(cm, wk)
+            energy_step(co, wk, h)
         if SY.shape[0] > 0:
             for i in range(n):
                 SY[ns[0], i] = y[i]
@@ -216,12 +233,24 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                     stats[4] = 0
         have_F = False
         tol_end = 1e-14 * max(1.0, abs(t_new))
+        if energy:   # z's increment over the step, refined where the stage powers do not resolve the power
+            en[1][1] = 0
+            if energy_flag(co, wk, h, rtol):
+                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+                energy_dense(co, wk, h)
+                have_F = True
+                stats[2] += 3 + energy_refine(cm, wk, F, y, t, h, rtol, ys, scale)
         if tout[iout] < t_new - tol_end:   # outputs inside this step (those at its end: below)
-            _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
-            stats[2] += 3
-            have_F = True
+            if not have_F:
+                _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F)
+                stats[2] += 3
+                have_F = True
+                if energy:
+                    energy_dense(co, wk, h)
             while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
                 to = tout[iout]
+                if energy and iout < ZO.shape[0]:
+                    stats[2] += energy_output(cm, wk, F, y, t, h, to, rtol, ys, scale, ZO[iout])
                 _dense(F, y, t, h, to, yo)
                 s_ = _project(cm, wk, to, yo, proj_tol, bool(False))
                 stats[3] += 1
@@ -237,6 +266,8 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             if have_F and not computed:
                 stats[2] += 3
             if t_ev < np.inf:
+                if energy:
+                    energy_event(cm, wk, co, F, y, t, h, t_ev, rtol, ys, scale)
                 return _end_at(cm, wk, F, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(True), FRICTION_EVENT)
         if n_sensors > 0:
@@ -248,10 +279,14 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 st[0], st[1] = t, h   # ends at the step's start, the outputs up to it kept
                 return SENSOR_FAILED, drop_after(tout, iout, t)
             if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
+                if energy:
+                    energy_event(cm, wk, co, F, y, t, h, t_stop, rtol, ys, scale)
                 return _end_at(cm, wk, F, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(False), SENSOR_STOP)
         for i in range(n):
             y[i] = ynew[i]
+        if energy:   # z at the step's end; the powers at the state of f set below
+            en[4][0], en[4][1] = en[5][0], en[5][1]
         if cm[31][5] == 1:   # joint coordinates: f(t_new, ynew) is the last stage unless the projection onto
             s_, moved = tree_project(cm, wk, t_new, y, proj_tol)   # coordinate constraints or drivers moved ynew
             if s_ != OK:
@@ -261,9 +296,13 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 stats[3] += 1
                 s_ = rhs(cm, wk, t_new, y, f, bool(True))
                 stats[2] += 1
+                if energy:
+                    en[2][0], en[2][1] = en[0][1], en[0][2]
             else:
                 for i in range(n):
                     f[i] = K[N_STAGES, i]
+                if energy:
+                    en[2][0], en[2][1] = en[3][N_STAGES, 0], en[3][N_STAGES, 1]
         else:
             s_ = project(cm, wk, t_new, y[:nq], y[nq:], proj_tol, bool(True))
             stats[3] += 1
@@ -273,11 +312,15 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             s_ = rhs(cm, wk, t_new, y, f, bool(False))   # the projection's factorisation is at these positions
             stats[2] += 1
             accept_state(cm, wk)   # joint angles read from the frames: continued from this state on
+            if energy:
+                en[2][0], en[2][1] = en[0][1], en[0][2]
         for i in range(n):
             if not np.isfinite(y[i]):
                 st[0], st[1] = t, h
                 return NONFINITE, iout
         while iout < tout.shape[0] and tout[iout] <= t_new + tol_end:   # outputs at the step's end: its
+            if energy and iout < ZO.shape[0]:
+                ZO[iout, 0], ZO[iout, 1] = en[4][0], en[4][1]
             write_state(cm, wk, y, Y[iout], Y[iout - 1] if iout > 0 else Y[iout, :0])   # projected state,
             iout += 1                                                    # no dense output needed
             written += 1

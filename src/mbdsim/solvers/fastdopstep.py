@@ -16,7 +16,7 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
-from . import fastfriction, fasttree
+from . import fastenergy, fastfriction, fasttree
 from .fastdyn import OK, _to6, accelerations, normalize_into, project, rhs, tree_project
 
 N_STAGES = _c.N_STAGES
@@ -336,12 +336,15 @@ def _stages(cm, wk, co, t, h, y, K, ys, ynew):
             ys[i] = y[i] + h * acc
         if rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True)) != OK:
             return False
+        fastenergy.stage_power(wk, s)
     for i in range(n):
         acc = 0.0
         for j in range(N_STAGES):
             acc += B[j] * K[j, i]
         ynew[i] = y[i] + h * acc
-    return rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
+    ok = rhs(cm, wk, t + h, ynew, K[N_STAGES], bool(True)) == OK
+    fastenergy.stage_power(wk, N_STAGES)
+    return ok
 
 
 @kernel(_nrt=False, inline="always")
@@ -356,7 +359,15 @@ def _dense_coeffs(cm, wk, co, t, h, y, ynew, K, ys, F):
                 acc += A[s, j] * K[j, i]
             ys[i] = y[i] + h * acc
         rhs(cm, wk, t + C[s] * h, ys, K[s], bool(True))
-    for i in range(n):
+        fastenergy.stage_power(wk, s)
+    _dense_rows(D, h, y, ynew, K, F)
+
+
+@kernel(_nrt=False)
+def _dense_rows(D, h, y, ynew, K, F):
+    """The dense output coefficients F (7, n) of a step of size h from y to ynew with the 16 stage
+    derivatives K (16, n): the state's, and the energy bookkeeping's quadrature state (`energy_dense`)."""
+    for i in range(y.shape[0]):
         dy = ynew[i] - y[i]
         F[0, i] = dy
         F[1, i] = h * K[0, i] - dy

@@ -30,7 +30,7 @@ from ..system.kernels import frames_into, quat_step, rows_kernel
 from .fastcontact import shape_contacts
 from .fastloads import bushings_kernel, contacts_kernel, loads_kernel
 from .kkt_tree import _row_dot
-from . import fastfriction, fasttree, loopcoord, pathcoord, treecoord
+from . import fastenergy, fastfriction, fasttree, loopcoord, pathcoord, treecoord
 from .fastsolve import _factor, _factor_rows, _kkt, _reselect, _solve, _solve_rows, loop_ratio, rows_dropped  # noqa: F401
 from .pycall import call_address
 
@@ -68,20 +68,30 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
     """Gravity, gyroscopic torques, constant point forces/torques, linear spring-dampers, bushings, the
     loads written as expressions (system.exprloads_kernel; at time t [s], y: the joint-coordinate state on
     the tree path), contacts, shape contacts (solvers.fastcontact) and the loads written as Python callables (the callback of solvers.pyloads,
-    reading the frames r, A, rd, w, which must be the work arrays wk[0:4]) into F."""
+    reading the frames r, A, rd, w, which must be the work arrays wk[0:4]) into F. When the run keeps the
+    energy bookkeeping (wk[53], solvers.fastenergy), the dissipation power and the applied loads' power of
+    this state go to wk[53][0] (the shape contacts' points recorded into wk[53][9] for it)."""
+    en = wk[53]
+    pw = en[0]
+    fastenergy.reset(pw)
     loads_kernel(cm[9], cm[10], cm[8], cm[6], cm[21], cm[22], cm[23], cm[24], cm[25], cm[26], cm[27], cm[28],
-                 cm[29], r, A, rd, w, F)
+                 cm[29], r, A, rd, w, F, pw)
     if cm[36].shape[0]:
         bushings_kernel(cm[36], cm[37], cm[38], cm[39], cm[40], cm[41], r, A, rd, w, cm[6], F, wk[42][0],
-                        wk[42][1])
+                        wk[42][1], pw)
     if cm[43][7].shape[0]:
-        expr_loads(cm[43], wk[44], t, y, r, A, rd, w, cm[6], F)
+        expr_loads(cm[43], wk[44], t, y, r, A, rd, w, cm[6], F, pw)
     if cm[44][0].shape[0]:
         ct = cm[44]
-        contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F)
+        contacts_kernel(ct[0], ct[1], ct[2], ct[3], ct[4], r, A, rd, w, cm[6], F, pw)
     if cm[46][10].shape[0]:   # shape contacts (issue 30)
         sc = cm[46]
-        shape_contacts(sc, r, A, rd, w, cm[6], F, sc[12], sc[13])
+        on = pw[0] != 0.0   # then the touching points are recorded, for their dissipation power
+        rec, nrec = (en[9], en[10]) if on else (sc[12], sc[13])
+        nrec[0] = 0
+        shape_contacts(sc, r, A, rd, w, cm[6], F, rec, nrec)
+        if on:
+            fastenergy.contact_power(sc[11], rec, nrec, pw, en[1])
     if wk[48][1][0] != 0:   # loads written as Python callables (solvers.pyloads), from the frames in wk
         _python_loads(wk[48][0], wk[48][1], t, F)
 
@@ -181,8 +191,11 @@ def accelerations(cm, wk, t, q, v, y, vd, lam, refactor=True):
     for i in range(lam.shape[0]):
         lam[i] = 0.0
     _solve(cm, wk, F, wk[7], x6, lam)
-    if cm[48][0].shape[0] and not _friction(cm, wk, x6, lam):
-        return FRICTION_FAILED
+    if cm[48][0].shape[0]:
+        if not _friction(cm, wk, x6, lam):
+            return FRICTION_FAILED
+        if wk[53][0][0] != 0.0:   # joint friction's dissipation power (solvers.fastenergy)
+            fastenergy.friction_power(cm[48][0], wk[5], cm[12], cm[13], cm[5], cm[6], v, lam, wk[53][0])
     _from6(cm, x6, vd)
     if cm[50][0].shape[0]:   # loop couplers: the auxiliary angles' accelerations, the link rows' multipliers
         loopcoord.aux_rates(cm[50], wk[52], x6, vd, lam)

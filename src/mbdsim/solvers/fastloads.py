@@ -25,13 +25,15 @@ def _centre(r, A, f, s):
 
 
 @kernel(_nrt=False)
-def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F):
+def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F, pw):
     """Compliant contacts (system.force_elements.contact) into F: signed gap g [m] between the shapes, normal
     n from body_i's shape towards body_j's, contact point cp in the middle of the overlap; while g < 0 the
     Adams IMPACT normal force max(0, k delta^e - STEP(delta, 0, 0, d, c_max) g_dot) along n and the
     regularised Coulomb friction -mu Fn v_t / sqrt(|v_t|^2 + v_s^2) (v_t: the tangential part of the
     relative velocity of the material points at cp) act on body_j at cp, their opposite on body_i.
-    Arrays of `system.compiled._contacts`; frames r, A, rd, w (w in ground axes)."""
+    Arrays of `system.compiled._contacts`; frames r, A, rd, w (w in ground axes). With pw[0] != 0 their
+    dissipation power (Fn - k delta^e) (-g_dot) + mu Fn |v_t|^2 / sqrt(|v_t|^2 + v_s^2) [W] is added to pw[1]
+    (solvers.fastenergy)."""
     for c in range(ct_f.shape[0]):
         fi, fj, kind = ct_f[c, 0], ct_f[c, 1], ct_kind[c]
         Ri, Rj, k, ex, cmax, dpen, mu, vs = (ct_par[c, 0], ct_par[c, 1], ct_par[c, 2], ct_par[c, 3],
@@ -73,6 +75,8 @@ def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F):
         t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2
         mf = mu * Fn / np.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + vs * vs) if mu > 0.0 else 0.0
         G0, G1, G2 = Fn * n0 - mf * t0, Fn * n1 - mf * t1, Fn * n2 - mf * t2
+        if pw[0] != 0.0:
+            pw[1] += (Fn - k * delta ** ex) * (-gd) + mf * (t0 * t0 + t1 * t1 + t2 * t2)
         _point_force(F, A, fj, p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2], G0, G1, G2, rigid)
         _point_force(F, A, fi, p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2], -G0, -G1, -G2, rigid)
 
@@ -87,8 +91,11 @@ def _rotT(A, f, x0, x1, x2):
 
 @kernel(_nrt=False)
 def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, pf_torque, sp_f, sp_s, sp_par,
-                 r, A, rd, w, F):
-    """Loads of `loads_into` with explicit arrays (six slots per frame); no allocation."""
+                 r, A, rd, w, F, pw):
+    """Loads of `loads_into` with explicit arrays (six slots per frame); no allocation. With pw[0] != 0
+    the power of the constant forces and torques [W] is added to pw[2] and the spring-dampers' damping power
+    c L_dot^2 [W] to pw[1] (solvers.fastenergy)."""
+    on = pw[0] != 0.0
     nf = F.shape[0]
     for f in range(nf):
         for k in range(6):
@@ -119,9 +126,14 @@ def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, p
                 F[f, 3] += t0
                 F[f, 4] += t1
                 F[f, 5] += t2
+                if on:
+                    pw[2] += G0 * w[f, 0] + G1 * w[f, 1] + G2 * w[f, 2]
         else:
             s0, s1, s2 = _rot(A, f, pf_s[e, 0], pf_s[e, 1], pf_s[e, 2])
             _point_force(F, A, f, s0, s1, s2, G0, G1, G2, rigid)
+            if on:
+                c0, c1, c2 = _cross_into(w[f, 0], w[f, 1], w[f, 2], s0, s1, s2)
+                pw[2] += G0 * (rd[f, 0] + c0) + G1 * (rd[f, 1] + c1) + G2 * (rd[f, 2] + c2)
     for e in range(sp_f.shape[0]):   # spring-dampers: tension k (L - L0) + c dL/dt + preload
         fi, fj = sp_f[e, 0], sp_f[e, 1]
         si0, si1, si2 = _rot(A, fi, sp_s[e, 0, 0], sp_s[e, 0, 1], sp_s[e, 0, 2])
@@ -138,6 +150,8 @@ def loads_kernel(mass, inertia, gravity, rigid, pf_f, pf_s, pf_v, pf_ff, pf_R, p
         inv = 1.0 / L if L > 0 else 0.0
         Ld = (d0 * e0 + d1 * e1 + d2 * e2) * inv
         T = sp_par[e, 0] * (L - sp_par[e, 2]) + sp_par[e, 1] * Ld + sp_par[e, 3]
+        if on:
+            pw[1] += sp_par[e, 1] * Ld * Ld
         u0, u1, u2 = d0 * inv * T, d1 * inv * T, d2 * inv * T
         _point_force(F, A, fi, si0, si1, si2, u0, u1, u2, rigid)
         _point_force(F, A, fj, sj0, sj1, sj2, -u0, -u1, -u2, rigid)
@@ -169,9 +183,10 @@ def _rotvec(r00, r01, r02, r10, r11, r12, r20, r21, r22):
 
 
 @kernel(_nrt=False)
-def bushings_kernel(bu_f, bu_s, bu_R, bu_k, bu_c, bu_f0, r, A, rd, w, rigid, F, Mi, Mj):
+def bushings_kernel(bu_f, bu_s, bu_R, bu_k, bu_c, bu_f0, r, A, rd, w, rigid, F, Mi, Mj, pw):
     """Linear six-component bushings (Adams BUSHING semantics, see model.element_specs.Bushing) into F.
-    Mi, Mj (3, 3): scratch for the markers' axes in ground."""
+    Mi, Mj (3, 3): scratch for the markers' axes in ground. With pw[0] != 0 the damping power
+    x_dot.C x_dot + w.C w [W] (marker_i components) is added to pw[1] (solvers.fastenergy)."""
     for e in range(bu_f.shape[0]):
         fi, fj = bu_f[e, 0], bu_f[e, 1]
         for a in range(3):
@@ -217,6 +232,9 @@ def bushings_kernel(bu_f, bu_s, bu_R, bu_k, bu_c, bu_f0, r, A, rd, w, rigid, F, 
         w1 = Mi[0, 1] * wr0 + Mi[1, 1] * wr1 + Mi[2, 1] * wr2
         w2 = Mi[0, 2] * wr0 + Mi[1, 2] * wr1 + Mi[2, 2] * wr2
         k, c, f0 = bu_k, bu_c, bu_f0
+        if pw[0] != 0.0:
+            pw[1] += (c[e, 0] * xd0 * xd0 + c[e, 1] * xd1 * xd1 + c[e, 2] * xd2 * xd2 + c[e, 3] * w0 * w0
+                      + c[e, 4] * w1 * w1 + c[e, 5] * w2 * w2)
         F0 = -k[e, 0] * x0 - c[e, 0] * xd0 + f0[e, 0]
         F1 = -k[e, 1] * x1 - c[e, 1] * xd1 + f0[e, 1]
         F2 = -k[e, 2] * x2 - c[e, 2] * xd2 + f0[e, 2]

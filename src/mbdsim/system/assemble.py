@@ -79,6 +79,9 @@ class System:
     # issue 11: why the compiled core cannot run this system (rows the kernels do not carry: couplers,
     # user constraints); empty when it can (callable sensors are called back: solvers.pyloads).  compile_system checks it.
     not_compiled: list = field(default_factory=list)
+    # simulate(monitor=True): compiled runs accumulate the dissipated energy and the applied loads' work in
+    # their step loop for the energy balance (solvers.energy_run); set per simulate call
+    track_energy: bool = False
     # Caches of functions of this System alone (packed constraint rows, friction base rows, the compiled
     # model, the assembled initial state): computed on first use, never changed after, shared by the
     # copies assemble_system hands out for an unchanged Model.  Not run state.

@@ -145,7 +145,9 @@ class Work:
     arrays_: tuple
 
     @classmethod
-    def for_model(cls, cm: CompiledModel) -> "Work":
+    def for_model(cls, cm: CompiledModel, energy_outputs: int = -1) -> "Work":
+        """The work arrays of a run of `cm`; with energy_outputs >= 0 the run keeps the energy bookkeeping
+        (slot 53, `energy_work`) for that many outputs."""
         nq, nv, nc, nf, dense, _mode = (int(x) for x in cm.dims)
         # 32, 33, 39: the dense augmented matrix (dense = 1: singular masses) or the square Jacobian's LU
         # (dense = 2: zero-DOF models, solvers.kkt_square; 33's last slot flags a valid LU)
@@ -177,7 +179,8 @@ class Work:
              _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
              _friction_work(cm.friction or _friction(None), nf, nc, nv),   # 50: joint friction (solvers.fastfriction)
              pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
-             loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack, nf, nc))   # 52: solvers.loopcoord
+             loopcoords.work(cm.loop_coords or loopcoords.empty(), cm.loop_stack, nf, nc),   # 52: solvers.loopcoord
+             energy_work(energy_outputs, len(cm.shape_contacts) > 10 and len(cm.shape_contacts[10]) > 0))   # 53
         work = cls(a)
         work.__dict__["model"] = cm   # (for the slot types, `arrays`)
         return work
@@ -192,6 +195,24 @@ class Work:
             if cm is not None:
                 object.__setattr__(cm, "_work_type", s._numba_type_)
         return s
+
+
+def energy_work(n_outputs: int = -1, shape_contacts: bool = False) -> tuple:
+    """Slot 53 of the work arrays: the energy bookkeeping of a compiled run (solvers.fastenergy, the step
+    loop's in solvers.fastenergystep): 0 [on (1.0) or off (0.0), dissipation power P [W], applied loads' power
+    [W]] of the last loads evaluation, 1 flags [shape-contact records overflowed, the step refined] (int64),
+    2 the powers at the state of the step's f (2,), 3 the stage powers (16, 2), 4 z = [D, W] [J] since the
+    run's start at the step's start, 5 z at its end, 6 z's dense output coefficients (7, 2), 7 scratch (2,), 8 z at each output
+    (n_outputs, 2), 9 the shape contacts' point records (force_elements.shape_contact.MAX_POINTS, NREC) and
+    10 their count (1,) (int64), 11 the refinement's interval stack (64, 4), 12 its scratch (3, 2), 13 [the
+    largest kinetic energy at a step's end [J]] (solvers.fastenergystep). Off (n_outputs < 0): empty outputs and records."""
+    from ..solvers.fastcontact import NREC
+    from .force_elements.shape_contact import MAX_POINTS
+    on = n_outputs >= 0
+    z = np.zeros
+    return (np.array([1.0 if on else 0.0, 0.0, 0.0]), z(2, np.int64), z(2), z((16, 2)), z(2), z(2), z((7, 2)),
+            z(2), z((max(n_outputs, 0), 2)), z((MAX_POINTS if on and shape_contacts else 0, NREC)),
+            z(1, np.int64), z((64, 4)), z((3, 2)), z(1))
 
 
 def _coord_work(cm, nf) -> tuple:

@@ -205,10 +205,12 @@ def sensor_values(ex, ew, t, y, r, A, rd, w, g):
 
 
 @kernel(_nrt=False)
-def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
+def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F, pw):
     """Measures, expression programs and their loads at one state into F (see the module docstring).
     y: the joint-coordinate state [theta, theta_dot] on the tree path (read by joint measures that have
-    a tree coordinate), else unused."""
+    a tree coordinate), else unused. With pw[0] != 0 (solvers.fastenergy) the power of the point forces and
+    torques [W] is added to pw[2], and the dissipation program of a joint load (its second program,
+    ld_prog[e, 1] >= 0: torsion springs' and stops' damping power, system.exprloads_pack) to pw[1]."""
     ld_kind, ld_f, ld_s, ld_R, ld_v, ld_prog = ex[7], ex[8], ex[9], ex[10], ex[11], ex[12]
     code, consts, tables, start, end = ex[13], ex[14], ex[15], ex[16], ex[17]
     x, stack = ew[0], ew[1]
@@ -227,9 +229,14 @@ def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
             G0, G1, G2 = _rot(A, ld_f[e, 2], l0, l1, l2)
             if k == 1:
                 _torque(F, A, fi, G0, G1, G2, rigid)
+                if pw[0] != 0.0 and fi != 0 and rigid[fi]:
+                    pw[2] += G0 * w[fi, 0] + G1 * w[fi, 1] + G2 * w[fi, 2]
             else:
                 s0, s1, s2 = _rot(A, fi, ld_s[e, 0, 0], ld_s[e, 0, 1], ld_s[e, 0, 2])
                 _force(F, A, fi, s0, s1, s2, G0, G1, G2, rigid)
+                if pw[0] != 0.0 and fi != 0:
+                    c0, c1, c2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], s0, s1, s2)
+                    pw[2] += G0 * (rd[fi, 0] + c0) + G1 * (rd[fi, 1] + c1) + G2 * (rd[fi, 2] + c2)
         elif k == 2:        # line force: +T u on i, -T u on j, u from point i to point j
             si = _rot(A, fi, ld_s[e, 0, 0], ld_s[e, 0, 1], ld_s[e, 0, 2])
             sj = _rot(A, fj, ld_s[e, 1, 0], ld_s[e, 1, 1], ld_s[e, 1, 2])
@@ -245,3 +252,5 @@ def expr_loads(ex, ew, t, y, r, A, rd, w, rigid, F):
             _, Jri, Jpi, Jrj, Jpj, _ = row_terms(5 if k == 3 else 4, r, A, rd, w, fi, fj, ld_v[e], 0.0)
             _row_load(F, A, fi, v0, Jri, Jpi, rigid)
             _row_load(F, A, fj, v0, Jrj, Jpj, rigid)
+            if pw[0] != 0.0 and ld_prog[e, 1] >= 0:   # its dissipation power (torsion springs, stops)
+                pw[1] += _value(code, consts, tables, start, end, ld_prog[e, 1], x, stack)

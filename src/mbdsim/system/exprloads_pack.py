@@ -46,18 +46,34 @@ def torsion_expression(elem) -> LoadExpr:
     return _coordinate_expression(text, elem.joint, "rotation")
 
 
+def _stop_text(elem, xd) -> str:
+    """The Stop's load law as text in x and the rate written `xd` (an expression text)."""
+    f = lambda v: repr(float(v))  # noqa: E731
+    law = f"{f(elem.stiffness)}, {f(elem.exponent)}, {f(elem.damping)}, {f(elem.penetration)}"
+    if elem.lower is not None and elem.upper is not None:
+        return f"BISTOP(x, {xd}, {f(elem.lower)}, {f(elem.upper)}, {law})"
+    if elem.lower is not None:
+        return f"IMPACT(x, {xd}, {f(elem.lower)}, {law})"
+    return f"-IMPACT(-x, -({xd}), {f(-elem.upper)}, {law})"
+
+
 def stop_expression(elem) -> LoadExpr:
     """The load [N or N m] of a Stop along its joint coordinate x (> 0 pushes x up) as a load expression of
     x and its rate: Adams IMPACT at the lower wall, its mirror image at the upper one, BISTOP for both
     (mbdsim.functions; the law of system.force_elements.stop)."""
-    f = lambda v: repr(float(v))  # noqa: E731
-    law = f"{f(elem.stiffness)}, {f(elem.exponent)}, {f(elem.damping)}, {f(elem.penetration)}"
-    if elem.lower is not None and elem.upper is not None:
-        text = f"BISTOP(x, x_dot, {f(elem.lower)}, {f(elem.upper)}, {law})"
-    elif elem.lower is not None:
-        text = f"IMPACT(x, x_dot, {f(elem.lower)}, {law})"
-    else:
-        text = f"-IMPACT(-x, -x_dot, {f(-elem.upper)}, {law})"
+    return _coordinate_expression(_stop_text(elem, "x_dot"), elem.joint, elem.dof)
+
+
+def dissipation_expression(elem) -> LoadExpr | None:
+    """The damping power [W] of a TorsionSpring or Stop as a load expression of its joint coordinate x and
+    rate x_dot: -(L(x, x_dot) - L(x, 0)) x_dot of its load law L (c theta_dot^2 for a torsion spring; for a
+    stop (f - k p^e) dp/dt at the penetrated wall, as force_elements.stop.dissipation), read by the compiled
+    energy bookkeeping (solvers.fastenergy); None without damping."""
+    if not float(elem.damping):
+        return None
+    if isinstance(elem, TorsionSpring):
+        return _coordinate_expression(f"{float(elem.damping)!r}*x_dot*x_dot", elem.joint, "rotation")
+    text = f"-(({_stop_text(elem, 'x_dot')}) - ({_stop_text(elem, '0.0')}))*x_dot"
     return _coordinate_expression(text, elem.joint, elem.dof)
 
 
@@ -208,7 +224,9 @@ def pack(sys, elems, mode, tree, state, sensors=(), input_slots=None, switches=F
             value = torsion_expression(e) if isinstance(e, TorsionSpring) else \
                 stop_expression(e) if isinstance(e, Stop) else e.value
             v = np.stack([g.f_i, g.g_i, g.f_j]) if rot else np.stack([g.h_i, g.s_i, g.s_j])
-            loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, [program(e, value), -1, -1]))
+            diss = dissipation_expression(e) if isinstance(e, (TorsionSpring, Stop)) else None
+            p = [program(e, value), -1 if diss is None else program(e, diss), -1]   # 2nd: its damping power
+            loads.append((3 if rot else 4, (g.bi, g.bj, 0), (z3, z3), eye, v, p))
     sn = []
     for sensor in sensors:
         if sensor.text is None:   # a Python callable: called back through a ctypes callback (solvers.pyloads)

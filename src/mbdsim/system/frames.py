@@ -135,14 +135,15 @@ def cross(a, b):
     return out
 
 
-def point_state(fr: Frames, fid, s_B):
-    """Ground position, velocity and (if available) acceleration of points s_B [m] fixed on frames fid."""
+def point_state(fr: Frames, fid, s_B, acceleration=True):
+    """Ground position, velocity and (if available, and asked for) acceleration of points s_B [m] fixed on
+    frames fid (acceleration=False: None, without computing a Result's accelerations for lazy frames)."""
     A = fr.A[..., fid, :, :]
     s = np.einsum("...ij,...j->...i", A, s_B)
     w = fr.w[..., fid, :]
     pos = fr.r[..., fid, :] + s
     vel = fr.rd[..., fid, :] + cross(w, s)
     acc = None
-    if fr.rdd is not None:
+    if acceleration and fr.rdd is not None:
         acc = fr.rdd[..., fid, :] + cross(fr.alpha[..., fid, :], s) + cross(w, cross(w, s))
     return pos, vel, acc

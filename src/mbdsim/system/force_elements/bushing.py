@@ -18,8 +18,8 @@ def bushing_state(sys, fr, elem):
     (relative angular velocity), Ai (N, 3, 3) marker_i axes -> ground, and the ground points p_i, p_j."""
     mi, mj = elem.marker_i, elem.marker_j
     fi, fj = sys.fid[mi.body], sys.fid[mj.body]
-    p_i, v_i, _ = point_state(fr, fi, mi.s_B)
-    p_j, v_j, _ = point_state(fr, fj, mj.s_B)
+    p_i, v_i, _ = point_state(fr, fi, mi.s_B, False)
+    p_j, v_j, _ = point_state(fr, fj, mj.s_B, False)
     Ai = fr.A[:, fi] @ mi.R_BM
     Aj = fr.A[:, fj] @ mj.R_BM
     w_i, w_j = fr.w[:, fi], fr.w[:, fj]

@@ -110,8 +110,8 @@ class LineForceEval(_Angles):
         """+T u on point i, -T u on point j (u from i to j): T > 0 pulls the points together."""
         Q = np.zeros(sys.nv)
         fi, fj = sys.fid[elem.marker_i.body], sys.fid[elem.marker_j.body]
-        pi, _, _ = point_state(fr, fi, elem.marker_i.s_B)
-        pj, _, _ = point_state(fr, fj, elem.marker_j.s_B)
+        pi, _, _ = point_state(fr, fi, elem.marker_i.s_B, False)
+        pj, _, _ = point_state(fr, fj, elem.marker_j.s_B, False)
         d = pj - pi
         L = float(np.linalg.norm(d))
         u = d / L if L > 0 else np.zeros(3)

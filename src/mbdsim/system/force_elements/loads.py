@@ -63,8 +63,8 @@ class TorqueEval:
 def spring_state(sys, fr, elem):
     """Length L [m], rate dL/dt [m/s], unit vector i->j, ground points and offsets (single state)."""
     fi, fj = sys.fid[elem.marker_i.body], sys.fid[elem.marker_j.body]
-    pi, vi, _ = point_state(fr, fi, elem.marker_i.s_B)
-    pj, vj, _ = point_state(fr, fj, elem.marker_j.s_B)
+    pi, vi, _ = point_state(fr, fi, elem.marker_i.s_B, False)
+    pj, vj, _ = point_state(fr, fj, elem.marker_j.s_B, False)
     d = pj - pi
     L = np.linalg.norm(d, axis=-1)
     u = d / np.where(L > 0, L, 1.0)[..., None]
