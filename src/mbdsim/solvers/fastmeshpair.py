@@ -78,7 +78,7 @@ def _sharp(sc, t, j):
     nb = nbr[t, j]
     if nb < 0:
         return False
-    cs = 0.0
+    cs, n0, n1, n2 = 0.0, 0.0, 0.0, 1.0
     for k in range(2):
         f = t if k == 0 else nb
         a0, a1, a2 = verts[tri[f, 0], 0], verts[tri[f, 0], 1], verts[tri[f, 0], 2]
