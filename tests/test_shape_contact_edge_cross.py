@@ -11,7 +11,7 @@ import mbdsim as mb
 from mbdsim.solvers.fastcontact import REC_FIELDS
 
 G, K, E = 9.81, 1e6, 1.5
-W, H, LR = 0.2, 0.05, 0.6      # roof: width (x), ridge height, length (along y) [m]
+W, H, LR, B = 0.2, 0.05, 0.6, 0.2   # roof: width (x), ridge height, length (along y), base depth [m]
 WU, HU, LU = 0.06, 0.05, 0.2   # upper prism: width, height, length (along its local x) [m]
 S = 0.05                       # upper box's cross-section side [m]
 
@@ -23,9 +23,10 @@ def _rot(axis, ang):
 
 
 def roof():
-    """A closed triangular prism mesh, its ridge along y at (0, y, H), |y| <= LR / 2, its base z = 0."""
-    tri = [(-W / 2, 0.0), (W / 2, 0.0), (0.0, H)]
-    p = trimesh.Trimesh(np.array([[x, y, z] for y in (-LR / 2, LR / 2) for x, z in tri])).convex_hull
+    """A closed house-shaped prism mesh, its ridge along y at (0, y, H), |y| <= LR / 2, eaves at z = 0 and base
+    z = -B (B deeper than the mesh pair's skin: a vertex above the roof is not taken behind the base face)."""
+    prof = [(-W / 2, -B), (W / 2, -B), (W / 2, 0.0), (0.0, H), (-W / 2, 0.0)]
+    p = trimesh.Trimesh(np.array([[x, y, z] for y in (-LR / 2, LR / 2) for x, z in prof])).convex_hull
     return mb.Mesh(p.vertices, p.faces)
 
 

@@ -16,7 +16,13 @@ each owned by one of its triangles, so that the hierarchy walk meets each once:
 * a ridge: its part inside the polyhedron, [t0, t1] along it (Cyrus-Beck clipping on the face planes); the
   face of least depth over that part is the reference (normal n outward); a point at each end of the part
   that is not a peak (peaks push on their own), depth the end's distance below that face: a ridge across a
-  face is a line contact, one point at each end of the line (as a cylinder on a face);
+  face is a line contact, one point at each end of the line (as a cylinder on a face); unless an edge of the
+  polyhedron crosses the ridge inside it (`_edge_across`: `crossing`, the closest points inside both edges,
+  their common normal L in the ridge's normal cone, the edge the polyhedron's lowest feature along -L) less
+  deep along L than the whole ridge lies below any face plane (the separating-axis depth of the ridge as a
+  segment; the part inside alone would make a steep wedge's slope the reference) and L not within FACE_COS of
+  the reference face's normal (a box lying on the ridge keeps its face): then one point midway between the
+  two edges, normal L (a wedge's or a box's edge resting crosswise on a roof's ridge);
 * a peak: its depth below the nearest face plane, that face's normal.
 
 Rows of the slot buffer S (solvers.fastmesh layout: used, depth [m], point [m], normal, weight), the point
@@ -27,7 +33,10 @@ the triangles' planes miss a ridge under their curved side): per owned ridge the
 signed distance from the solid (fastgjk.segment_penetration; a capsule by the nearest points of its core and
 the ridge, where that is not an end of the core, whose end sphere has it already), a cylinder lying along a
 ridge (within LINE_SIN of its axis) a point at each end of the part of the ridge beside its side, each as
-deep as the radius less its distance from the axis; per owned peak its depth in the solid.  A ridge point counts
+deep as the radius less its distance from the axis, a ridge within LINE_SIN of parallel to a cylinder's flat
+end whose deepest point is on that end a line contact along the chord over the end disc (`_end_chord`: a
+point at each end of the chord, so that equal depths act at the chord's middle, as a uniform line load); per
+owned peak its depth in the solid.  A ridge point counts
 only when its normal lies in the ridge's normal cone (between its two faces' normals, sc[35] naming the
 neighbour across each edge): a cylinder resting on one face beside the ridge pushes on that face alone.
 """
@@ -110,8 +119,10 @@ def ridge_points(sc, x, Px, Pm, t, S, s):
         t0, t1 = _clip(planes, p0, p1, y0, y1, y2, e0, e1, e2)
         if not t0 < t1:
             continue
-        best, g = np.inf, -1   # the reference face: least depth over the part inside
+        best, g, full = np.inf, -1, np.inf   # the reference face: least depth over the part inside
         for k in range(p0, p1):
+            full = min(full, max(planes[k, 3] - (planes[k, 0] * y0 + planes[k, 1] * y1 + planes[k, 2] * y2),
+                                 planes[k, 3] - (planes[k, 0] * z0 + planes[k, 1] * z1 + planes[k, 2] * z2)))
             da = planes[k, 3] - (planes[k, 0] * (y0 + t0 * e0) + planes[k, 1] * (y1 + t0 * e1)
                                  + planes[k, 2] * (y2 + t0 * e2))
             db = planes[k, 3] - (planes[k, 0] * (y0 + t1 * e0) + planes[k, 1] * (y1 + t1 * e1)
@@ -120,7 +131,7 @@ def ridge_points(sc, x, Px, Pm, t, S, s):
                 best, g = max(da, db), k
         n0, n1, n2 = dir_ground(Px, planes[g, 0], planes[g, 1], planes[g, 2])
         D, X0, X1, X2, L0, L1, L2 = _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2)
-        if D < best and -(L0 * n0 + L1 * n1 + L2 * n2) <= FACE_COS:
+        if D < full and -(L0 * n0 + L1 * n1 + L2 * n2) <= FACE_COS:
             _row(S, s, D, X0, X1, X2, -L0, -L1, -L2)   # an edge of x across the ridge: the common normal L
             s += 1
             continue
