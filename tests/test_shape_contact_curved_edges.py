@@ -197,13 +197,16 @@ def test_cylinder_standing_across_a_ridge_is_a_line_load_on_the_chord(c):
 
 
 def test_cylinder_standing_across_a_ridge_through_its_axis_stays_upright():
-    """The ridge through the axis carries the weight at the chord's two ends, m g / 2 = k d^e each: the cylinder
-    rests upright at the IMPACT penetration, no moment turning it."""
-    r, hl, mass = 0.03, 0.05, 0.5
+    """The ridge through the axis carries the weight at the chord's two ends, m g / 2 = k d^e each: the cylinder,
+    let down from half that depth, settles upright at the IMPACT penetration, no moment turning it (the choice
+    of the chord by the line's geometry, not by the deepest point along the level chord, keeps the force smooth:
+    7 steps to 0.01 s, where the deepest point's end-or-side switch took 85 000)."""
+    r, hl, mass = 0.03, 0.05, 1.0
     d = (mass * G / 2 / K) ** (1 / E)
     z0 = H + hl - d
     m = mb.Model(gravity=(0, 0, -G))
-    b = m.add_body("b", mass, (4e-4, 4e-4, 2e-4), position=(0.0, 0.0, z0))
+    Ix = mass * (3 * r * r + 4 * hl * hl) / 12   # a solid cylinder's
+    b = m.add_body("b", mass, (Ix, Ix, mass * r * r / 2), position=(0.0, 0.0, z0 + d / 2))   # settles from d / 2
     fl = m.ground.add_shape("floor", mb.Mesh(*tent()))
     m.add_contact("c", fl, b.add_shape("geo", mb.Cylinder(r, 2 * hl, axis="z")), K, E, 300.0, 1e-5, mu=0.5,
                   friction_velocity=1e-3)

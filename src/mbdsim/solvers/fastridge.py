@@ -34,7 +34,7 @@ signed distance from the solid (fastgjk.segment_penetration; a capsule by the ne
 the ridge, where that is not an end of the core, whose end sphere has it already), a cylinder lying along a
 ridge (within LINE_SIN of its axis) a point at each end of the part of the ridge beside its side, each as
 deep as the radius less its distance from the axis, a ridge within LINE_SIN of parallel to a cylinder's flat
-end whose deepest point is on that end a line contact along the chord over the end disc (`_end_chord`: a
+end, the middle of its chord nearer the end's plane than the side, a line contact along the chord over the end disc (`_end_chord`: a
 point at each end of the chord, so that equal depths act at the chord's middle, as a uniform line load); per
 owned peak its depth in the solid.  A ridge point counts
 only when its normal lies in the ridge's normal cone (between its two faces' normals, sc[35] naming the
@@ -231,13 +231,12 @@ def curved_ridge_points(sc, x, Px, Pm, t, S, s):
                                                                        Px[0] + zq * u0, Px[1] + zq * u1,
                                                                        Px[2] + zq * u2))
                         continue
-        depth, n0, n1, n2, _q0, _q1, _q2, tt = segment_penetration(kd, Px, p, g0, g1, g2, e0, e1, e2, 0.0)
-        if kd == CYLINDER and depth > 0.0:
-            un = n0 * Px[5] + n1 * Px[8] + n2 * Px[11]
-            fu = (e0 - g0) * Px[5] + (e1 - g1) * Px[8] + (e2 - g2) * Px[11]
-            if abs(un) > 0.999 and fu * fu <= LINE_SIN * LINE_SIN * ((e0 - g0) ** 2 + (e1 - g1) ** 2 + (e2 - g2) ** 2):
-                s = _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, 1.0 if un > 0.0 else -1.0, S, s)
+        if kd == CYLINDER:
+            s1 = _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, S, s)
+            if s1 >= 0:
+                s = s1
                 continue
+        depth, n0, n1, n2, _q0, _q1, _q2, tt = segment_penetration(kd, Px, p, g0, g1, g2, e0, e1, e2, 0.0)
         if depth > 0.0 and 0.0 < tt < 1.0:
             _row(S, s, depth, g0 + tt * (e0 - g0), g1 + tt * (e1 - g1), g2 + tt * (e2 - g2), n0, n1, n2)
             s = _in_cone(sc, Pm, t, j, S, s, s + 1)
@@ -245,20 +244,27 @@ def curved_ridge_points(sc, x, Px, Pm, t, S, s):
 
 
 @kernel(_nrt=False)
-def _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, sg, S, s):
-    """The ridge g-e (ground; corner j of triangle t, mesh pose Pm) across the flat end sg (+1: local z = h,
-    -1: z = -h) of the cylinder (pose Px, p = r, h), within LINE_SIN of parallel to it: a line contact along
-    the chord, the ridge's part over the end disc, a point at each end of the chord that is not a peak (peaks
-    push on their own), each as deep as it lies inside the end's plane, the end's normal; equal depths put the
-    resultant at the chord's middle, as a uniform line load does.  Rows from s while S has room; returns the
-    next row."""
+def _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, S, s):
+    """The ridge g-e (ground; corner j of triangle t, mesh pose Pm) across a flat end of the cylinder (pose Px,
+    p = r, h), within LINE_SIN of parallel to it, its line's point nearest the axis (the chord's middle) nearer
+    that end's plane than the side: a line contact along the chord, the ridge's part over the end disc, a point
+    at each end of the chord that is not a peak (peaks push on their own), each as deep as it lies inside the
+    end's plane, the end's normal; equal depths put the resultant at the chord's middle, as a uniform line
+    load does.  Rows from s while S has room; returns the next row, or -1 when the ridge is no such chord
+    (decided by the geometry of the line, not by the deepest point, which is anywhere along a level chord)."""
     a0, a1, a2 = to_local(Px, g0, g1, g2)
     b0, b1, b2 = to_local(Px, e0, e1, e2)
     f0, f1, f2 = b0 - a0, b1 - a1, b2 - a2
     A_, B_, C_ = f0 * f0 + f1 * f1, a0 * f0 + a1 * f1, a0 * a0 + a1 * a1 - p[0] * p[0]
+    if not (A_ > 0.0 and f2 * f2 <= LINE_SIN * LINE_SIN * (A_ + f2 * f2)):
+        return -1
+    tm = -B_ / A_   # the chord's middle: off the axis by cm, at height zm
+    zm = a2 + tm * f2
+    cm = np.sqrt(max(C_ + p[0] * p[0] - B_ * B_ / A_, 0.0))
+    if not (cm < p[0] and abs(zm) < p[1] and p[1] - abs(zm) < p[0] - cm):
+        return -1
+    sg = 1.0 if zm > 0.0 else -1.0
     disc = B_ * B_ - A_ * C_
-    if not (A_ > 0.0 and disc > 0.0):
-        return s
     lo, hi = max((-B_ - np.sqrt(disc)) / A_, 0.0), min((-B_ + np.sqrt(disc)) / A_, 1.0)
     if not lo < hi:
         return s
