@@ -34,9 +34,9 @@ signed distance from the solid (fastgjk.segment_penetration; a capsule by the ne
 the ridge, where that is not an end of the core, whose end sphere has it already), a cylinder lying along a
 ridge (within LINE_SIN of its axis) a point at each end of the part of the ridge beside its side, each as
 deep as the radius less its distance from the axis, a ridge within LINE_SIN of parallel to a cylinder's flat
-end, the middle of its chord nearer the end's plane than the side, a line contact along the chord over the end disc (`_end_chord`: a
-point at each end of the chord, so that equal depths act at the chord's middle, as a uniform line load); per
-owned peak its depth in the solid.  A ridge point counts
+end, the middle of its chord nearer the end's plane than the side, a line contact along the chord over the
+end disc (`_end_chord`: a point at each end of the chord, so that equal depths act at the chord's middle, as
+a uniform line load); per owned peak its depth in the solid.  A ridge point counts
 only when its normal lies in the ridge's normal cone (between its two faces' normals, sc[35] naming the
 neighbour across each edge): a cylinder resting on one face beside the ridge pushes on that face alone.
 """
