@@ -46,10 +46,10 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastedges import FACE_COS, _extreme
+from .fastedges import FACE_COS
 from .fastgjk import _signed_distance, segment_penetration
-from .fastnarrow import (CAPSULE, CYLINDER, LINE_SIN, dir_ground, dir_local, segment_closest, segments_closest, to_ground,
-                         to_local)
+from .fastnarrow import (CAPSULE, CYLINDER, LINE_SIN, dir_ground, dir_local, segment_closest, segments_closest,
+                         support_depth, to_ground, to_local)
 
 
 @kernel(_nrt=False)
@@ -360,7 +360,7 @@ def _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2):
             l0, l1, l2 = -l0, -l1, -l2
             if not in_cone(sc, Pm, t, j, l0, l1, l2):
                 continue
-        lo = -_extreme(Px, verts, sv[x, 0], sv[x, 1], l0, l1, l2, -1.0)
+        lo = -support_depth(sc[1][x], Px, sc[4][x], verts, sv[x, 0], sv[x, 1] - sv[x, 0], 0.0, 0.0, 0.0, l0, l1, l2)
         if l0 * a0 + l1 * a1 + l2 * a2 > lo + tol or l0 * b0 + l1 * b1 + l2 * b2 > lo + tol:
             continue   # not x's supporting edge along -L
         D = l0 * y0 + l1 * y1 + l2 * y2 - lo
