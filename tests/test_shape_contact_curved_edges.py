@@ -174,3 +174,48 @@ def test_cylinder_and_capsule_rest_across_two_ridges_by_the_lever_rule(geo, c):
     assert np.allclose(last.x, (-0.03, 0.03), atol=1e-4)
     assert np.allclose(last.normal_force, F, rtol=2e-3), (last.normal_force, F)
     assert abs(last.normal_force.sum() - mass * G) < 1e-3 * mass * G
+
+
+@pytest.mark.parametrize("c", [0.0, 0.012])
+def test_cylinder_standing_across_a_ridge_is_a_line_load_on_the_chord(c):
+    """A cylinder (r = 0.03) standing on its end across the tent's ridge (along x), its axis c off the ridge: the
+    ridge touches the end disc along the chord |x| <= sqrt(r^2 - c^2), D deep all along, a uniform line load whose
+    resultant (k D^e at each end of the chord) acts at the chord's middle: the moment about the centre is that of
+    the line-load integral, int (s, -c, -z) x (0, 0, q) ds = (-c F, 0, 0), zero through the axis."""
+    r, hl = 0.03, 0.05
+    zc = H + hl - D
+    p = _points(mb.Mesh(*tent()), mb.Cylinder(r, 2 * hl, axis="z"), (0.0, c, zc))
+    assert len(p) == 2, p
+    half = np.sqrt(r * r - c * c)
+    assert np.allclose(p.x, (-half, half), atol=1e-9) and np.allclose(p.y, 0.0, atol=1e-9)
+    assert np.allclose(p.penetration, D, rtol=1e-9)
+    assert np.allclose(p[["nx", "ny", "nz"]].to_numpy(), (0, 0, 1), atol=1e-12)
+    Fz = p.normal_force.to_numpy()
+    arm = p[["x", "y", "z"]].to_numpy() - (0.0, c, zc)
+    moment = np.cross(arm, np.column_stack([0 * Fz, 0 * Fz, Fz])).sum(axis=0)
+    assert np.allclose(moment, (-c * 2 * K * D ** E, 0.0, 0.0), rtol=1e-9, atol=1e-12), moment
+
+
+def test_cylinder_standing_across_a_ridge_through_its_axis_stays_upright():
+    """The ridge through the axis carries the weight at the chord's two ends, m g / 2 = k d^e each: the cylinder,
+    let down from half that depth, settles upright at the IMPACT penetration, no moment turning it (the choice
+    of the chord by the line's geometry, not by the deepest point along the level chord, keeps the force smooth:
+    7 steps to 0.01 s, where the deepest point's end-or-side switch took 85 000)."""
+    r, hl, mass = 0.03, 0.05, 1.0
+    d = (mass * G / 2 / K) ** (1 / E)
+    z0 = H + hl - d
+    m = mb.Model(gravity=(0, 0, -G))
+    Ix = mass * (3 * r * r + 4 * hl * hl) / 12   # a solid cylinder's
+    b = m.add_body("b", mass, (Ix, Ix, mass * r * r / 2), position=(0.0, 0.0, z0 + d / 2))   # settles from d / 2
+    fl = m.ground.add_shape("floor", mb.Mesh(*tent()))
+    m.add_contact("c", fl, b.add_shape("geo", mb.Cylinder(r, 2 * hl, axis="z")), K, E, 300.0, 1e-5, mu=0.5,
+                  friction_velocity=1e-3)
+    res = mb.simulate(m, 0.3, 0.01, method="dop853", rtol=1e-8)
+    assert res.success
+    assert abs(res.position("b")[-1, 2] - z0) < 1e-3 * d
+    assert np.max(np.abs(res.orientation("b")[-1] - np.eye(3))) < 1e-9
+    pts = res.contact_points("c")
+    last = pts[pts.time == pts.time.max()].sort_values("x")
+    assert len(last) == 2, last
+    assert np.allclose(last.x, (-r, r), atol=1e-6)
+    assert np.allclose(last.normal_force, mass * G / 2, rtol=1e-3)

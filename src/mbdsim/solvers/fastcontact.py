@@ -21,8 +21,8 @@ each end of the part of the edge beside its axis); a convex shape against a tria
 its bounding-volume hierarchy (solvers.fastmesh; with a box or hull also the mesh's ridges and peaks
 inside it, solvers.fastridge; a mesh no larger than a box or hull it meets puts its vertices on the
 polyhedron's faces instead); two triangle meshes by the vertices of each against the other's triangles
-(`_mesh_pair`, the two hierarchies walked together, solvers.fastmeshpair; a penalty approximation for
-finely tessellated meshes); two cylinders, or a
+and their sharp ridges crossing (solvers.fastmeshpair.mesh_pair, the two hierarchies walked together; a
+penalty approximation for finely tessellated meshes); two cylinders, or a
 capsule and a cylinder, with axes within LINE_SIN of parallel along their line (`_line_pair`: a point at
 each end of the overlap of the axes); the other convex pairs (cylinders and ellipsoids against
 curved shapes) in solvers.fastgjk: a sphere or capsule against a cylinder or an ellipsoid by the distance
@@ -30,13 +30,8 @@ of its point or segment from the solid (closed forms and a monotone Newton itera
 state), the others (cylinders and ellipsoids among themselves) by GJK and EPA over support functions, one
 point midway between the witness points.
 
-Law at each point (depth delta > 0 [m], normal n from shape_i towards shape_j, gap rate gd = n . v_rel):
-IMPACT  Fn = max(0, k delta^e - STEP(delta, 0, 0, d, c_max) gd), or with a coefficient of restitution eps
-(POISSON) Fn = k delta^e (1 - (1 - eps^2) STEP(gd, 0, 0, RESTITUTION_VELOCITY, 1)): the unloading branch
-returns eps^2 of the work of the loading one, so a mass leaves with eps times its approach speed.
-Friction -mu(s) Fn t / s (t: tangential slip velocity, s = |t|): mode 0 (mu, friction_velocity vs)
-mu(s) = mu s / sqrt(s^2 + vs^2); mode 1 (Adams) mu = STEP(s, -vs, -mu_s, vs, mu_s) below the stiction
-velocity vs, STEP(s, vs, mu_s, vt, mu_d) up to the transition velocity vt, mu_d above.
+The contact law at each point (IMPACT or POISSON normal force, Coulomb friction with Adams' stiction and
+transition velocities) and its record: solvers.fastlaw._apply (its names re-exported here).
 """
 from __future__ import annotations
 
@@ -44,88 +39,18 @@ import numpy as np
 from .._jit import kernel
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
-from ..system.exprloads_kernel import _cross, _force as _point_force
+from ..system.exprloads_kernel import _cross
 from .fastcross import edge_crossings
 from .fastedges import FACE_COS, hull_edges
 from .fastbroad import boxes, partner, sort_order, sweep_axis
 from .fastgjk import penetration, rounded_penetration
+from .fastlaw import (NREC, PAR_FIELDS, REC_FIELDS, RESTITUTION_VELOCITY, _apply,  # noqa: F401  (re-exported)
+                      friction_coefficient, normal_force)
 from .fastmesh import NSLOT, mesh_points
-from .fastmeshpair import mesh_mesh_points
+from .fastmeshpair import mesh_pair
 from .fastnarrow import (BOX, CAPSULE, CYLINDER, HULL, LINE_SIN, MESH, PLANE, SPHERE, candidate, deepest_on_face,
                          exit_depth, face, inside_except, n_candidates, pressed, segments_closest, support_depth,
                          to_ground)
-
-RESTITUTION_VELOCITY = 1e-4   # [m/s] width of the POISSON law's switch from loading to unloading
-NREC = 15
-REC_FIELDS = ("pair", "x", "y", "z", "nx", "ny", "nz", "penetration", "normal_force", "friction_x",
-              "friction_y", "friction_z", "slip_velocity", "gap_rate", "element")
-PAR_FIELDS = ("stiffness", "exponent", "damping", "penetration", "restitution", "friction_mode", "mu_static",
-              "mu_dynamic", "stiction_velocity", "transition_velocity", "element")
-
-
-@kernel(_nrt=False)
-def _step(x, x0, h0, x1, h1):
-    """Adams STEP: cubic from h0 at x0 to h1 at x1, constant outside."""
-    if x <= x0:
-        return h0
-    if x >= x1:
-        return h1
-    u = (x - x0) / (x1 - x0)
-    return h0 + (h1 - h0) * u * u * (3.0 - 2.0 * u)
-
-
-@kernel(_nrt=False)
-def friction_coefficient(s, mode, mu_s, mu_d, vs, vt):
-    """mu(s) of the slip speed s [m/s] >= 0 (module docstring)."""
-    if mode == 0:
-        return mu_s * s / np.sqrt(s * s + vs * vs)
-    if s <= vs:
-        return _step(s, -vs, -mu_s, vs, mu_s)
-    if s <= vt:
-        return _step(s, vs, mu_s, vt, mu_d)
-    return mu_d
-
-
-@kernel(_nrt=False)
-def normal_force(delta, gd, k, ex, cmax, dpen, eps):
-    """Normal force [N] >= 0 at depth delta > 0 [m] and gap rate gd [m/s] (module docstring)."""
-    if eps < 0.0:
-        u = min(delta / dpen, 1.0)
-        return max(k * delta ** ex - cmax * u * u * (3.0 - 2.0 * u) * gd, 0.0)
-    return k * delta ** ex * (1.0 - (1.0 - eps * eps) * _step(gd, 0.0, 0.0, RESTITUTION_VELOCITY, 1.0))
-
-
-@kernel(_nrt=False)
-def _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, delta):
-    """The contact law at the point p [m] (normal n from shape_i towards shape_j, depth delta [m]): the force
-    on shape_j's frame at p and its opposite on shape_i's."""
-    pr, pp, sh_f = sc[10], sc[11], sc[0]
-    fi, fj = sh_f[pr[pair, 0]], sh_f[pr[pair, 1]]
-    x0, x1, x2 = _cross(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
-    y0, y1, y2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
-    v0 = rd[fj, 0] + x0 - rd[fi, 0] - y0
-    v1 = rd[fj, 1] + x1 - rd[fi, 1] - y1
-    v2 = rd[fj, 2] + x2 - rd[fi, 2] - y2
-    gd = n0 * v0 + n1 * v1 + n2 * v2
-    Fn = normal_force(delta, gd, pp[pair, 0], pp[pair, 1], pp[pair, 2], pp[pair, 3], pp[pair, 4])
-    t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2
-    s = np.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
-    c = 0.0
-    if pp[pair, 6] > 0.0 or pp[pair, 7] > 0.0:
-        mode = int(pp[pair, 5])
-        if mode == 0:
-            c = pp[pair, 6] * Fn / np.sqrt(s * s + pp[pair, 8] * pp[pair, 8])
-        elif s > 0.0:
-            c = friction_coefficient(s, mode, pp[pair, 6], pp[pair, 7], pp[pair, 8], pp[pair, 9]) * Fn / s
-    G0, G1, G2 = Fn * n0 - c * t0, Fn * n1 - c * t1, Fn * n2 - c * t2
-    _point_force(F, A, fj, p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2], G0, G1, G2, rigid)
-    _point_force(F, A, fi, p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2], -G0, -G1, -G2, rigid)
-    k = nrec[0]
-    if k < rec.shape[0]:
-        vals = (float(pair), p0, p1, p2, n0, n1, n2, delta, Fn, -c * t0, -c * t1, -c * t2, s, gd, pp[pair, 10])
-        for j in range(NREC):
-            rec[k, j] = vals[j]
-        nrec[0] = k + 1
 
 
 @kernel(_nrt=False)
@@ -407,26 +332,6 @@ def _line_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
 
 
 @kernel(_nrt=False)
-def _mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
-    """Two triangle meshes (a penalty approximation for finely tessellated meshes): the vertices of each
-    below the other's triangles (fastmeshpair.mesh_mesh_points: the two hierarchies walked together, depth
-    capped at a skin), per vertex the direction of least depth (the nearest face of a closed mesh), each a
-    point of the contact law."""
-    S = sc[29]
-    for side in range(2):
-        x, msh, Px, Pm, sign = (b, a, Pb, Pa, 1.0) if side == 0 else (a, b, Pa, Pb, -1.0)
-        nrow = mesh_mesh_points(sc, x, msh, Px, Pm)
-        for k in range(nrow // NSLOT):
-            best, bd = -1, np.inf
-            for s in range(k * NSLOT, (k + 1) * NSLOT):
-                if S[s, 0] > 0.0 and S[s, 1] < bd:
-                    best, bd = s, S[s, 1]
-            if best >= 0:
-                _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, S[best, 2], S[best, 3], S[best, 4],
-                       sign * S[best, 5], sign * S[best, 6], sign * S[best, 7], S[best, 1])
-
-
-@kernel(_nrt=False)
 def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     """The narrow phase of one pair whose bounding boxes overlap (module docstring)."""
     kind, rad, pr, PS = sc[1], sc[5], sc[10], sc[17]
@@ -444,7 +349,7 @@ def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
         _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
         return
     if ka == MESH and kb == MESH:
-        _mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
+        mesh_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec)
         return
     if ka == MESH or kb == MESH:
         msh, x, Px, Pm, sign = (a, b, Pb, Pa, 1.0) if ka == MESH else (b, a, Pa, Pb, -1.0)

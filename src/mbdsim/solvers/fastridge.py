@@ -16,7 +16,13 @@ each owned by one of its triangles, so that the hierarchy walk meets each once:
 * a ridge: its part inside the polyhedron, [t0, t1] along it (Cyrus-Beck clipping on the face planes); the
   face of least depth over that part is the reference (normal n outward); a point at each end of the part
   that is not a peak (peaks push on their own), depth the end's distance below that face: a ridge across a
-  face is a line contact, one point at each end of the line (as a cylinder on a face);
+  face is a line contact, one point at each end of the line (as a cylinder on a face); unless an edge of the
+  polyhedron crosses the ridge inside it (`_edge_across`: `crossing`, the closest points inside both edges,
+  their common normal L in the ridge's normal cone, the edge the polyhedron's lowest feature along -L) less
+  deep along L than the whole ridge lies below any face plane (the separating-axis depth of the ridge as a
+  segment; the part inside alone would make a steep wedge's slope the reference) and L not within FACE_COS of
+  the reference face's normal (a box lying on the ridge keeps its face): then one point midway between the
+  two edges, normal L (a wedge's or a box's edge resting crosswise on a roof's ridge);
 * a peak: its depth below the nearest face plane, that face's normal.
 
 Rows of the slot buffer S (solvers.fastmesh layout: used, depth [m], point [m], normal, weight), the point
@@ -27,7 +33,10 @@ the triangles' planes miss a ridge under their curved side): per owned ridge the
 signed distance from the solid (fastgjk.segment_penetration; a capsule by the nearest points of its core and
 the ridge, where that is not an end of the core, whose end sphere has it already), a cylinder lying along a
 ridge (within LINE_SIN of its axis) a point at each end of the part of the ridge beside its side, each as
-deep as the radius less its distance from the axis; per owned peak its depth in the solid.  A ridge point counts
+deep as the radius less its distance from the axis, a ridge within LINE_SIN of parallel to a cylinder's flat
+end, the middle of its chord nearer the end's plane than the side, a line contact along the chord over the
+end disc (`_end_chord`: a point at each end of the chord, so that equal depths act at the chord's middle, as
+a uniform line load); per owned peak its depth in the solid.  A ridge point counts
 only when its normal lies in the ridge's normal cone (between its two faces' normals, sc[35] naming the
 neighbour across each edge): a cylinder resting on one face beside the ridge pushes on that face alone.
 """
@@ -37,9 +46,10 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
+from .fastedges import FACE_COS
 from .fastgjk import _signed_distance, segment_penetration
-from .fastnarrow import (CAPSULE, CYLINDER, LINE_SIN, dir_ground, dir_local, segment_closest, segments_closest, to_ground,
-                         to_local)
+from .fastnarrow import (CAPSULE, CYLINDER, LINE_SIN, dir_ground, dir_local, segment_closest, segments_closest,
+                         support_depth, to_ground, to_local)
 
 
 @kernel(_nrt=False)
@@ -109,8 +119,10 @@ def ridge_points(sc, x, Px, Pm, t, S, s):
         t0, t1 = _clip(planes, p0, p1, y0, y1, y2, e0, e1, e2)
         if not t0 < t1:
             continue
-        best, g = np.inf, -1   # the reference face: least depth over the part inside
+        best, g, full = np.inf, -1, np.inf   # the reference face: least depth over the part inside
         for k in range(p0, p1):
+            full = min(full, max(planes[k, 3] - (planes[k, 0] * y0 + planes[k, 1] * y1 + planes[k, 2] * y2),
+                                 planes[k, 3] - (planes[k, 0] * z0 + planes[k, 1] * z1 + planes[k, 2] * z2)))
             da = planes[k, 3] - (planes[k, 0] * (y0 + t0 * e0) + planes[k, 1] * (y1 + t0 * e1)
                                  + planes[k, 2] * (y2 + t0 * e2))
             db = planes[k, 3] - (planes[k, 0] * (y0 + t1 * e0) + planes[k, 1] * (y1 + t1 * e1)
@@ -118,6 +130,11 @@ def ridge_points(sc, x, Px, Pm, t, S, s):
             if max(da, db) < best:
                 best, g = max(da, db), k
         n0, n1, n2 = dir_ground(Px, planes[g, 0], planes[g, 1], planes[g, 2])
+        D, X0, X1, X2, L0, L1, L2 = _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2)
+        if D < full and -(L0 * n0 + L1 * n1 + L2 * n2) <= FACE_COS:
+            _row(S, s, D, X0, X1, X2, -L0, -L1, -L2)   # an edge of x across the ridge: the common normal L
+            s += 1
+            continue
         for end in range(2):
             tt = t0 if end == 0 else t1
             if (end == 0 and tt == 0.0 and mask & (64 << j)) or \
@@ -214,6 +231,11 @@ def curved_ridge_points(sc, x, Px, Pm, t, S, s):
                                                                        Px[0] + zq * u0, Px[1] + zq * u1,
                                                                        Px[2] + zq * u2))
                         continue
+        if kd == CYLINDER:
+            s1 = _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, S, s)
+            if s1 >= 0:
+                s = s1
+                continue
         depth, n0, n1, n2, _q0, _q1, _q2, tt = segment_penetration(kd, Px, p, g0, g1, g2, e0, e1, e2, 0.0)
         if depth > 0.0 and 0.0 < tt < 1.0:
             _row(S, s, depth, g0 + tt * (e0 - g0), g1 + tt * (e1 - g1), g2 + tt * (e2 - g2), n0, n1, n2)
@@ -222,24 +244,58 @@ def curved_ridge_points(sc, x, Px, Pm, t, S, s):
 
 
 @kernel(_nrt=False)
-def _in_cone(sc, Pm, t, j, S, s, s1):
-    """s1 when the row s just written (s1 = s + 1; s1 = s: none) has its normal (from the mesh into the shape)
-    in the normal cone of the ridge from corner j of triangle t (between the two faces' normals: n . t_i >= 0
-    for each face i, t_i in that face, across the edge, away from the face; a curved shape resting on one face
-    beside the ridge then pushes on that face alone, through its candidate points), else s."""
-    if s1 == s:
+def _end_chord(sc, Px, p, Pm, t, j, mask, g0, g1, g2, e0, e1, e2, S, s):
+    """The ridge g-e (ground; corner j of triangle t, mesh pose Pm) across a flat end of the cylinder (pose Px,
+    p = r, h), within LINE_SIN of parallel to it, its line's point nearest the axis (the chord's middle) nearer
+    that end's plane than the side: a line contact along the chord, the ridge's part over the end disc, a point
+    at each end of the chord that is not a peak (peaks push on their own), each as deep as it lies inside the
+    end's plane, the end's normal; equal depths put the resultant at the chord's middle, as a uniform line
+    load does.  Rows from s while S has room; returns the next row, or -1 when the ridge is no such chord
+    (decided by the geometry of the line, not by the deepest point, which is anywhere along a level chord)."""
+    a0, a1, a2 = to_local(Px, g0, g1, g2)
+    b0, b1, b2 = to_local(Px, e0, e1, e2)
+    f0, f1, f2 = b0 - a0, b1 - a1, b2 - a2
+    A_, B_, C_ = f0 * f0 + f1 * f1, a0 * f0 + a1 * f1, a0 * a0 + a1 * a1 - p[0] * p[0]
+    if not (A_ > 0.0 and f2 * f2 <= LINE_SIN * LINE_SIN * (A_ + f2 * f2)):
+        return -1
+    tm = -B_ / A_   # the chord's middle: off the axis by cm, at height zm
+    zm = a2 + tm * f2
+    cm = np.sqrt(max(C_ + p[0] * p[0] - B_ * B_ / A_, 0.0))
+    if not (cm < p[0] and abs(zm) < p[1] and p[1] - abs(zm) < p[0] - cm):
+        return -1
+    sg = 1.0 if zm > 0.0 else -1.0
+    disc = B_ * B_ - A_ * C_
+    lo, hi = max((-B_ - np.sqrt(disc)) / A_, 0.0), min((-B_ + np.sqrt(disc)) / A_, 1.0)
+    if not lo < hi:
         return s
+    u0, u1, u2 = sg * Px[5], sg * Px[8], sg * Px[11]   # the end's outward normal
+    for end in range(2):
+        tt = lo if end == 0 else hi
+        if (tt == 0.0 and mask & (64 << j)) or (tt == 1.0 and mask & (64 << ((j + 1) % 3))) or s >= S.shape[0]:
+            continue
+        dep = p[1] - sg * (a2 + tt * f2)
+        if dep > 0.0:
+            _row(S, s, dep, g0 + tt * (e0 - g0), g1 + tt * (e1 - g1), g2 + tt * (e2 - g2), u0, u1, u2)
+            s = _in_cone(sc, Pm, t, j, S, s, s + 1)
+    return s
+
+
+@kernel(_nrt=False)
+def in_cone(sc, Pm, t, j, m0, m1, m2):
+    """Whether the ground direction m (out of the mesh, pose Pm) lies in the normal cone of the ridge from corner j
+    of triangle t (between its two faces' normals: m . w_i >= 0 for each face i, w_i in that face, across the edge,
+    away from the face's far corner); an edge without a neighbour (a mesh's border) takes any direction."""
     verts, tri, nbr = sc[7], sc[22], sc[35]
     nb = nbr[t, j]
     if nb < 0:
-        return s1
+        return True
     ia, ib, ic = tri[t, j], tri[t, (j + 1) % 3], tri[t, (j + 2) % 3]
     io = tri[nb, 0]
     if io == ia or io == ib:
         io = tri[nb, 1]
         if io == ia or io == ib:
             io = tri[nb, 2]
-    m0, m1, m2 = dir_local(Pm, S[s, 5], S[s, 6], S[s, 7])   # in the mesh's axes, as its vertices
+    m0, m1, m2 = dir_local(Pm, m0, m1, m2)   # in the mesh's axes, as its vertices
     a0, a1, a2 = verts[ia, 0], verts[ia, 1], verts[ia, 2]
     e0, e1, e2 = verts[ib, 0] - a0, verts[ib, 1] - a1, verts[ib, 2] - a2
     ee = e0 * e0 + e1 * e1 + e2 * e2
@@ -249,5 +305,65 @@ def _in_cone(sc, Pm, t, j, S, s, s1):
         f = (c0 * e0 + c1 * e1 + c2 * e2) / ee
         w0, w1, w2 = f * e0 - c0, f * e1 - c1, f * e2 - c2   # away from the far corner, across the edge
         if m0 * w0 + m1 * w1 + m2 * w2 < -1e-9 * np.sqrt(w0 * w0 + w1 * w1 + w2 * w2):
-            return s
-    return s1
+            return False
+    return True
+
+
+@kernel(_nrt=False)
+def _in_cone(sc, Pm, t, j, S, s, s1):
+    """s1 when the row s just written (s1 = s + 1; s1 = s: none) has its normal (from the mesh into the shape)
+    in the normal cone of the ridge from corner j of triangle t (`in_cone`: a curved shape resting on one face
+    beside the ridge then pushes on that face alone, through its candidate points), else s."""
+    if s1 == s or in_cone(sc, Pm, t, j, S[s, 5], S[s, 6], S[s, 7]):
+        return s1
+    return s
+
+
+@kernel(_nrt=False)
+def crossing(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2):
+    """Two segments a-b and c-e that cross: (ok, X on a-b, Y on c-e [m], L): X, Y the closest points of the two
+    lines, L the unit common normal (b - a) x (e - c) normalised; ok false when the segments are within 1e-6 of
+    parallel or X or Y is not inside its segment (strictly: an end is a vertex's contact, not an edge's)."""
+    d0, d1, d2 = b0 - a0, b1 - a1, b2 - a2
+    f0, f1, f2 = e0 - c0, e1 - c1, e2 - c2
+    L0, L1, L2 = d1 * f2 - d2 * f1, d2 * f0 - d0 * f2, d0 * f1 - d1 * f0
+    A_, E_ = d0 * d0 + d1 * d1 + d2 * d2, f0 * f0 + f1 * f1 + f2 * f2
+    nrm = np.sqrt(L0 * L0 + L1 * L1 + L2 * L2)
+    if not nrm > 1e-6 * np.sqrt(A_ * E_):
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    r0, r1, r2 = a0 - c0, a1 - c1, a2 - c2
+    B_, C_, F_ = d0 * f0 + d1 * f1 + d2 * f2, d0 * r0 + d1 * r1 + d2 * r2, f0 * r0 + f1 * r1 + f2 * r2
+    u = (B_ * F_ - C_ * E_) / (nrm * nrm)   # A E - B^2 = |d x f|^2
+    v = (B_ * u + F_) / E_
+    if not (0.0 < u < 1.0 and 0.0 < v < 1.0):
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    return True, a0 + u * d0, a1 + u * d1, a2 + u * d2, c0 + v * f0, c1 + v * f1, c2 + v * f2, L0 / nrm, \
+        L1 / nrm, L2 / nrm
+
+
+@kernel(_nrt=False)
+def _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2):
+    """An edge of the box or hull x (pose Px) crossing the ridge g-h (ground; corner j of triangle t, mesh pose
+    Pm) inside x: (D [m], X (the ridge's point) [m], L), the least depth D = L . X - min over x's vertices of
+    L . v along the edges' common normal L (out of the mesh, in the ridge's normal cone, and -L in x's: the edge
+    is x's lowest feature along L at both its ends); D = inf when no edge crosses."""
+    verts, sv, rad, eran, edges = sc[7], sc[6], sc[5], sc[31], sc[32]
+    tol = 1e-9 * rad[x]
+    best, X0, X1, X2, L0, L1, L2 = np.inf, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0
+    for k in range(eran[x, 0], eran[x, 1]):
+        a0, a1, a2 = to_ground(Px, verts[edges[k, 0], 0], verts[edges[k, 0], 1], verts[edges[k, 0], 2])
+        b0, b1, b2 = to_ground(Px, verts[edges[k, 1], 0], verts[edges[k, 1], 1], verts[edges[k, 1], 2])
+        ok, y0, y1, y2, _z0, _z1, _z2, l0, l1, l2 = crossing(g0, g1, g2, h0, h1, h2, a0, a1, a2, b0, b1, b2)
+        if not ok:
+            continue
+        if not in_cone(sc, Pm, t, j, l0, l1, l2):
+            l0, l1, l2 = -l0, -l1, -l2
+            if not in_cone(sc, Pm, t, j, l0, l1, l2):
+                continue
+        lo = -support_depth(sc[1][x], Px, sc[4][x], verts, sv[x, 0], sv[x, 1] - sv[x, 0], 0.0, 0.0, 0.0, l0, l1, l2)
+        if l0 * a0 + l1 * a1 + l2 * a2 > lo + tol or l0 * b0 + l1 * b1 + l2 * b2 > lo + tol:
+            continue   # not x's supporting edge along -L
+        D = l0 * y0 + l1 * y1 + l2 * y2 - lo
+        if D > 0.0 and D < best:
+            best, X0, X1, X2, L0, L1, L2 = D, y0, y1, y2, l0, l1, l2
+    return best, X0, X1, X2, L0, L1, L2
