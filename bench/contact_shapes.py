@@ -51,16 +51,36 @@ def mb_box_slide(method="dop853"):
     return sec, abs(_fit_acc(res.time, res.position("box") @ t) / ref - 1)
 
 
-def mb_cyl_roll(method="dop853"):
-    theta, r, rho = np.radians(15), 0.05, 1000.0
+def cyl_roll_model(theta=np.radians(15)):
+    """(model, downhill tangent) of a solid cylinder (r 0.05 m, 1000 kg/m^3) on a theta incline, resting
+    at its static penetration."""
+    r, rho = 0.05, 1000.0
     from test_shape_contact_plane import K, E, incline
     n, _, t = incline(theta)
     geo = mb.Cylinder(r, 0.1, axis="y")
-    mass, I = geo.mass_properties(rho)
+    mass, _ = geo.mass_properties(rho)
     m = mb.Model(gravity=(0, 0, -G))
     b = m.add_body("roller", 0.0, position=n * (r - (mass * G * np.cos(theta) / (2 * K)) ** (1 / E)))
     s = b.add_shape("geo", geo, density=rho)
     m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), n), s, K, E, 200.0, 1e-4, mu=0.5, friction_velocity=1e-4)
+    return m, t
+
+
+def pile_model(a=0.1):
+    """Eight boxes of side a [m] over the floor (pile_positions), all pairs in one contact."""
+    m = mb.Model(gravity=(0, 0, -G))
+    shapes = []
+    for i, (pos, rot) in enumerate(pile_positions()):
+        b = m.add_body(f"b{i}", 1.0, (a * a / 6,) * 3, position=pos, orientation=rot.as_matrix())
+        shapes.append(b.add_shape("geo", mb.Box((a, a, a))))
+    m.add_contact("c", [mb.Plane(m.ground, (0, 0, 0), (0, 0, 1))] + shapes, shapes, 1e5, 1.5, 50.0, 1e-3, mu=0.5,
+                  friction_velocity=1e-2)
+    return m
+
+
+def mb_cyl_roll(method="dop853"):
+    theta = np.radians(15)
+    m, t = cyl_roll_model(theta)
     sec, res = _best(lambda: mb.simulate(m, 0.5, 0.005, method=method, rtol=1e-6, monitor=False))
     ref = G * np.sin(theta) / 1.5
     return sec, abs(_fit_acc(res.time, res.position("roller") @ t) / ref - 1)
@@ -78,14 +98,7 @@ def pile_positions():
 
 
 def mb_pile(method="dop853"):
-    a = 0.1
-    m = mb.Model(gravity=(0, 0, -G))
-    shapes = []
-    for i, (pos, rot) in enumerate(pile_positions()):
-        b = m.add_body(f"b{i}", 1.0, (a * a / 6,) * 3, position=pos, orientation=rot.as_matrix())
-        shapes.append(b.add_shape("geo", mb.Box((a, a, a))))
-    m.add_contact("c", [mb.Plane(m.ground, (0, 0, 0), (0, 0, 1))] + shapes, shapes, 1e5, 1.5, 50.0, 1e-3, mu=0.5,
-                  friction_velocity=1e-2)
+    m = pile_model()
     sec, res = _best(lambda: mb.simulate(m, 1.5, 0.01, method=method, rtol=1e-5, monitor=False))
     ke = float(res.kinetic_energy()[-1])
     return sec, ke

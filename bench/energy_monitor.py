@@ -56,31 +56,15 @@ def planetary_damper():
 
 
 def _contact(name):
-    import contact_shapes as cs   # noqa: F401  (the scenes as the contact bench builds them)
-    from test_shape_contact_plane import K, E, box_on_incline, incline
+    import contact_shapes as cs   # the scenes as the contact bench builds them
+    from test_shape_contact_plane import box_on_incline
     if name == "box_slide":
         m, _ = box_on_incline(np.radians(30), "box", None, v0=0.5, mu=0.3, friction_velocity=1e-3)
         return m, dict(end_time=0.5, output_step=0.005, method="dop853", rtol=1e-6)
     if name == "cyl_roll":
-        theta, r, rho = np.radians(15), 0.05, 1000.0
-        n, _, t = incline(theta)
-        geo = mb.Cylinder(r, 0.1, axis="y")
-        mass, _ = geo.mass_properties(rho)
-        m = mb.Model(gravity=(0, 0, -G))
-        b = m.add_body("roller", 0.0, position=n * (r - (mass * G * np.cos(theta) / (2 * K)) ** (1 / E)))
-        s = b.add_shape("geo", geo, density=rho)
-        m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), n), s, K, E, 200.0, 1e-4, mu=0.5, friction_velocity=1e-4)
-        return m, dict(end_time=0.5, output_step=0.005, method="dop853", rtol=1e-6)
+        return cs.cyl_roll_model()[0], dict(end_time=0.5, output_step=0.005, method="dop853", rtol=1e-6)
     if name == "pile":
-        a = 0.1
-        m = mb.Model(gravity=(0, 0, -G))
-        shapes = []
-        for i, (pos, rot) in enumerate(cs.pile_positions()):
-            b = m.add_body(f"b{i}", 1.0, (a * a / 6,) * 3, position=pos, orientation=rot.as_matrix())
-            shapes.append(b.add_shape("geo", mb.Box((a, a, a))))
-        m.add_contact("c", [mb.Plane(m.ground, (0, 0, 0), (0, 0, 1))] + shapes, shapes, 1e5, 1.5, 50.0, 1e-3,
-                      mu=0.5, friction_velocity=1e-2)
-        return m, dict(end_time=1.5, output_step=0.01, method="dop853", rtol=1e-5)
+        return cs.pile_model(), dict(end_time=1.5, output_step=0.01, method="dop853", rtol=1e-5)
     if name == "cam":
         from test_shape_contact_cam import cam_model, lift_off_speed
         w = 0.7 * lift_off_speed()

@@ -11,13 +11,9 @@ from scipy.integrate import solve_ivp
 from scipy.spatial.transform import Rotation
 
 import mbdsim as mb
+from test_core_four_bar import A_, B_, C_, D_, G, IZZ, MASS, TH1_0, closure  # noqa: F401  (the same four-bar)
 
 pytestmark = pytest.mark.filterwarnings("ignore::mbdsim.RedundantConstraintWarning")   # (3D revolutes: redundant)
-G = 9.81
-A_, B_, C_, D_ = 0.1, 0.3, 0.25, 0.3          # crank, coupler, rocker, ground link [m] (Grashof crank-rocker)
-MASS = np.array([0.5, 1.2, 0.9])
-IZZ = MASS * np.array([A_, B_, C_]) ** 2 / 12
-TH1_0 = np.radians(60.0)
 
 
 def e(th):
@@ -26,16 +22,6 @@ def e(th):
 
 def perp(th):
     return np.array([-np.sin(th), np.cos(th)])
-
-
-def closure(th1):
-    """Coupler and rocker angles for crank angle th1 (the y > 0 branch); the rocker angle is that of B - C."""
-    A, C = A_ * e(th1), np.array([D_, 0.0])
-    d = np.linalg.norm(C - A)
-    x = (B_**2 - C_**2 + d**2) / (2 * d)
-    u = (C - A) / d
-    B = A + x * u + np.sqrt(B_**2 - x**2) * np.array([-u[1], u[0]])
-    return np.arctan2(*(B - A)[::-1]), np.arctan2(*(B - C)[::-1])
 
 
 def four_bar(springs, torque=0.0):
