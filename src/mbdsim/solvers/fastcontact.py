@@ -285,13 +285,6 @@ def _round_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
 
 
 @kernel(_nrt=False)
-def _row(PS, s):
-    """Shape s's pose (the 12-tuple of fastnarrow.pose) from its row of sc[17]."""
-    return (PS[s, 0], PS[s, 1], PS[s, 2], PS[s, 3], PS[s, 4], PS[s, 5], PS[s, 6], PS[s, 7], PS[s, 8], PS[s, 9],
-            PS[s, 10], PS[s, 11])
-
-
-@kernel(_nrt=False)
 def _line_pair(sc, pair, a, b, Pa, Pb, r, A, rd, w, rigid, F, rec, nrec):
     """Two cylinders, or a capsule and a cylinder, whose axes are within LINE_SIN of parallel and whose
     projections overlap: a line contact, one point at each end of the overlap of the two axes (clipped on
@@ -336,7 +329,7 @@ def _narrow(sc, pair, r, A, rd, w, rigid, F, rec, nrec):
     """The narrow phase of one pair whose bounding boxes overlap (module docstring)."""
     kind, rad, pr, PS = sc[1], sc[5], sc[10], sc[17]
     a, b = pr[pair, 0], pr[pair, 1]
-    Pa, Pb = _row(PS, a), _row(PS, b)
+    Pa, Pb = PS[a], PS[b]   # views of the poses' rows (a 12-tuple passed down is many times slower here)
     ka, kb = kind[a], kind[b]
     if ka == PLANE or kb == PLANE:
         pl, x, P, Q, sign = (a, b, Pb, Pa, 1.0) if ka == PLANE else (b, a, Pa, Pb, -1.0)

@@ -62,16 +62,21 @@ def normal_force(delta, gd, k, ex, cmax, dpen, eps):
 
 
 @kernel(_nrt=False)
+def relative_velocity(r, rd, w, fi, fj, p0, p1, p2):
+    """Velocity [m/s] (ground) of frame fj's material point at the ground point p relative to frame fi's (r
+    [m], rd [m/s], w [rad/s]: the frames' origins, their velocities and angular velocities, ground axes)."""
+    x0, x1, x2 = _cross(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
+    y0, y1, y2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
+    return rd[fj, 0] + x0 - rd[fi, 0] - y0, rd[fj, 1] + x1 - rd[fi, 1] - y1, rd[fj, 2] + x2 - rd[fi, 2] - y2
+
+
+@kernel(_nrt=False)
 def _apply(sc, pair, r, A, rd, w, rigid, F, rec, nrec, p0, p1, p2, n0, n1, n2, delta):
     """The contact law at the point p [m] (normal n from shape_i towards shape_j, depth delta [m]): the force
     on shape_j's frame at p and its opposite on shape_i's."""
     pr, pp, sh_f = sc[10], sc[11], sc[0]
     fi, fj = sh_f[pr[pair, 0]], sh_f[pr[pair, 1]]
-    x0, x1, x2 = _cross(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
-    y0, y1, y2 = _cross(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
-    v0 = rd[fj, 0] + x0 - rd[fi, 0] - y0
-    v1 = rd[fj, 1] + x1 - rd[fi, 1] - y1
-    v2 = rd[fj, 2] + x2 - rd[fi, 2] - y2
+    v0, v1, v2 = relative_velocity(r, rd, w, fi, fj, p0, p1, p2)
     gd = n0 * v0 + n1 * v1 + n2 * v2
     Fn = normal_force(delta, gd, pp[pair, 0], pp[pair, 1], pp[pair, 2], pp[pair, 3], pp[pair, 4])
     t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2

@@ -15,6 +15,7 @@ from numba import njit
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import entry, kernel  # noqa: F401  (njit without the wrappers that dominate compilation; issue 32)
 from ..system.exprloads_kernel import _cross as _cross_into, _force as _point_force, _rot
+from .fastlaw import normal_force, relative_velocity
 
 
 @kernel(_nrt=False)
@@ -63,15 +64,10 @@ def contacts_kernel(ct_f, ct_kind, ct_s, ct_n, ct_par, r, A, rd, w, rigid, F, pw
             p0, p1, p2 = c0 - h * m0, c1 - h * m1, c2 - h * m2
             n0, n1, n2 = sign * m0, sign * m1, sign * m2
         # relative velocity of the material points at cp (body_j minus body_i)
-        x0, x1, x2 = _cross_into(w[fj, 0], w[fj, 1], w[fj, 2], p0 - r[fj, 0], p1 - r[fj, 1], p2 - r[fj, 2])
-        y0, y1, y2 = _cross_into(w[fi, 0], w[fi, 1], w[fi, 2], p0 - r[fi, 0], p1 - r[fi, 1], p2 - r[fi, 2])
-        v0 = rd[fj, 0] + x0 - rd[fi, 0] - y0
-        v1 = rd[fj, 1] + x1 - rd[fi, 1] - y1
-        v2 = rd[fj, 2] + x2 - rd[fi, 2] - y2
+        v0, v1, v2 = relative_velocity(r, rd, w, fi, fj, p0, p1, p2)
         gd = n0 * v0 + n1 * v1 + n2 * v2
         delta = -g
-        u = min(delta / dpen, 1.0)
-        Fn = max(k * delta ** ex - cmax * u * u * (3.0 - 2.0 * u) * gd, 0.0)
+        Fn = normal_force(delta, gd, k, ex, cmax, dpen, -1.0)   # IMPACT
         t0, t1, t2 = v0 - gd * n0, v1 - gd * n1, v2 - gd * n2
         mf = mu * Fn / np.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + vs * vs) if mu > 0.0 else 0.0
         G0, G1, G2 = Fn * n0 - mf * t0, Fn * n1 - mf * t1, Fn * n2 - mf * t2

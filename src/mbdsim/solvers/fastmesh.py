@@ -4,7 +4,7 @@ A mesh shape (geometry.pack) has its triangles (sc[22]: vertex rows of sc[7], in
 bounding-volume hierarchy) and that hierarchy (sc[27]: each node's box in the mesh's local axes [m];
 sc[28]: left and right child, or -1 and the node's first triangle and count), both built at pack time
 (geometry.bvh).  `mesh_points` walks the hierarchy with the convex shape's bounding box (in the mesh's
-axes; an explicit stack, sc[30]) and, per triangle met (its outward normal m by the right-hand rule):
+axes) and its bounding sphere (a node's box must meet both; an explicit stack, sc[30]) and, per triangle met (its outward normal m by the right-hand rule):
 
 * a sphere, and each end sphere of a capsule: the closest point of the triangle (face, edge or vertex),
   touching when nearer than the radius, with the normal from that point to the centre;
@@ -33,7 +33,8 @@ import numpy as np
 
 from .. import _jitcache  # noqa: F401  (numba's cache directory, before any kernel is defined)
 from .._jit import kernel
-from .fastnarrow import BOX, CAPSULE, CYLINDER, ELLIPSOID, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground
+from .fastnarrow import (BOX, CAPSULE, CYLINDER, ELLIPSOID, HULL, SPHERE, candidate, dir_local, n_candidates, to_ground,
+                         to_local)
 from .fastridge import curved_ridge_points, ridge_points
 
 NSLOT = 4          # contact directions kept per candidate point
@@ -217,6 +218,15 @@ def slot_means(S, nrow):
 
 
 @kernel(_nrt=False)
+def box_distance2(nodes, nd, c0, c1, c2):
+    """Squared distance [m^2] from the point c to node nd's box (zero inside it); nodes' rows as sc[27]."""
+    d0 = max(nodes[nd, 0] - c0, 0.0, c0 - nodes[nd, 3])
+    d1 = max(nodes[nd, 1] - c1, 0.0, c1 - nodes[nd, 4])
+    d2 = max(nodes[nd, 2] - c2, 0.0, c2 - nodes[nd, 5])
+    return d0 * d0 + d1 * d1 + d2 * d2
+
+
+@kernel(_nrt=False)
 def mesh_points(sc, x, msh, Px, Pm):
     """Points of convex shape x (pose Px) on mesh msh (pose Pm) into the slot rows of sc[29] (module
     docstring), and after them, for a box or hull, the mesh's ridges and peaks inside it (solvers.fastridge);
@@ -238,6 +248,10 @@ def mesh_points(sc, x, msh, Px, Pm):
     e0 = abs(Pm[3]) * h0 + abs(Pm[6]) * h1 + abs(Pm[9]) * h2
     e1 = abs(Pm[4]) * h0 + abs(Pm[7]) * h1 + abs(Pm[10]) * h2
     e2 = abs(Pm[5]) * h0 + abs(Pm[8]) * h1 + abs(Pm[11]) * h2
+    # and its bounding sphere (about its frame's origin, radius sc[5]) in the mesh's axes: a node's box must
+    # meet both (the sphere prunes the box's corners: most of the triangles under a ball)
+    c0, c1, c2 = to_local(Pm, Px[0], Px[1], Px[2])
+    rr = sc[5][x] * sc[5][x]
     if meta[msh, 3] <= meta[msh, 2]:
         return 0
     stack[0] = meta[msh, 2]
@@ -247,6 +261,8 @@ def mesh_points(sc, x, msh, Px, Pm):
         nd = stack[top]
         if l0 + e0 < nodes[nd, 0] or l0 - e0 > nodes[nd, 3] or l1 + e1 < nodes[nd, 1] or \
                 l1 - e1 > nodes[nd, 4] or l2 + e2 < nodes[nd, 2] or l2 - e2 > nodes[nd, 5]:
+            continue
+        if box_distance2(nodes, nd, c0, c1, c2) > rr:
             continue
         if links[nd, 0] < 0:
             for t in range(links[nd, 2], links[nd, 2] + links[nd, 3]):

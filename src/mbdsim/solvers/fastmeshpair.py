@@ -31,7 +31,7 @@ from .._jit import kernel
 from .fastlaw import _apply
 from .fastmesh import NSLOT, clear_slots, point_below, slot_means, triangle
 from .fastnarrow import to_ground, to_local
-from .fastridge import crossing, in_cone
+from .fastridge import cone_crossing, in_cone
 
 SKIN = 0.5        # a mesh's vertex counts below another mesh's triangle to SKIN x the smaller bounding radius
 SHARP_COS = 0.94  # a ridge whose faces' normals are closer than this (cosine; about 20 degrees) has no edge contact
@@ -114,13 +114,10 @@ def _ridge_crossings(sc, x, Px, Pm, t, u, cap, S, s):
             c0, c1, c2 = to_ground(Px, verts[tri[u, i], 0], verts[tri[u, i], 1], verts[tri[u, i], 2])
             v = tri[u, (i + 1) % 3]
             e0, e1, e2 = to_ground(Px, verts[v, 0], verts[v, 1], verts[v, 2])
-            ok, X0, X1, X2, Y0, Y1, Y2, L0, L1, L2 = crossing(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2)
+            ok, X0, X1, X2, Y0, Y1, Y2, L0, L1, L2 = cone_crossing(sc, Pm, t, j, a0, a1, a2, b0, b1, b2, c0, c1, c2,
+                                                                   e0, e1, e2)
             if not ok:
                 continue
-            if not in_cone(sc, Pm, t, j, L0, L1, L2):
-                L0, L1, L2 = -L0, -L1, -L2
-                if not in_cone(sc, Pm, t, j, L0, L1, L2):
-                    continue
             D = L0 * (X0 - Y0) + L1 * (X1 - Y1) + L2 * (X2 - Y2)
             if not (D > 0.0 and D < cap) or not in_cone(sc, Px, u, i, -L0, -L1, -L2):
                 continue

@@ -342,6 +342,18 @@ def crossing(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2):
 
 
 @kernel(_nrt=False)
+def cone_crossing(sc, Pm, t, j, a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2):
+    """`crossing` of the ridge a-b (corner j of triangle t of a mesh of pose Pm) with the segment c-e, its common
+    normal L turned into the ridge's normal cone (`in_cone`); ok False when they do not cross or neither L nor
+    -L lies in the cone."""
+    ok, X0, X1, X2, Y0, Y1, Y2, L0, L1, L2 = crossing(a0, a1, a2, b0, b1, b2, c0, c1, c2, e0, e1, e2)
+    if ok and not in_cone(sc, Pm, t, j, L0, L1, L2):
+        L0, L1, L2 = -L0, -L1, -L2
+        ok = in_cone(sc, Pm, t, j, L0, L1, L2)
+    return ok, X0, X1, X2, Y0, Y1, Y2, L0, L1, L2
+
+
+@kernel(_nrt=False)
 def _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2):
     """An edge of the box or hull x (pose Px) crossing the ridge g-h (ground; corner j of triangle t, mesh pose
     Pm) inside x: (D [m], X (the ridge's point) [m], L), the least depth D = L . X - min over x's vertices of
@@ -353,13 +365,10 @@ def _edge_across(sc, x, Px, Pm, t, j, g0, g1, g2, h0, h1, h2):
     for k in range(eran[x, 0], eran[x, 1]):
         a0, a1, a2 = to_ground(Px, verts[edges[k, 0], 0], verts[edges[k, 0], 1], verts[edges[k, 0], 2])
         b0, b1, b2 = to_ground(Px, verts[edges[k, 1], 0], verts[edges[k, 1], 1], verts[edges[k, 1], 2])
-        ok, y0, y1, y2, _z0, _z1, _z2, l0, l1, l2 = crossing(g0, g1, g2, h0, h1, h2, a0, a1, a2, b0, b1, b2)
+        ok, y0, y1, y2, _z0, _z1, _z2, l0, l1, l2 = cone_crossing(sc, Pm, t, j, g0, g1, g2, h0, h1, h2, a0, a1, a2,
+                                                                   b0, b1, b2)
         if not ok:
             continue
-        if not in_cone(sc, Pm, t, j, l0, l1, l2):
-            l0, l1, l2 = -l0, -l1, -l2
-            if not in_cone(sc, Pm, t, j, l0, l1, l2):
-                continue
         lo = -support_depth(sc[1][x], Px, sc[4][x], verts, sv[x, 0], sv[x, 1] - sv[x, 0], 0.0, 0.0, 0.0, l0, l1, l2)
         if l0 * a0 + l1 * a1 + l2 * a2 > lo + tol or l0 * b0 + l1 * b1 + l2 * b2 > lo + tol:
             continue   # not x's supporting edge along -L
