@@ -250,7 +250,7 @@ def main():
     start = res.find("## Shape contact (issue 30)")
     if start >= 0:
         end = res.find("\n## ", start + 5)
-        res = res[:start] + text + (res[end + 1:] if end >= 0 else "")
+        res = res[:start] + text + ("\n" + res[end + 1:] if end >= 0 else "")
     else:
         res = res.rstrip("\n") + "\n\n" + text
     (HERE / "RESULTS.md").write_text(res)
