@@ -3,7 +3,8 @@
 Three-stage collocation at c = (4 - sqrt 6) / 10, (4 + sqrt 6) / 10, 1, solved by simplified Newton
 iterations in the transformed variables W = T^-1 Z: one real system (gamma / h - J) and one complex
 system ((alpha + i beta) / h - J) of the state's size per iteration, J the Jacobian of the compiled
-right-hand side (`fastdyn.rhs`, the O(N) equations of motion) by forward differences (n evaluations).
+right-hand side (`fastdyn.rhs`, the O(N) equations of motion) by forward differences (n evaluations, or
+one per group of columns sharing no nonzero row between full Jacobians: `_jacobian`).
 J is kept across steps while Newton converges well (recomputed after a step that needed more than two
 iterations at a contraction rate above 1e-3, or when Newton fails with an old J); the two LU
 factorisations (partial pivoting, `_lu`) are kept while h is unchanged (h is kept when the controller
@@ -60,12 +61,14 @@ STAGNATION = 0.9
 FAC_MIN, FAC_MAX = 0.2, 10.0
 EVALS_PER_RETURN = 1_000_000   # state entries x right-hand-side evaluations between returns to Python
 CALLBACK_RETRIES = 24          # as fastdop: failed Python-callable loads in a row before the run ends
-N_SCRATCH = 21                 # rows of the scratch S (n columns) that `run` takes
+N_SCRATCH = 23                 # rows of the scratch S (n columns) that `run` takes
 # rows of S: Z 0-2, W 3-5, F 6-8, Q 9-11 (the last accepted step's dense output), dW 12-14, ynew 15,
-# scale 16, err 17, tmp 18, yo 19, yq 20 (the start of the step Q belongs to)
+# scale 16, err 17, tmp 18, yo 19, yq 20 (the start of the step Q belongs to), the Jacobian's column groups
+# 21, the columns' difference steps 22
 # st: t, h, h_old, err_old, J current (0/1), h of the LU factors (0: none), Q valid (0/1), t of Q's step,
-#     h of Q's step, J computed (0/1)
-N_ST = 10
+#     h of Q's step, J computed (0/1), column groups (0: none), grouped Jacobians since the last full one
+N_ST = 12
+JAC_REFRESH = 8   # grouped Jacobians between full ones (`_jacobian`)
 
 
 @kernel(_nrt=False)
@@ -82,7 +85,7 @@ def _lu_solve(A, piv, b):
 
 
 @kernel(_nrt=False)
-def _jacobian(cm, wk, t, y, f, Jm, yt, ft):
+def _full_jacobian(cm, wk, t, y, f, Jm, yt, ft):
     """Jm = df/dy at (t, y) (f = f(t, y)) by forward differences, step sqrt(eps max(1e-5, |y_j|)) as
     radau5.f; yt, ft: scratch. Returns a status (not OK: an evaluation failed)."""
     n = y.shape[0]
@@ -97,7 +100,85 @@ def _jacobian(cm, wk, t, y, f, Jm, yt, ft):
         if s_ != OK:
             return s_
         for i in range(n):
-            Jm[i, j] = (ft[i] - f[i]) / d
+            v = (ft[i] - f[i]) / d
+            Jm[i, j] = v if v != 0.0 or ft[i] == f[i] else 1e-300
+    return OK
+
+
+@kernel(_nrt=False)
+def _column_groups(Jm, grp, mark):
+    """Columns of Jm that share no nonzero row, in groups (Curtis, Powell and Reid): grp[j] the group of
+    column j; mark: scratch (n). Greedy, one group per pass over the columns left; returns the number of
+    groups, or 0 when grouping saves less than half of the columns (a dense Jacobian: no groups)."""
+    n = Jm.shape[0]
+    for j in range(n):
+        grp[j] = -1.0
+        mark[j] = -1.0
+    left, g = n, 0
+    while left > 0:
+        if 2 * g >= n:
+            return 0
+        taken = 0
+        for j in range(n):
+            if grp[j] >= 0.0:
+                continue
+            ok = True
+            for i in range(n):
+                if Jm[i, j] != 0.0 and mark[i] == g:
+                    ok = False
+                    break
+            if ok:
+                grp[j] = g
+                taken += 1
+                for i in range(n):
+                    if Jm[i, j] != 0.0:
+                        mark[i] = g
+        left -= taken
+        g += 1
+    return g if 2 * g < n else 0
+
+
+@kernel(_nrt=False)
+def _jacobian(cm, wk, t, y, f, Jm, S, st, stats):
+    """Jm = df/dy at (t, y) (f = f(t, y)): by forward differences over every column (`_full_jacobian`, n
+    evaluations) after each JAC_REFRESH grouped ones, and in between one evaluation per group of columns
+    that share no nonzero row of the last full Jacobian (`_column_groups`: the free bodies of a pile of
+    parts touch a few others; each group's columns are perturbed together, each difference read back on its
+    column's rows). A coupling that appeared since the last full Jacobian is missing until the next one, or
+    until Newton fails (then st[11] forces a full one): it slows Newton, not the accuracy, which the error
+    estimate controls. Counts evaluations and Jacobians into stats; returns a status."""
+    n = y.shape[0]
+    yt, ft, grp, dj = S[18], S[17], S[21], S[22]
+    G = int(st[10])
+    if G == 0 or st[11] >= JAC_REFRESH:
+        s_ = _full_jacobian(cm, wk, t, y, f, Jm, yt, ft)
+        stats[2] += n
+        stats[4] += 1
+        st[10] = _column_groups(Jm, grp, dj) if s_ == OK else 0.0
+        st[11] = 0.0
+        return s_
+    for i in range(n):
+        yt[i] = y[i]
+    for g in range(G):
+        for j in range(n):
+            if grp[j] == g:
+                d = np.sqrt(2.220446049250313e-16 * max(1e-5, abs(y[j])))
+                yt[j] = y[j] + d
+                dj[j] = yt[j] - y[j]
+        s_ = rhs(cm, wk, t, yt, ft, bool(True))
+        stats[2] += 1
+        for j in range(n):
+            if grp[j] == g:
+                yt[j] = y[j]
+                for i in range(n):
+                    if Jm[i, j] != 0.0:   # the row's one column in this group (the pattern is kept: no zeros)
+                        v = (ft[i] - f[i]) / dj[j]
+                        Jm[i, j] = v if v != 0.0 or ft[i] == f[i] else 1e-300
+        if s_ != OK:
+            st[11] = JAC_REFRESH
+            return s_
+    stats[4] += 1
+    st[11] += 1.0
     return OK
 
 
@@ -290,9 +371,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
         converged, n_iter, rate, s_ = False, 0, -1.0, OK
         for attempt in range(2):
             if st[9] == 0.0:
-                s_ = _jacobian(cm, wk, t, y, f, Jm, S[18], S[17])
-                stats[2] += n
-                stats[4] += 1
+                s_ = _jacobian(cm, wk, t, y, f, Jm, S, st, stats)
                 if s_ != OK:
                     break
                 st[9], st[4], st[5] = 1.0, 1.0, 0.0
@@ -314,7 +393,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             converged, n_iter, rate, s_ = _newton(cm, wk, co, t, y, h, S, LR, LC, piv, cv, newton_tol, stats)
             if converged or st[4] != 0.0 or s_ != OK:
                 break
-            st[9] = 0.0   # Newton failed with an old Jacobian: a fresh one at (t, y)
+            st[9], st[11] = 0.0, JAC_REFRESH   # Newton failed with an old Jacobian: a fresh, full one at (t, y)
         if s_ != OK and wk[48][1][1] != 0:   # a Python-callable load failed (as fastdop)
             wk[48][1][1] = 0
             failed += 1
@@ -401,9 +480,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             iout += 1
             written += 1
         if recompute_jac:
-            s_ = _jacobian(cm, wk, t_new, y, f, Jm, S[18], S[17])
-            stats[2] += n
-            stats[4] += 1
+            s_ = _jacobian(cm, wk, t_new, y, f, Jm, S, st, stats)
             st[5] = 0.0
             if s_ == OK:
                 st[9], st[4] = 1.0, 1.0
