@@ -125,3 +125,25 @@ def test_applied_force_work_torsion_spring_and_stop():
     assert theta.max() > 0.3   # the stop was hit
     assert np.allclose(res.energy["W"], 0.05 * (theta - theta[0]), rtol=0, atol=1e-10)
     assert res.diagnostics.summary()["energy_error"] < 1e-8
+
+
+def test_work_of_python_callable_force_and_torque_summed_in_the_kernel():
+    """A rod pendulum braked by a drag torque -c w and pushed by an offset point force, both written as Python
+    callables (called back from the step loop), plus a constant torque: the kernel sums the callables' power
+    from the loads the callback writes, and W is the change of the kinetic and potential energy (nothing
+    else does work or dissipates)."""
+    m, c = 2.0, 0.3
+    mdl = mb.Model(gravity=(0.0, -G, 0.0))
+    rod = mdl.add_body("rod", m, (0.01, 2 / 12, 2 / 12), position=(0.5, 0, 0))
+    mdl.add_revolute("pin", mdl.ground, rod, (0, 0, 0), (0, 0, 1))
+    mdl.add_torque("drag", rod, lambda t, s: (0.0, 0.0, -c * s.angular_velocity(rod)[2]))
+    mdl.add_force("push", (rod, (1.0, 0, 0)), lambda t, s: (0.0, -0.5 * np.cos(3 * t), 0.0))
+    mdl.add_torque("T", rod, (0, 0, 0.4))
+    res = mb.simulate(mdl, 2.0, 0.01, method="dop853", rtol=1e-10)
+    assert res.success and set(res.stats["called_back"]) == {"drag", "push"}
+    assert res.stats.get("energy") == "compiled", res.stats.get("energy")
+    E = res.kinetic_energy() + m * G * res.position("rod")[:, 1]
+    W = res.energy["W"] - res.energy["W"][0]
+    assert np.max(np.abs(W)) > 0.1
+    assert np.max(np.abs(W - (E - E[0]))) < 1e-8 * np.max(np.abs(W)), np.max(np.abs(W - (E - E[0])))
+    assert res.diagnostics.summary()["energy_error"] < 1e-8

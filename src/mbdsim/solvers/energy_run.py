@@ -25,11 +25,13 @@ def coverage(sys, cm) -> tuple[bool, bool]:
     """(D, W): whether the compiled loads of CompiledModel `cm` evaluate the dissipation power of every
     element of `sys` that has one, and the power of every applied force and torque."""
     from ..system.force_elements import evaluator
+    from .pyloads import all_applied
     called = set(cm.python_loads)
+    applied = all_applied([sys.model.forces[n] for n in called])   # the kernel sums the callback's power then
     d_ok = w_ok = True
     for e in sys.model.forces.values():
         if isinstance(e, (Force, Torque)):
-            w_ok = w_ok and e.name not in called
+            w_ok = w_ok and (e.name not in called or applied)
         elif hasattr(evaluator(e), "dissipation"):
             d_ok = d_ok and type(e) in DISSIPATIVE and e.name not in called
     return d_ok, w_ok

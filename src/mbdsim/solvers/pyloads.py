@@ -81,6 +81,13 @@ def sensor_callback(sensor) -> SensorCallback:
     return cb
 
 
+def all_applied(elems) -> bool:
+    """Whether the called-back elements are all applied forces and torques (their power: the work W of the
+    energy balance, summed by the kernel from the loads the callback writes; solvers.energy_run)."""
+    from ..model.forces import Force, Torque
+    return all(isinstance(e, (Force, Torque)) for e in elems)
+
+
 class PythonLoads:
     """The callback of one run's work arrays (keep this object alive as long as the kernels may call it)."""
 
@@ -104,6 +111,7 @@ class PythonLoads:
                 cb.target = self
         if self.elems:
             self.ctl[0] = self._address(self._call)
+            self.ctl[3] = int(all_applied(self.elems))   # their power is the applied loads' work (fastenergy)
         if cm.python_drivers:
             fns = sys.derived["packed"][6]
             drv, owner = sys.derived["packed"][5], sys.row_owner

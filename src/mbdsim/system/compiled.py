@@ -174,8 +174,9 @@ class Work:
              # 47: (the pivot ratio below which it re-selects, its nominal value RESELECT_RATIO)
              np.array(t.loop_rows, dtype=np.int64), np.full(2, RESELECT_RATIO),
              # 48: loads and drivers written as Python callables (solvers.pyloads): the loads (nf, 6) and
-             # [load callback address (0: none), failed flag, driver callback address (0: none)]
-             (z((nf, 6)), np.zeros(3, np.int64)),
+             # [load callback address (0: none), failed flag, driver callback address (0: none), whether the
+             # loads' power is the applied loads' work (1: they are all forces and torques; solvers.fastenergy)]
+             (z((nf, 6)), np.zeros(4, np.int64)),
              _coord_work(cm, nf),   # 49: coordinate constraints on the tree (solvers.treecoord)
              _friction_work(cm.friction or _friction(None), nf, nc, nv),   # 50: joint friction (solvers.fastfriction)
              pathcoords.work(cm.paths or pathcoords.empty(), cm.path_stack),   # 51: solvers.pathcoord
