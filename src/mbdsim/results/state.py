@@ -13,7 +13,7 @@ class State:
     def __init__(self, system, t, q, v, frames=None):
         from .result import Result
         self.t = float(t)
-        self._res = Result(system, [t], q[None, :], v[None, :], None, None)
+        self._res = Result(system, np.array((self.t,)), q[None, :], v[None, :], None, None)
         if frames is not None:   # the frames of (q, v) already computed (the compiled kernels' own)
             self._res.inject_frames(frames)
 
@@ -32,14 +32,25 @@ class State:
         return x[()] if x.ndim == 0 else x
 
     def __getattr__(self, name):
+        from .result import Result
         attr = getattr(self._res, name)
         if not callable(attr):
             return attr
+        if callable(getattr(Result, name, None)) and not name.startswith("__"):
+            # a Result method: its one-sample wrapper made once, as a method of the class (the callables of
+            # loads call it at every evaluation of the step loop, each with a new State)
+            def method(self, *args, _name=name, **kwargs):
+                return _one(getattr(self._res, _name)(*args, **kwargs))
+            method.__name__ = name
+            method.__doc__ = getattr(Result, name).__doc__
+            setattr(State, name, method)
+            return getattr(self, name)
+        return lambda *args, **kwargs: _one(attr(*args, **kwargs))
 
-        def one(*args, **kwargs):
-            out = attr(*args, **kwargs)
-            return out[0] if isinstance(out, np.ndarray) and out.ndim >= 1 and len(out) == 1 else out
-        return one
+
+def _one(out):
+    """A Result measure's value at its one sample (the time axis dropped)."""
+    return out[0] if isinstance(out, np.ndarray) and out.ndim >= 1 and len(out) == 1 else out
 
 
 def _continued(sys, name, t, raw):

@@ -96,7 +96,6 @@ class PythonLoads:
         self.sys, self.cm, self.wk = sys, cm, wk
         self.elems = [sys.model.forces[n] for n in cm.python_loads]
         self.F, self.ctl = wk[48][0], wk[48][1]
-        self.y = np.zeros(sys.nq + sys.nv)
         self.calls, self.error, self.interrupted = 0, None, False
         self.last_failed = False   # whether the latest call of either callback failed
         self.sensor_error = None   # the error of a Python-callable sensor (the run ends with it)
@@ -119,8 +118,13 @@ class PythonLoads:
             self.drivers = [(d, triple(fns[d]), f"motion '{owner[rows[d]]}'") for d in cm.python_drivers]
             self._driver_names = ", ".join(e for _, _, e in self.drivers)
             self.ctl[2] = self._address(self._drive)
-        # the velocity slots of each frame (frame f's six load slots are v[vadr[f]: vadr[f] + 6]; particles 3)
-        self.slots = [(f, int(a), 6 if sys.frame_rigid[f] else 3) for f, a in enumerate(sys.frame_v_adr) if a >= 0]
+        # the velocity slots of each frame (frame f's six load slots are v[vadr[f]: vadr[f] + 6]; particles 3):
+        # F[f, k] = Q[vadr[f] + k], one scatter of the flat F
+        slots = [(f, int(a), 6 if sys.frame_rigid[f] else 3) for f, a in enumerate(sys.frame_v_adr) if a >= 0]
+        self.F_dst = np.array([6 * f + k for f, a, n in slots for k in range(n)], dtype=np.int64)
+        self.F_src = np.array([a + k for f, a, n in slots for k in range(n)], dtype=np.int64)
+        self.F_flat = self.F.reshape(-1)   # a view (F is C-contiguous)
+        self.evals = [(evaluator(e), e) for e in self.elems]
 
     def _address(self, fn) -> int:
         cb = _CALLBACK(fn)
@@ -174,9 +178,9 @@ class PythonLoads:
         the single-instant Frames the evaluators take."""
         sys, cm, wk = self.sys, self.cm, self.wk
         r, A, rd, w = wk[0].copy(), wk[1].copy(), wk[2].copy(), wk[3].copy()
-        fasttree.to_maximal(cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid, r, A, rd, w,
-                            self.y, self.y[:0])
-        q, v = self.y[:sys.nq].copy(), self.y[sys.nq:].copy()
+        y = np.empty(sys.nq + sys.nv)
+        fasttree.to_maximal(cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid, r, A, rd, w, y, y[:0])
+        q, v = y[:sys.nq], y[sys.nq:]
         state = State(sys, t, q, v, Frames(r[None], A[None], rd[None], w[None]))
         # joint angles read by the evaluators (torsion springs, stops, expression loads in closed loops):
         # continued beyond +-pi over the run by the State's anchors (results.state._continued)
@@ -215,15 +219,14 @@ class PythonLoads:
 
     def _loads_at(self, t):
         state, fr = self.state(t)
-        Q = np.zeros(self.sys.nv)
-        for e in self.elems:
-            Q += evaluator(e).generalized(self.sys, fr, e, t, state)
-        if not np.all(np.isfinite(Q)):
-            bad = next(e for e in self.elems if not np.all(np.isfinite(
-                evaluator(e).generalized(self.sys, fr, e, t, state))))
+        first, *rest = self.evals
+        Q = first[0].generalized(self.sys, fr, first[1], t, state)
+        for ev, e in rest:
+            Q = Q + ev.generalized(self.sys, fr, e, t, state)
+        if not np.isfinite(Q).all():
+            bad = next(e for ev, e in self.evals if not np.all(np.isfinite(ev.generalized(self.sys, fr, e, t, state))))
             raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
-        for f, a, n in self.slots:
-            self.F[f, :n] = Q[a:a + n]
+        self.F_flat[self.F_dst] = Q[self.F_src]
 
 
 def settle(pyl, status, error):
