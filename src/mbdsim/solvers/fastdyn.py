@@ -93,28 +93,21 @@ def loads_into(cm, wk, t, y, r, A, rd, w, F):
         if on:
             fastenergy.contact_power(sc[11], rec, nrec, pw, en[1])
     if wk[48][1][0] != 0:   # loads written as Python callables (solvers.pyloads), from the frames in wk
-        _python_loads(wk[48][0], wk[48][1], t, F, A, rd, w, pw)
+        _python_loads(wk[48][0], wk[48][1], t, F)
+        if wk[48][1][3] != 0 and pw[0] != 0.0:   # their power Q . v [W], which the callback writes into the
+            pw[2] += wk[48][0][0, 0]              # ground row: applied loads' work (solvers.fastenergy)
 
 
 @kernel(_nrt=False, inline="never")
-def _python_loads(F_ext, ctl, t, F, A, rd, w, pw):
-    """Call the load callback (address ctl[0]; ctl[1] = 1 when it failed) and add its loads F_ext to F
-    (per frame: force [N] ground axes, torque [N m] body axes). With the energy bookkeeping on and ctl[3] = 1
-    (the called-back loads are all applied forces and torques) their power F . rd + T . (A^T w) [W] goes to
-    the applied loads' pw[2] (solvers.fastenergy). Kept out of `loads_into` (never inlined, small
-    arguments) so that the loads of every other model stay as cheap as before: with the call inline, a
-    one-body tree's right-hand side took 0.3 us more."""
+def _python_loads(F_ext, ctl, t, F):
+    """Call the load callback (address ctl[0]; ctl[1] = 1 when it failed) and add its loads F_ext to F.
+    Kept out of `loads_into` (never inlined, small arguments) so that the loads of every other model stay
+    as cheap as before: with the call inline, a one-body tree's right-hand side took 0.3 us more."""
     if call_address(ctl[0], t) != 0:
         ctl[1] = 1
-    work = ctl[3] != 0 and pw[0] != 0.0
     for f in range(1, F.shape[0]):
         for k in range(6):
             F[f, k] += F_ext[f, k]
-        if work:
-            p = F_ext[f, 0] * rd[f, 0] + F_ext[f, 1] * rd[f, 1] + F_ext[f, 2] * rd[f, 2]
-            for k in range(3):
-                p += F_ext[f, 3 + k] * (A[f, 0, k] * w[f, 0] + A[f, 1, k] * w[f, 1] + A[f, 2, k] * w[f, 2])
-            pw[2] += p
 
 
 @kernel(_nrt=False)

@@ -8,7 +8,8 @@ When a run's monitor checks the energy balance (`simulate(monitor=True)`), each 
          torsion springs and stops (the dissipation program of their joint load, `system.exprloads_kernel`)
          and joint friction (lambda_f x_dot, `friction_power`);
   pw[2]  the power of the applied loads [W]: constant and expression point forces (F . v of the point) and
-         torques (T . w);
+         torques (T . w), and those written as Python callables (Q . v, from their callback: solvers.pyloads,
+         fastdyn.loads_into);
 the same laws as the `dissipation` evaluators of system.force_elements (the independent reference,
 results/energy.py). pw[0] is 1.0 when this is on, 0.0 otherwise (then nothing is summed or recorded:
 runs with monitor=False pay one comparison per kernel). The step loop (`solvers.fastdopstep`: stage
