@@ -227,7 +227,8 @@ class PythonLoads:
             bad = next(e for ev, e in self.evals if not np.all(np.isfinite(ev.generalized(self.sys, fr, e, t, state))))
             raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
         self.F_flat[self.F_dst] = Q[self.F_src]
-        if self.ctl[3]:   # their power [W] for the kernel's energy account, in the ground row (never applied)
+        if self.ctl[3] and self.wk[53][0][0] != 0.0:   # their power [W] for the kernel's energy account (on),
+            # in the ground row (never applied)
             self.F[0, 0] = float(Q @ state._res.v[0])
 
 
