@@ -5,21 +5,93 @@ import bisect
 
 import numpy as np
 from ..model.joint_kinds import is_angle
+from ..system.frames import Frames, cross
 
 
 class State:
-    """Measures of a single instant (t [s]); methods mirror Result but return one sample (no time axis)."""
+    """Measures of a single instant (t [s]); methods mirror Result but return one sample (no time axis).
 
-    def __init__(self, system, t, q, v, frames=None):
-        from .result import Result
+    Light: the common measures of a body or marker without `frame=` / `relative_to=` (position [m],
+    velocity [m/s], angular velocity [rad/s], all in ground axes; orientation, the body-to-ground
+    rotation) are read straight from the instant's body frames; every other Result method works too, on a
+    one-sample Result built on first use. `q`, `v`: the coordinates and velocity variables (1-D)."""
+
+    def __init__(self, system, t, q, v, frames=None, maximal=None):
+        """q, v: the coordinates and velocity variables, or None with `maximal() -> (q, v)` computing them
+        on first use (from the compiled kernels' frames)."""
         self.t = float(t)
-        self._res = Result(system, np.array((self.t,)), q[None, :], v[None, :], None, None)
-        if frames is not None:   # the frames of (q, v) already computed (the compiled kernels' own)
-            self._res.inject_frames(frames)
+        self.system = system
+        self._q, self._v, self._maximal = q, v, maximal
+        # the single-instant Frames (nframes, ...) of (q, v) already computed (the compiled kernels'), or None
+        self._fr = frames
+        self._result = None
 
     @property
     def time(self) -> float:
         return self.t
+
+    @property
+    def q(self):
+        """Coordinates (nq,) of this instant (positions [m], Euler parameters)."""
+        if self._q is None:
+            self._q, self._v = self._maximal()
+        return self._q
+
+    @property
+    def v(self):
+        """Velocity variables (nv,) of this instant ([m/s], body-axes angular velocities [rad/s])."""
+        if self._v is None:
+            self._q, self._v = self._maximal()
+        return self._v
+
+    @property
+    def _res(self):
+        """The one-sample Result of this instant (built on first use)."""
+        if self._result is None:
+            from .result import Result
+            res = Result(self.system, np.array((self.t,)), self.q[None, :], self.v[None, :], None, None)
+            fr = self._fr
+            if fr is not None:   # the same arrays, with a sample axis
+                res.inject_frames(Frames(fr.r[None], fr.A[None], fr.rd[None], fr.w[None]))
+            self._result = res
+        return self._result
+
+    def _frames(self):
+        fr = self._fr
+        if fr is None:
+            f = self._res.frames
+            fr = self._fr = Frames(f.r[0], f.A[0], f.rd[0], f.w[0])
+        return fr
+
+    def position(self, target, frame=None):
+        """Position [m] (3,) of a body's CM or a marker origin (Result.position at this instant)."""
+        if frame is not None:
+            return _one(self._res.position(target, frame))
+        fid, s_B, _ = _where(self.system, target)
+        fr = self._frames()
+        return fr.r[fid] + fr.A[fid].dot(s_B) if s_B is not None else fr.r[fid].copy()
+
+    def velocity(self, target, frame=None, relative_to=None):
+        """Velocity [m/s] (3,) of a body's CM or a marker origin (Result.velocity at this instant)."""
+        if frame is not None or relative_to is not None:
+            return _one(self._res.velocity(target, frame, relative_to))
+        fid, s_B, _ = _where(self.system, target)
+        fr = self._frames()
+        if s_B is None:
+            return fr.rd[fid].copy()
+        return fr.rd[fid] + cross(fr.w[fid], fr.A[fid].dot(s_B))
+
+    def angular_velocity(self, target, frame=None, relative_to=None):
+        """Angular velocity [rad/s] (3,) of the body of `target`, ground axes (Result.angular_velocity)."""
+        if frame is not None or relative_to is not None:
+            return _one(self._res.angular_velocity(target, frame, relative_to))
+        return self._frames().w[_where(self.system, target)[0]].copy()
+
+    def orientation(self, target):
+        """Rotation matrix (3, 3) from the axes of `target` to ground (Result.orientation at this instant)."""
+        fid, _, R_BM = _where(self.system, target)
+        A = self._frames().A[fid]
+        return A.dot(R_BM) if R_BM is not None else A.copy()
 
     def joint_coordinate(self, joint):
         """Joint coordinate at this instant; an angle continues beyond +-pi along the analysis, as in a Result."""
@@ -32,11 +104,13 @@ class State:
         return x[()] if x.ndim == 0 else x
 
     def __getattr__(self, name):
+        if name.startswith("_"):
+            raise AttributeError(name)
         from .result import Result
         attr = getattr(self._res, name)
         if not callable(attr):
             return attr
-        if callable(getattr(Result, name, None)) and not name.startswith("__"):
+        if callable(getattr(Result, name, None)):
             # a Result method: its one-sample wrapper made once, as a method of the class (the callables of
             # loads call it at every evaluation of the step loop, each with a new State)
             def method(self, *args, _name=name, **kwargs):
@@ -46,6 +120,23 @@ class State:
             setattr(State, name, method)
             return getattr(self, name)
         return lambda *args, **kwargs: _one(attr(*args, **kwargs))
+
+
+def _where(sys, target):
+    """(frame index, s_B or None, R_BM or None) of a target (None: a body's CM and axes), cached on the
+    System per target (a Body or Marker by identity, a name by value)."""
+    cache = sys.run_state.setdefault("state_targets", {})
+    key = target if isinstance(target, str) else id(target)
+    hit = cache.get(key)
+    if hit is None or hit[0] is not target and not isinstance(target, str):
+        from ..model.body import Marker
+        from ..system.measures import locate, resolve
+        fid, s_B, R_BM = locate(sys, target)
+        marker = isinstance(resolve(sys, target), Marker)
+        hit = (target, (fid, np.array(s_B, dtype=float) if marker else None,
+                        np.array(R_BM, dtype=float) if marker else None))
+        cache[key] = hit
+    return hit[1]
 
 
 def _one(out):

@@ -124,7 +124,17 @@ class PythonLoads:
         self.F_dst = np.array([6 * f + k for f, a, n in slots for k in range(n)], dtype=np.int64)
         self.F_src = np.array([a + k for f, a, n in slots for k in range(n)], dtype=np.int64)
         self.F_flat = self.F.reshape(-1)   # a view (F is C-contiguous)
+        # every frame rigid: Q is F's rows 1.. as they stand (a view the loads are added into, no scatter)
+        contiguous = np.array_equal(self.F_dst, 6 + np.arange(sys.nv)) and np.array_equal(self.F_src, np.arange(sys.nv))
+        self._Q_in_F = self.F_flat[6:6 + sys.nv] if contiguous else None
         self.evals = [(evaluator(e), e) for e in self.elems]
+        self._load_entity = "load '" + ", ".join(e.name for e in self.elems) + "'"
+        self.applied = bool(self.elems) and all_applied(self.elems)
+        # fasttree.to_maximal's model arguments (the absolute state from the kernel's frames)
+        self._tree = (cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid)
+        self._nq, self._ny = sys.nq, sys.nq + sys.nv
+        self._frames = tuple(wk[k] for k in range(4))   # the kernel's r, A, rd, w (work slots 0-3)
+        self._monitor = wk[53][0]   # [0] != 0 while the run keeps the energy account
 
     def _address(self, fn) -> int:
         cb = _CALLBACK(fn)
@@ -174,18 +184,27 @@ class PythonLoads:
         return 1
 
     def state(self, t) -> tuple[State, Frames]:
-        """The light State of the kernel's current frames at t [s] (absolute [q, v] rebuilt from them) and
-        the single-instant Frames the evaluators take."""
-        sys, cm, wk = self.sys, self.cm, self.wk
-        r, A, rd, w = wk[0].copy(), wk[1].copy(), wk[2].copy(), wk[3].copy()
-        y = np.empty(sys.nq + sys.nv)
-        fasttree.to_maximal(cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid, r, A, rd, w, y, y[:0])
-        q, v = y[:sys.nq], y[sys.nq:]
-        state = State(sys, t, q, v, Frames(r[None], A[None], rd[None], w[None]))
+        """The light State of the kernel's current frames at t [s] and the single-instant Frames the
+        evaluators take (the State's own). The absolute [q, v] are rebuilt from the frames (one compiled
+        call) on first use when every called-back load is a force or torque (their evaluators read the
+        frames only), else at once (the Frames carry them)."""
+        f = self._frames
+        r, A, rd, w = f[0].copy(), f[1].copy(), f[2].copy(), f[3].copy()
+
+        def maximal():
+            y = np.empty(self._ny)
+            fasttree.to_maximal(*self._tree, r, A, rd, w, y, y[:0])
+            return y[:self._nq], y[self._nq:]
+        if self.applied:   # (their evaluators read the frames only)
+            fr = Frames(r, A, rd, w, t=t)
+            return State(self.sys, t, None, None, fr, maximal), fr
+        q, v = maximal()
+        fr = Frames(r, A, rd, w, t=t, q=q, v=v)
+        state = State(self.sys, t, q, v, fr)
         # joint angles read by the evaluators (torsion springs, stops, expression loads in closed loops):
         # continued beyond +-pi over the run by the State's anchors (results.state._continued)
-        angle = lambda jt: np.atleast_1d(state.joint_coordinate(jt))[:1]  # noqa: E731
-        return state, Frames(r, A, rd, w, t=t, q=q, v=v, angle=angle)
+        fr.angle = lambda jt: np.atleast_1d(state.joint_coordinate(jt))[:1]
+        return state, fr
 
     def signal(self, sensor, t) -> float:
         """The signal of a Python-callable sensor at t [s] and the kernel's current frames; nan when it
@@ -214,11 +233,28 @@ class PythonLoads:
 
     def _call(self, t):
         """The load callback: generalized loads of the called-back elements at t [s] into slot 48[0]."""
-        names = ", ".join(e.name for e in self.elems)
-        return self._guarded(lambda: self._loads_at(t), f"load '{names}'", "value", t, lambda: self.F.fill(np.nan))
+        return self._guarded(lambda: self._loads_at(t), self._load_entity, "value", t, self._poison_loads)
+
+    def _poison_loads(self):
+        self.F.fill(np.nan)
 
     def _loads_at(self, t):
         state, fr = self.state(t)
+        if self.applied:   # forces and torques only: added into one Q (their values checked finite on return)
+            Q = self._Q_in_F
+            if Q is None:
+                Q = np.zeros(self.sys.nv)
+            else:
+                Q.fill(0.0)
+            on = self._monitor[0] != 0.0   # the run keeps the energy account: their power [W] too
+            P = 0.0
+            for ev, e in self.evals:
+                P += ev.accumulate(self.sys, fr, e, t, state, Q, on)
+            if self._Q_in_F is None:
+                self.F_flat[self.F_dst] = Q[self.F_src]
+            if on:   # for the kernel's account, in the ground row (never applied)
+                self.F[0, 0] = P
+            return
         first, *rest = self.evals
         Q = first[0].generalized(self.sys, fr, first[1], t, state)
         for ev, e in rest:
@@ -227,9 +263,6 @@ class PythonLoads:
             bad = next(e for ev, e in self.evals if not np.all(np.isfinite(ev.generalized(self.sys, fr, e, t, state))))
             raise EvaluationError(f"load '{bad.name}'", "value", "is not finite", time=float(t))
         self.F_flat[self.F_dst] = Q[self.F_src]
-        if self.ctl[3] and self.wk[53][0][0] != 0.0:   # their power [W] for the kernel's energy account (on),
-            # in the ground row (never applied)
-            self.F[0, 0] = float(Q @ state._res.v[0])
 
 
 def settle(pyl, status, error):

@@ -126,6 +126,10 @@ def _rotate(R, x):
 def cross(a, b):
     """Cross products a x b of stacks of 3-vectors (..., 3) (np.cross's arithmetic, without its axis
     handling: several times faster on the short stacks of a Result)."""
+    if a.ndim == 1 and b.ndim == 1:   # two 3-vectors (the loads of one state): float arithmetic
+        a0, a1, a2 = a.tolist()
+        b0, b1, b2 = b.tolist()
+        return np.array((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0))
     a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
     b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
     out = np.empty(a.shape if a.shape == b.shape else np.broadcast_shapes(a.shape, b.shape))

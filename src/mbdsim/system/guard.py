@@ -86,9 +86,11 @@ def call_vector(fn, t, state, entity: str, field: str) -> np.ndarray:
         raise
     except Exception as exc:  # noqa: BLE001 - user code
         raise EvaluationError(entity, field, f"callable raised {type(exc).__name__}: {exc}", time=_time(t)) from exc
-    if type(v) in (tuple, list) and len(v) == 3 and all(type(x) is int or isinstance(x, float) for x in v):
-        if math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2]):   # the usual answer, checked
-            return np.array(v, dtype=float)                                         # at a tenth of the cost
+    if type(v) in (tuple, list) and len(v) == 3:   # the usual answer, checked at a tenth of the cost
+        x, y, z = v
+        if (isinstance(x, float) or type(x) is int) and (isinstance(y, float) or type(y) is int) and \
+                (isinstance(z, float) or type(z) is int) and math.isfinite(x + y + z):
+            return np.array(v, dtype=float)
     try:
         a = as_numbers(v).reshape(-1)
     except (TypeError, ValueError):
