@@ -214,6 +214,11 @@ def sensor_stop(run, times, Y, n, t_fail, y_fail):
 # keeps it when it needed at most 1 / PAY of DOP853's right-hand-side evaluations per second of model
 # time (an implicit step also factorises and solves: LU factorisations that grow as n^3 with the state)
 PROBE_STEPS, PROBE_SHARE, PAY = 50, 0.1, 2.0
+# ... the trial's first PROBE_STEPS steps decide already where Radau's steps are SETTLED to EARLY times DOP853's
+# and cost more: under way with longer steps than the explicit method, yet not the orders of magnitude longer
+# that a stiff model's implicit steps take (steps of DOP853's size or shorter: Radau still resolving a fast
+# mode the explicit run left excited, which its growing steps damp; the whole trial decides)
+SETTLED, EARLY = 2.0, 10.0
 
 
 def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):
@@ -243,7 +248,12 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     y_start = getattr(run, "last_state", None) if run.joint_space else None
     trial = not (run.joint_space or len(sys.lock_rows) or getattr(sys.model, "sensors", None))
     t_p = _probe_end(pre["stats"], float(times[0]), t_s, rest) if trial else None
-    second = _integrate(sys, rep_s, rr, rest if t_p is None else rest[rest <= t_p],
+    # the trial's first, short part (PROBE_STEPS of DOP853's steps): DOP853 on at once where Radau's steps
+    # stay within EARLY of DOP853's and cost more (contact that every method must resolve)
+    t_e = _probe_end(pre["stats"], float(times[0]), t_s, rest, 0.0) if t_p is not None else None
+    t_e = t_e if t_e is not None and t_e < t_p else None
+    t_1 = t_p if t_e is None else t_e
+    second = _integrate(sys, rep_s, rr, rest if t_1 is None else rest[rest <= t_1],
                         None if progress is None else _Joined(progress, first, t_s),
                         None if y_start is None else np.array(y_start))
     res = join(first, second, t_s)
@@ -252,21 +262,50 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     res.stats = merge_stats(pre["stats"], second.stats, float(times[0]), t_s, reason)
     res.stats["order_history"][-1] = (t_s,) + HISTORY
     res.stats.update(assembly=rep, njev=second.stats["njev"], nlu=second.stats["nlu"], rtol_reached=rtol)
-    if t_p is not None and second.success:
+    if t_1 is not None and second.success:
         span = t_s - float(times[0])   # DOP853's mean step and evaluations per second of model time before t_s
         explicit = (span / max(pre["stats"]["steps"], 1), pre["stats"]["nfev"] / span)
-        res = _after_probe(sys, rep, res, second, rest[rest >= t_p], explicit, rr, (rtol, atol, max_step),
-                           progress, reason)
+        tol = (rtol, atol, max_step)
+        if t_e is not None:
+            way = _radau_under_way(second, rr)
+            if way is not None and PAY * way[1] > explicit[1] and SETTLED * explicit[0] <= way[0] < EARLY * explicit[0]:
+                return _after_probe(sys, rep, res, second, rest[rest >= t_e], explicit, rr, tol, progress, reason)
+            # not decided: Radau on to the trial's end, where the choice is made on that part's steps
+            rr, second, res = _radau_on(sys, rep, res, second, rest[(rest >= t_e) & (rest <= t_p)], rr, tol, progress)
+            if not second.success:
+                return res
+        res = _after_probe(sys, rep, res, second, rest[rest >= t_p], explicit, rr, tol, progress, reason)
     return res
 
 
-def _probe_end(stats, t0, t_s, rest):
+def _radau_on(sys, rep, res, probe, rest, rr, tol, progress):
+    """(run, its part, joined Result): `res` continued by Radau over `rest` from the end of `probe` (a
+    RadauRun sharing rr's arrays); statistics summed."""
+    from .autoswitch import _Joined, join
+    t_0 = float(rest[0])
+    rep_0 = dataclasses.replace(rep, t=t_0, q=np.array(probe.q[-1]), v=np.array(probe.v[-1]))
+    run = RadauRun.sharing(rr, *tol)
+    part = _integrate(sys, rep_0, run, rest, None if progress is None else _Joined(progress, res, t_0))
+    out = join(res, part, t_0)
+    out.stats = _summed(res.stats, part.stats)
+    return run, part, out
+
+
+def _summed(stats, more):
+    stats = dict(stats)
+    for k in ("steps", "rejected", "nfev", "njev", "nlu", "factorizations", "projections"):
+        stats[k] = int(stats.get(k, 0)) + int(more.get(k, 0))
+    return stats
+
+
+def _probe_end(stats, t0, t_s, rest, share=None):
     """The output time of `rest` (from t_s) that ends Radau's trial: the first at least PROBE_STEPS of the
-    explicit run's mean accepted step, and PROBE_SHARE of the time left, after t_s; None when that is the
-    last (no choice left to make)."""
+    explicit run's mean accepted step, and `share` (default PROBE_SHARE) of the time left, after t_s; None
+    when that is the last (no choice left to make)."""
     if not t_s > t0 or stats.get("steps", 0) < 1:
         return None
-    window = max(PROBE_STEPS * (t_s - t0) / stats["steps"], PROBE_SHARE * (rest[-1] - t_s))
+    share = PROBE_SHARE if share is None else share
+    window = max(PROBE_STEPS * (t_s - t0) / stats["steps"], share * (rest[-1] - t_s))
     later = rest[1:][rest[1:] >= t_s + window]
     return float(later[0]) if len(later) > 1 else None
 
@@ -303,9 +342,7 @@ def _after_probe(sys, rep, res, probe, rest, explicit, rr, tol, progress, reason
     third = integrate_compiled(sys, rep_p, rest, *tol, progress=prog) if explicit else \
         _integrate(sys, rep_p, RadauRun.sharing(rr, *tol), rest, prog)
     out = join(res, third, t_p)
-    stats = dict(res.stats)
-    for k in ("steps", "rejected", "nfev", "njev", "nlu", "factorizations", "projections"):
-        stats[k] = int(stats.get(k, 0)) + int(third.stats.get(k, 0))
+    stats = _summed(res.stats, third.stats)
     if explicit:
         t_s = float(probe.time[0])
         stats["order_history"] = list(stats["order_history"]) + [(t_p, third.stats["method"], 8)]
