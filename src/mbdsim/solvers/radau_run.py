@@ -344,7 +344,7 @@ def _after_probe(sys, rep, res, probe, rest, explicit, rr, tol, progress, reason
     out = join(res, third, t_p)
     stats = _summed(res.stats, third.stats)
     if explicit:
-        t_s = float(probe.time[0])
+        t_s = float(res.stats.get("switch_time", probe.time[0]))   # (the trial may be two parts of Radau)
         stats["order_history"] = list(stats["order_history"]) + [(t_p, third.stats["method"], 8)]
         stats["method"] = (f"auto: {third.stats['method']} until t = {t_s:.6g} s, then {METHOD} until t = "
                            f"{t_p:.6g} s, then {third.stats['method']} ({reason}; Radau IIA's steps {way[0]:.3g} s "

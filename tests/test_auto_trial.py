@@ -1,0 +1,42 @@
+"""auto's hand-over trial (solvers.radau_run.continue_radau): where Radau's first steps after the switch are
+settled at a few times DOP853's and cost more evaluations (tumbling boxes in compliant contact, which every
+method must resolve), DOP853 takes over after the trial's first part, and the run matches DOP853's own."""
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+import mbdsim as mb
+from mbdsim.solvers import radau_run
+
+G = 9.81
+
+
+def boxes(n=8, a=0.1):
+    """n tilted boxes of side a [m] dropped in layers of four on the floor, all pairs in one contact."""
+    rng = np.random.default_rng(3)
+    m = mb.Model(gravity=(0, 0, -G))
+    shapes = []
+    for i in range(n):
+        b = m.add_body(f"b{i}", 1.0, (a * a / 6,) * 3, position=(0.18 * (i % 2) + 0.09 * (i // 4), 0.18 * ((i // 2) % 2) + 0.09 * (i // 4),
+                                                    0.1 + 0.2 * (i // 4)),
+                       orientation=Rotation.from_rotvec(rng.uniform(-0.4, 0.4, 3)).as_matrix())
+        shapes.append(b.add_shape("geo", mb.Box((a, a, a))))
+    m.add_contact("c", [mb.Plane(m.ground, (0, 0, 0), (0, 0, 1))] + shapes, shapes, 1e5, 1.5, 50.0, 1e-3,
+                  mu=0.5, friction_velocity=1e-2)
+    return m
+
+
+def test_contact_trial_decided_after_its_first_part_and_matches_dop853():
+    m = boxes()
+    res = mb.simulate(m, 1.0, 0.01, rtol=1e-5, monitor=False)
+    ref = mb.simulate(m, 1.0, 0.01, method="dop853", rtol=1e-5, monitor=False)
+    st = res.stats
+    hist = [h[1:] for h in st["order_history"]]
+    assert hist == [("DOP853 (compiled)", 8), ("Radau", 5), ("DOP853 (compiled)", 8)], st["order_history"]
+    t_s, t_back = st["order_history"][1][0], st["order_history"][2][0]
+    assert f"until t = {t_s:.6g} s, then Radau" in st["method"]
+    # the hand-back is the first output time PROBE_STEPS of DOP853's mean steps after the switch, well
+    # before the full trial's PROBE_SHARE of the time left
+    assert t_back < t_s + radau_run.PROBE_SHARE * (1.0 - t_s), (t_s, t_back)
+    for b in m.bodies:
+        assert np.max(np.abs(res.position(b) - ref.position(b))) < 1e-3
+    assert abs(res.kinetic_energy()[-1] - ref.kinetic_energy()[-1]) < 1e-3
