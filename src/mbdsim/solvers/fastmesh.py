@@ -4,7 +4,8 @@ A mesh shape (geometry.pack) has its triangles (sc[22]: vertex rows of sc[7], in
 bounding-volume hierarchy) and that hierarchy (sc[27]: each node's box in the mesh's local axes [m];
 sc[28]: left and right child, or -1 and the node's first triangle and count), both built at pack time
 (geometry.bvh).  `mesh_points` walks the hierarchy with the convex shape's bounding box (in the mesh's
-axes) and its bounding sphere (a node's box must meet both; an explicit stack, sc[30]) and, per triangle met (its outward normal m by the right-hand rule):
+axes) and its bounding sphere (a node's box must meet both; an explicit stack, sc[30]) and, per triangle
+met (its outward normal m by the right-hand rule):
 
 * a sphere, and each end sphere of a capsule: the closest point of the triangle (face, edge or vertex),
   touching when nearer than the radius, with the normal from that point to the centre;

@@ -84,6 +84,20 @@ def _lu_solve(A, piv, b):
     lu_solve(A, piv, A.shape[0], b)
 
 
+@kernel(_nrt=False, inline="always")
+def _fd_step(y_j):
+    """Forward-difference step for a state component y_j: sqrt(eps max(1e-5, |y_j|)), as radau5.f."""
+    return np.sqrt(2.220446049250313e-16 * max(1e-5, abs(y_j)))
+
+
+@kernel(_nrt=False, inline="always")
+def _fd_entry(ft_i, f_i, d):
+    """The difference quotient (ft_i - f_i) / d; 1e-300 where it rounds to 0 although f_i changed (the
+    entry stays in the sparsity pattern the column groups are made from)."""
+    v = (ft_i - f_i) / d
+    return v if v != 0.0 or ft_i == f_i else 1e-300
+
+
 @kernel(_nrt=False)
 def _full_jacobian(cm, wk, t, y, f, Jm, yt, ft):
     """Jm = df/dy at (t, y) (f = f(t, y)) by forward differences, step sqrt(eps max(1e-5, |y_j|)) as
@@ -92,16 +106,14 @@ def _full_jacobian(cm, wk, t, y, f, Jm, yt, ft):
     for i in range(n):
         yt[i] = y[i]
     for j in range(n):
-        d = np.sqrt(2.220446049250313e-16 * max(1e-5, abs(y[j])))
-        yt[j] = y[j] + d
+        yt[j] = y[j] + _fd_step(y[j])
         d = yt[j] - y[j]   # the step actually taken (representable)
         s_ = rhs(cm, wk, t, yt, ft, bool(True))
         yt[j] = y[j]
         if s_ != OK:
             return s_
         for i in range(n):
-            v = (ft[i] - f[i]) / d
-            Jm[i, j] = v if v != 0.0 or ft[i] == f[i] else 1e-300
+            Jm[i, j] = _fd_entry(ft[i], f[i], d)
     return OK
 
 
@@ -162,8 +174,7 @@ def _jacobian(cm, wk, t, y, f, Jm, S, st, stats):
     for g in range(G):
         for j in range(n):
             if grp[j] == g:
-                d = np.sqrt(2.220446049250313e-16 * max(1e-5, abs(y[j])))
-                yt[j] = y[j] + d
+                yt[j] = y[j] + _fd_step(y[j])
                 dj[j] = yt[j] - y[j]
         s_ = rhs(cm, wk, t, yt, ft, bool(True))
         stats[2] += 1
@@ -171,9 +182,10 @@ def _jacobian(cm, wk, t, y, f, Jm, S, st, stats):
             if grp[j] == g:
                 yt[j] = y[j]
                 for i in range(n):
-                    if Jm[i, j] != 0.0:   # the row's one column in this group (the pattern is kept: no zeros)
-                        v = (ft[i] - f[i]) / dj[j]
-                        Jm[i, j] = v if v != 0.0 or ft[i] == f[i] else 1e-300
+                    if Jm[i, j] != 0.0:   # the row's one column in this group (of the last full pattern,
+                        # kept: an exact zero is stored as 1e-300, so the entry is read again next time)
+                        v = _fd_entry(ft[i], f[i], dj[j])
+                        Jm[i, j] = v if v != 0.0 else 1e-300
         if s_ != OK:
             st[11] = JAC_REFRESH
             return s_
