@@ -5,7 +5,7 @@ import bisect
 
 import numpy as np
 from ..model.joint_kinds import is_angle
-from ..system.frames import Frames, cross
+from ..system.frames import Frames, point_state
 
 
 class State:
@@ -69,7 +69,7 @@ class State:
             return _one(self._res.position(target, frame))
         fid, s_B, _ = _where(self.system, target)
         fr = self._frames()
-        return fr.r[fid] + fr.A[fid].dot(s_B) if s_B is not None else fr.r[fid].copy()
+        return point_state(fr, fid, s_B, False)[0] if s_B is not None else fr.r[fid].copy()
 
     def velocity(self, target, frame=None, relative_to=None):
         """Velocity [m/s] (3,) of a body's CM or a marker origin (Result.velocity at this instant)."""
@@ -77,9 +77,7 @@ class State:
             return _one(self._res.velocity(target, frame, relative_to))
         fid, s_B, _ = _where(self.system, target)
         fr = self._frames()
-        if s_B is None:
-            return fr.rd[fid].copy()
-        return fr.rd[fid] + cross(fr.w[fid], fr.A[fid].dot(s_B))
+        return point_state(fr, fid, s_B, False)[1] if s_B is not None else fr.rd[fid].copy()
 
     def angular_velocity(self, target, frame=None, relative_to=None):
         """Angular velocity [rad/s] (3,) of the body of `target`, ground axes (Result.angular_velocity)."""

@@ -110,7 +110,6 @@ class PythonLoads:
                 cb.target = self
         if self.elems:
             self.ctl[0] = self._address(self._call)
-            self.ctl[3] = int(all_applied(self.elems))   # their power is the applied loads' work (fastenergy)
         if cm.python_drivers:
             fns = sys.derived["packed"][6]
             drv, owner = sys.derived["packed"][5], sys.row_owner
@@ -130,6 +129,7 @@ class PythonLoads:
         self.evals = [(evaluator(e), e) for e in self.elems]
         self._load_entity = "load '" + ", ".join(e.name for e in self.elems) + "'"
         self.applied = bool(self.elems) and all_applied(self.elems)
+        self.ctl[3] = int(self.applied)   # their power is the applied loads' work (fastenergy)
         # fasttree.to_maximal's model arguments (the absolute state from the kernel's frames)
         self._tree = (cm.tree, cm.p_idx, cm.r_idx, cm.rd_idx, cm.w_idx, cm.rigid_fid)
         self._nq, self._ny = sys.nq, sys.nq + sys.nv

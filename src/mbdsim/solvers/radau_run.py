@@ -333,23 +333,22 @@ def _after_probe(sys, rep, res, probe, rest, explicit, rr, tol, progress, reason
     stiffness test; joined, statistics summed."""
     from .autoswitch import _Joined, join
     from .compiled_run import integrate_compiled
+    way = _radau_under_way(probe, rr)
+    h_d, rate_d = explicit
+    if not (way is not None and PAY * way[1] > rate_d):
+        return _radau_on(sys, rep, res, probe, rest, rr, tol, progress)[2]
     t_p = float(rest[0])
     rep_p = dataclasses.replace(rep, t=t_p, q=np.array(probe.q[-1]), v=np.array(probe.v[-1]))
-    way = _radau_under_way(probe, rr)
     prog = None if progress is None else _Joined(progress, res, t_p)
-    h_d, rate_d = explicit
-    explicit = way is not None and PAY * way[1] > rate_d
-    third = integrate_compiled(sys, rep_p, rest, *tol, progress=prog) if explicit else \
-        _integrate(sys, rep_p, RadauRun.sharing(rr, *tol), rest, prog)
+    third = integrate_compiled(sys, rep_p, rest, *tol, progress=prog)
     out = join(res, third, t_p)
     stats = _summed(res.stats, third.stats)
-    if explicit:
-        t_s = float(res.stats.get("switch_time", probe.time[0]))   # (the trial may be two parts of Radau)
-        stats["order_history"] = list(stats["order_history"]) + [(t_p, third.stats["method"], 8)]
-        stats["method"] = (f"auto: {third.stats['method']} until t = {t_s:.6g} s, then {METHOD} until t = "
-                           f"{t_p:.6g} s, then {third.stats['method']} ({reason}; Radau IIA's steps {way[0]:.3g} s "
-                           f"at {way[1]:.3g} evaluations per second of model time, DOP853's {h_d:.3g} s at "
-                           f"{rate_d:.3g}: DOP853 on, without the stiffness test)")
-        stats["order"] = 8
+    t_s = float(res.stats.get("switch_time", probe.time[0]))   # (the trial may be two parts of Radau)
+    stats["order_history"] = list(stats["order_history"]) + [(t_p, third.stats["method"], 8)]
+    stats["method"] = (f"auto: {third.stats['method']} until t = {t_s:.6g} s, then {METHOD} until t = "
+                       f"{t_p:.6g} s, then {third.stats['method']} ({reason}; Radau IIA's steps {way[0]:.3g} s "
+                       f"at {way[1]:.3g} evaluations per second of model time, DOP853's {h_d:.3g} s at "
+                       f"{rate_d:.3g}: DOP853 on, without the stiffness test)")
+    stats["order"] = 8
     out.stats = stats
     return out

@@ -48,9 +48,8 @@ class ForceEval:
         the point) with power=True, else 0."""
         fid = sys.fid[elem.body]
         F = _vector(elem, elem.force, t, state, fr, sys, "force")
-        s = fr.A[fid].dot(elem.s_B)
-        add_point_force(sys, fr, Q, fid, s, F)
-        return float(F.dot(fr.rd[fid] + cross(fr.w[fid], s))) if power else 0.0
+        add_point_force(sys, fr, Q, fid, fr.A[fid].dot(elem.s_B), F)
+        return float(F.dot(point_state(fr, fid, elem.s_B, False)[1])) if power else 0.0
 
     @staticmethod
     def generalized(sys, fr, elem, t, state):
