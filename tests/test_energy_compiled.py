@@ -108,6 +108,27 @@ def test_joint_friction_block_coasting_to_rest():
     assert res.diagnostics.energy_error is not None and res.diagnostics.summary()["energy_error"] < 1e-8
 
 
+def test_friction_power_with_a_kink_inside_the_steps():
+    """A block sliding on a ground slide (no gravity) pressed sideways by F_y = c (t - t_k): the normal load
+    |c (t - t_k)| has a kink at t_k, inside a step (at rtol=1e-9 the step is refined: the power has a kink
+    where the state's acceleration has one, which its error control sees less). Closed form: v = v0 - mu c G(t) / m, G = (t_k^2 + sgn(t - t_k) (t - t_k)^2)
+    / 2, and D = m (v0^2 - v^2) / 2, at every output, also those inside the refined steps."""
+    m, v0, mu, c, tk = 1.0, 1.0, 0.3, 20.0, 0.1337
+    mdl = mb.Model("kink", gravity=(0, 0, 0))
+    blk = mdl.add_particle("block", m, (0, 0, 0), velocity=(v0, 0, 0))
+    slide = mdl.add_translational("slide", mdl.ground, blk, (0, 0, 0), (1, 0, 0))
+    mdl.add_friction("friction", slide, mu, mu)
+    mdl.add_force("side", (blk, (0, 0, 0)), ("0", f"{c}*(TIME-{tk})", "0"))
+    for rtol, tol, tol_balance in ((None, 3e-6, 1e-8), (1e-9, 2e-10, 2e-9)):
+        res = mb.simulate(mdl, 0.3, 0.0005, **({} if rtol is None else {"rtol": rtol}))
+        D = _compiled(res)
+        t = res.time
+        v = v0 - mu * c / m * (tk ** 2 + np.sign(t - tk) * (t - tk) ** 2) / 2
+        assert np.max(np.abs(D - 0.5 * m * (v0 ** 2 - v ** 2))) < tol * 0.5 * m * v0 ** 2
+        E = res.kinetic_energy()
+        assert np.max(np.abs(E[0] - E - D)) < tol_balance * E[0]   # the run's own balance
+
+
 def test_applied_force_work_torsion_spring_and_stop():
     """A wheel on a revolute (joint coordinates) driven by a constant torque, a damped torsion spring and a
     damped stop it hits: W = T theta exactly, D against the quadrature, and the balance T + V + D - W."""

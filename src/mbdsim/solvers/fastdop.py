@@ -250,7 +250,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
             while iout < tout.shape[0] and tout[iout] < t_new - tol_end:
                 to = tout[iout]
                 if energy and iout < ZO.shape[0]:
-                    stats[2] += energy_output(cm, wk, F, y, t, h, to, rtol, ys, scale, ZO[iout])
+                    energy_output(wk, t, h, to, ZO[iout])
                 _dense(F, y, t, h, to, yo)
                 s_ = _project(cm, wk, to, yo, proj_tol, bool(False))
                 stats[3] += 1
@@ -267,7 +267,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 stats[2] += 3
             if t_ev < np.inf:
                 if energy:
-                    energy_event(cm, wk, co, F, y, t, h, t_ev, rtol, ys, scale)
+                    energy_event(co, wk, t, h, t_ev)
                 return _end_at(cm, wk, F, y, t, h, t_ev, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(True), FRICTION_EVENT)
         if n_sensors > 0:
@@ -280,7 +280,7 @@ def run(cm, wk, co, st, y, f, t_end, tout, iout, Y, rtol, atol, max_step, max_st
                 return SENSOR_FAILED, drop_after(tout, iout, t)
             if t_stop < np.inf:   # a "stop" sensor: the outputs up to its time, and the state there
                 if energy:
-                    energy_event(cm, wk, co, F, y, t, h, t_stop, rtol, ys, scale)
+                    energy_event(co, wk, t, h, t_stop)
                 return _end_at(cm, wk, F, y, t, h, t_stop, tout, iout, proj_tol, st, stats, yo, bool(False),
                                bool(False), SENSOR_STOP)
         for i in range(n):

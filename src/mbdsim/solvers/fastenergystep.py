@@ -15,10 +15,13 @@ from .fastdyn import rhs
 
 # ---------------------------------------------------------------- energy bookkeeping (solvers.fastenergy)
 # wk[53] (system.compiled.energy_work): 0 pw [on, P, P_applied] of the last loads evaluation, 1 flags
-# [record overflow, this step refined], 2 the powers at the state of f (the next step's first stage), 3 the
-# stage powers (16, 2), 4 z = [D, W] [J] at the step's start, 5 z at its end, 6 z's dense output coefficients
-# (7, 2), 7 scratch (2,), 8 z at the outputs (nout, 2), 9-10 the shape contacts' point records, 11 the
-# refinement's interval stack (64, 4), 12 its scratch (3, 2), 13 [the largest kinetic energy at a step's end so
+# [record overflow, this step refined, its pieces], 2 the powers at the state of f (the next step's first
+# stage), 3 the stage powers (16, 2), 4 z = [D, W] [J] at the step's start, 5 z at its end, 6 z's dense output
+# coefficients (7, 2), 7 scratch (2,), 8 z at the outputs (nout, 2), 9-10 the shape contacts' point records,
+# 11 the refinement's pieces (system.compiled.REFINE_PIECES, 23): [lo, hi, P at the nine nodes of its two
+# halves' Gauss-Lobatto rules (lo, three inner, the middle, three inner, hi), the same for P_applied, the
+# error estimate |halves - whole| [J], the halves' integrals of P and P_applied [J]], 12 its scratch
+# (3, 2, 9): two pieces' own nodes, a piece's nine, 13 [the largest kinetic energy at a step's end so
 # far [J]] (the energy scale of z's tolerance, as the monitor's). z' = [P, P_applied] is a quadrature state of
 # the step: integrated with DOP853's weights and dense output from the stage powers, not in the error norm
 # (the steps are the same with and without it). Where P is not smooth over a step (contact onset and
@@ -31,6 +34,8 @@ from .fastdyn import rhs
 # the step (a contact that separates just after the step's start), where Gauss points may all miss it
 GL_X = np.array([-1.0, -np.sqrt(3.0 / 7.0), 0.0, np.sqrt(3.0 / 7.0), 1.0])
 GL_W = np.array([0.1, 49.0 / 90.0, 32.0 / 45.0, 49.0 / 90.0, 0.1])
+# the monomial coefficients of the Lagrange basis on those nodes: L_g(x) = sum_p LAGRANGE[g, p] x^p
+LAGRANGE = np.ascontiguousarray(np.linalg.inv(np.vander(GL_X, 5, increasing=True)).T)
 REFINE_SPLIT = 4      # a refined integral starts from this many equal pieces
 REFINE_EVALS = 4000   # power evaluations one refined integral takes at most
 
@@ -71,67 +76,143 @@ def energy_at(wk, t0, h, t, out):
 
 
 @kernel(_nrt=False)
-def energy_event(cm, wk, co, F, y, t0, h, t_ev, rtol, yq, yd):
+def energy_event(co, wk, t0, h, t_ev):
     """z at an event t_ev [s] inside the step (t0, h) where the run ends or restarts (its dense output
     computed: after `_dense_coeffs`; `energy_output`)."""
     en = wk[53]
     energy_dense(co, wk, h)
-    energy_output(cm, wk, F, y, t0, h, t_ev, rtol, yq, yd, en[7])
+    energy_output(wk, t0, h, t_ev, en[7])
     en[4][0] = en[7][0]
     en[4][1] = en[7][1]
 
 
-@kernel(_nrt=False)
-def _power_gl(cm, wk, F, y, t0, h, a, b, yq, yd, out):
-    """5-point Gauss-Lobatto of the powers [P, P_applied] over [a, b] inside the step (t0, h) on its dense
-    output (F, y) into out (2,) [J]; rhs at each point (yq, yd: scratch of the state's size)."""
+@kernel(_nrt=False, inline="always")
+def _power_at(cm, wk, F, y, t0, h, x, yq, yd, v, j):
+    """The powers [P, P_applied] [W] at x [s] on the step's dense output (F, y) into v[0, j], v[1, j] (rhs
+    there; yq, yd: scratch of the state's size)."""
     pw = wk[53][0]
-    out[0] = 0.0
-    out[1] = 0.0
-    half, mid = 0.5 * (b - a), 0.5 * (a + b)
-    for g in range(5):
-        x = mid + half * GL_X[g]
-        _dense(F, y, t0, h, x, yq)
-        rhs(cm, wk, x, yq, yd, bool(True))
-        out[0] += GL_W[g] * half * pw[1]
-        out[1] += GL_W[g] * half * pw[2]
+    _dense(F, y, t0, h, x, yq)
+    rhs(cm, wk, x, yq, yd, bool(True))
+    v[0, j] = pw[1]
+    v[1, j] = pw[2]
 
 
 @kernel(_nrt=False)
-def _power_integral(cm, wk, F, y, t0, h, a, b, tol, yq, yd, out):
-    """The integral of the powers over [a, b] inside the step (t0, h) on its dense output into out (2,) [J],
-    by adaptive bisection of `_power_gl` from REFINE_SPLIT pieces until halves agree to tol [J] (its share
-    (b - a) / span of it, at least 1e-3 of it: a kink is resolved to tol / 1000); returns the power
-    evaluations made."""
+def _pair(cm, wk, F, y, t0, h, lo, hi, P5, row, yq, yd):
+    """Piece [lo, hi] of the refinement into the record `row` of wk[53][11] (module comment): from the powers
+    P5 (2, 5) at its own Gauss-Lobatto nodes, the powers at its halves' six interior nodes (evaluated here),
+    the halves' integral and its error estimate |halves - whole| [J] (zero at round-off)."""
+    R = wk[53][11][row]
+    R[0], R[1] = lo, hi
+    hw = 0.25 * (hi - lo)
+    V = wk[53][12][2]
+    for c in range(2):
+        V[c, 0], V[c, 4], V[c, 8] = P5[c, 0], P5[c, 2], P5[c, 4]
+    for k in range(2):
+        centre = lo + (2 * k + 1) * hw
+        for g in range(1, 4):
+            _power_at(cm, wk, F, y, t0, h, centre + hw * GL_X[g], yq, yd, V, 4 * k + g)
+    err, big = 0.0, 0.0
+    for c in range(2):
+        whole, halves = 0.0, 0.0
+        for g in range(5):
+            whole += GL_W[g] * P5[c, g]
+            halves += GL_W[g] * (V[c, g] + V[c, 4 + g])
+            big = max(big, abs(P5[c, g]))
+        for j in range(9):
+            R[2 + 9 * c + j] = V[c, j]
+            big = max(big, abs(V[c, j]))
+        R[21 + c] = hw * halves
+        err += abs(hw * halves - 2.0 * hw * whole)
+    R[20] = err if err > 1e-13 * (hi - lo) * big else 0.0
+
+
+@kernel(_nrt=False)
+def _power_integral(cm, wk, F, y, t0, h, tol, yq, yd, out):
+    """The integral of the powers over the step (t0, h) on its dense output into out (2,) [J]: an adaptive
+    Gauss-Lobatto quadrature with a global error criterion (QUADPACK's): from REFINE_SPLIT pieces, the piece
+    whose halves disagree most with it is split (its halves' nodes reused: 6 evaluations a split) until the
+    estimates sum to at most tol [J], the records are full or REFINE_EVALS evaluations are spent (a kink is
+    resolved to what tol needs, not to its length's share). The pieces stay in wk[53][11] (their count in
+    wk[53][1][2]) for the partial integrals at the step's outputs (`_partial`); returns the evaluations."""
     en = wk[53]
-    S, g = en[11], en[12]
-    span = b - a
-    for k in range(REFINE_SPLIT):   # pushed last piece first: the first is integrated first
-        lo = a + span * (REFINE_SPLIT - 1 - k) / REFINE_SPLIT
-        hi = b if k == 0 else a + span * (REFINE_SPLIT - k) / REFINE_SPLIT
-        _power_gl(cm, wk, F, y, t0, h, lo, hi, yq, yd, g[0])
-        S[k, 0], S[k, 1], S[k, 2], S[k, 3] = lo, hi, g[0, 0], g[0, 1]
-    top, nev = REFINE_SPLIT, 5 * REFINE_SPLIT
+    R, G = en[11], en[12]
+    P5 = G[0]
+    nev = 0
+    for k in range(REFINE_SPLIT):
+        lo, hi = t0 + h * k / REFINE_SPLIT, (t0 + h) if k == REFINE_SPLIT - 1 else t0 + h * (k + 1) / REFINE_SPLIT
+        mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+        for g in range(5):
+            if g == 0 and k > 0:   # the previous piece's end
+                P5[0, 0], P5[1, 0] = R[k - 1, 10], R[k - 1, 19]
+                continue
+            _power_at(cm, wk, F, y, t0, h, mid + half * GL_X[g], yq, yd, P5, g)
+            nev += 1
+        _pair(cm, wk, F, y, t0, h, lo, hi, P5, k, yq, yd)
+        nev += 6
+    n = REFINE_SPLIT
+    while True:
+        total, worst, j = 0.0, 0.0, -1
+        for i in range(n):
+            total += R[i, 20]
+            if R[i, 20] > worst:
+                worst, j = R[i, 20], i
+        if total <= tol or j < 0 or n >= R.shape[0] or nev + 12 > REFINE_EVALS:
+            break
+        lo, hi = R[j, 0], R[j, 1]
+        if hi - lo <= 1e-9 * h:   # not to be split further: its estimate no longer counts
+            R[j, 20] = 0.0
+            continue
+        mid = 0.5 * (lo + hi)
+        for c in range(2):   # its halves' nodes: the new pieces' own
+            for g in range(5):
+                G[0, c, g] = R[j, 2 + 9 * c + g]
+                G[1, c, g] = R[j, 2 + 9 * c + 4 + g]
+        _pair(cm, wk, F, y, t0, h, lo, mid, G[0], j, yq, yd)
+        _pair(cm, wk, F, y, t0, h, mid, hi, G[1], n, yq, yd)
+        n += 1
+        nev += 12
     out[0] = 0.0
     out[1] = 0.0
-    while top > 0:
-        top -= 1
-        lo, hi, c0, c1 = S[top, 0], S[top, 1], S[top, 2], S[top, 3]
-        mid = 0.5 * (lo + hi)
-        _power_gl(cm, wk, F, y, t0, h, lo, mid, yq, yd, g[1])
-        _power_gl(cm, wk, F, y, t0, h, mid, hi, yq, yd, g[2])
-        nev += 10
-        f0, f1 = g[1, 0] + g[2, 0], g[1, 1] + g[2, 1]
-        share = max((hi - lo) / span, 1e-3) if span > 0.0 else 1.0
-        if abs(f0 - c0) + abs(f1 - c1) <= tol * share or top + 2 > S.shape[0] or nev >= REFINE_EVALS \
-                or hi - lo <= 1e-9 * h:
-            out[0] += f0
-            out[1] += f1
-            continue
-        S[top, 0], S[top, 1], S[top, 2], S[top, 3] = mid, hi, g[2, 0], g[2, 1]
-        S[top + 1, 0], S[top + 1, 1], S[top + 1, 2], S[top + 1, 3] = lo, mid, g[1, 0], g[1, 1]
-        top += 2
+    for i in range(n):
+        out[0] += R[i, 21]
+        out[1] += R[i, 22]
+    en[1][2] = n
     return nev
+
+
+@kernel(_nrt=False)
+def _partial(wk, t, out):
+    """The integral of the powers from the refined step's start to t [s] inside it into out (2,) [J]: the
+    pieces before t whole, the one holding t through the quartic interpolant of its half's five nodes."""
+    en = wk[53]
+    R = en[11]
+    out[0] = 0.0
+    out[1] = 0.0
+    for i in range(en[1][2]):
+        lo, hi = R[i, 0], R[i, 1]
+        if hi <= t:
+            out[0] += R[i, 21]
+            out[1] += R[i, 22]
+            continue
+        if lo >= t:
+            continue
+        hw = 0.25 * (hi - lo)
+        k = 0 if t <= lo + 2.0 * hw else 1
+        X = (t - (lo + (2 * k + 1) * hw)) / hw   # local coordinate of t in its half, [-1, 1]
+        for c in range(2):
+            acc = 0.0
+            if k == 1:   # the left half whole
+                for g in range(5):
+                    acc += GL_W[g] * R[i, 2 + 9 * c + g]
+            for g in range(5):
+                q, xp, mp = 0.0, X, -1.0
+                for p in range(5):
+                    q += LAGRANGE[g, p] * (xp - mp) / (p + 1)
+                    xp *= X
+                    mp *= -1.0
+                acc += q * R[i, 2 + 9 * c + 4 * k + g]
+            out[c] += hw * acc
 
 
 @kernel(_nrt=False)
@@ -189,28 +270,25 @@ def energy_flag(co, wk, h, rtol):
 @kernel(_nrt=False)
 def energy_refine(cm, wk, F, y, t0, h, rtol, yq, yd):
     """z at the end of a flagged step (t0, h) from the adaptive quadrature of the powers on its dense output
-    (F computed); marks the step refined (wk[53][1][1] = 1: its outputs and events integrate too); returns
-    the power evaluations made."""
+    (F computed); marks the step refined (wk[53][1][1] = 1: its outputs and events read the quadrature's
+    pieces); returns the power evaluations made."""
     en = wk[53]
     z, zn, out = en[4], en[5], en[7]
     tol = _energy_tol(wk, rtol, zn[0] - z[0], zn[1] - z[1])
-    nev = _power_integral(cm, wk, F, y, t0, h, t0, t0 + h, tol, yq, yd, out)
+    nev = _power_integral(cm, wk, F, y, t0, h, tol, yq, yd, out)
     zn[0], zn[1] = z[0] + out[0], z[1] + out[1]
     en[1][1] = 1
     return nev
 
 
 @kernel(_nrt=False)
-def energy_output(cm, wk, F, y, t0, h, t, rtol, yq, yd, out):
+def energy_output(wk, t0, h, t, out):
     """z at t [s] inside the step (t0, h) into out (2,): its dense output (after `energy_dense`), or in a
-    refined step the adaptive quadrature from t0; returns the power evaluations made."""
+    refined step the quadrature's pieces up to t (`_partial`)."""
     en = wk[53]
     if en[1][1] == 0:
         energy_at(wk, t0, h, t, out)
-        return 0
-    z, zn = en[4], en[5]
-    tol = _energy_tol(wk, rtol, zn[0] - z[0], zn[1] - z[1])
-    nev = _power_integral(cm, wk, F, y, t0, h, t0, t, tol, yq, yd, out)
-    out[0] += z[0]
-    out[1] += z[1]
-    return nev
+        return
+    _partial(wk, t, out)
+    out[0] += en[4][0]
+    out[1] += en[4][1]

@@ -198,22 +198,25 @@ class Work:
         return s
 
 
+REFINE_PIECES = 96   # pieces the energy refinement of one step keeps at most (solvers.fastenergystep)
+
+
 def energy_work(n_outputs: int = -1, shape_contacts: bool = False) -> tuple:
     """Slot 53 of the work arrays: the energy bookkeeping of a compiled run (solvers.fastenergy, the step
     loop's in solvers.fastenergystep): 0 [on (1.0) or off (0.0), dissipation power P [W], applied loads' power
-    [W]] of the last loads evaluation, 1 flags [shape-contact records overflowed, the step refined] (int64),
+    [W]] of the last loads evaluation, 1 flags [shape-contact records overflowed, the step refined, its pieces] (int64),
     2 the powers at the state of the step's f (2,), 3 the stage powers (16, 2), 4 z = [D, W] [J] since the
     run's start at the step's start, 5 z at its end, 6 z's dense output coefficients (7, 2), 7 scratch (2,), 8 z at each output
     (n_outputs, 2), 9 the shape contacts' point records (force_elements.shape_contact.MAX_POINTS, NREC) and
-    10 their count (1,) (int64), 11 the refinement's interval stack (64, 4), 12 its scratch (3, 2), 13 [the
+    10 their count (1,) (int64), 11 the refinement's pieces (REFINE_PIECES, 23), 12 its scratch (3, 2, 9), 13 [the
     largest kinetic energy at a step's end [J]] (solvers.fastenergystep). Off (n_outputs < 0): empty outputs and records."""
     from ..solvers.fastcontact import NREC
     from .force_elements.shape_contact import MAX_POINTS
     on = n_outputs >= 0
     z = np.zeros
-    return (np.array([1.0 if on else 0.0, 0.0, 0.0]), z(2, np.int64), z(2), z((16, 2)), z(2), z(2), z((7, 2)),
+    return (np.array([1.0 if on else 0.0, 0.0, 0.0]), z(3, np.int64), z(2), z((16, 2)), z(2), z(2), z((7, 2)),
             z(2), z((max(n_outputs, 0), 2)), z((MAX_POINTS if on and shape_contacts else 0, NREC)),
-            z(1, np.int64), z((64, 4)), z((3, 2)), z(1))
+            z(1, np.int64), z((REFINE_PIECES, 23)), z((3, 2, 9)), z(1))
 
 
 def _coord_work(cm, nf) -> tuple:
