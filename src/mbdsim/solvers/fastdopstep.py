@@ -17,7 +17,7 @@ from ._dop853_tableau import coefficients as _c   # scipy's tableau, without imp
 from ..system.exprloads_kernel import sensor_values
 from ..system.kernels import frames_into
 from . import fastenergy, fastfriction, fasttree
-from .fastdyn import OK, _to6, accelerations, normalize_into, project, rhs, tree_project
+from .fastdyn import OK, _constraints, _to6, accelerations, normalize_into, project, rhs, tree_project
 
 N_STAGES = _c.N_STAGES
 SENSOR_XTOL = 1e-13    # [s]: sensor times are located on the dense output to this
@@ -101,14 +101,23 @@ def _sensor_g(cm, wk, t, y, yo, g):
 @kernel(_nrt=False)
 def _friction_g(cm, wk, t, y, yo, g):
     """Each joint-friction element's switching function (solvers.fastfriction.switching) at the
-    integrator's state y at t [s] into g, from the coupled solve there (Euler parameters normalised in
-    the copy yo); status of that solve."""
+    integrator's state y at t [s] into g (Euler parameters normalised in the copy yo), from the coupled
+    solve there; status of that solve. Where no element sticks or is held (slip or none only) the values
+    are joint rates: the rows at y suffice, and no solve is made."""
     fw = wk[50]
     nq = cm[31][0]
     for i in range(y.shape[0]):
         yo[i] = y[i]
     normalize_into(cm, yo[:nq])
-    s_ = accelerations(cm, wk, t, yo[:nq], yo[nq:], yo[:nq], fw[12], fw[13], bool(True))
+    rates = True
+    for e in range(fw[0].shape[0]):
+        if fw[0][e] == 2 or fw[20][e] >= 0:
+            rates = False
+    if rates:
+        _constraints(cm, wk, t, yo[:nq], yo[nq:])
+        s_ = OK
+    else:
+        s_ = accelerations(cm, wk, t, yo[:nq], yo[nq:], yo[:nq], fw[12], fw[13], bool(True))
     _to6(cm, yo[nq:], fw[14])
     fastfriction.switching(cm[48], fw, wk[5], cm[12], cm[13], wk[1], fw[13], fw[14], g)
     return s_

@@ -42,11 +42,12 @@ the last accepted step (k,), 3 unit accelerations (k, nf, 6), 4 unit multipliers
 scratch (nf, 6), 6 zeros (nc), 7 S (k, k), 8 right-hand side (k,), 9 f (k,), 10 previous f (k,),
 11 frozen term directions (k, 4, 3), 12 vd (nv), 13 lambda (nc) and 14 v (nf, 6) of the switching
 functions, 15 [failed element + 1, iterations] int64, 16 new switching values (k,), 17 reaction
-scratch (3, 3), 18 switching scratch (k,), 19 combined multipliers (nc), 20 held group (k,) int64 (the
+scratch (3, 3), 18 switching scratch (k,), 19 the stick rows' right-hand sides (k,), 20 held group (k,) int64 (the
 group's id, its first sticking element, for its sticking and held members; -1: none), 21 the held
 members' lock rows in the sticking ones' c_h (k, k) (row h, column a), 22 static capacities (k,),
 23 generators (k, k), 24 orthonormal basis (k, k), 25 members (k,) int64, 26 subset indices (k,) int64,
-27 the LU row swaps of S (k,) int64.
+27 the LU row swaps of S (k,) int64, 28 the slip elements' reactions (`reaction`) of lam and of each unit
+solution (k, k + 1, 3, 3), 29 the stick rows of S (k, k).
 """
 from __future__ import annotations
 
@@ -150,47 +151,56 @@ def _small_solve(fw, S, b, x):
 def couple(fc, fw, Jc, bi, bj, A, gamma, x6, lam):
     """The friction loads f of the elements with a mode (module docstring) from the frictionless solution
     x6 (nf, 6), lam (nc) and the unit solutions in fw; x6 and lam become the coupled solution, with
-    lam[lock] = f. Returns True, or False with fw[15][0] = element + 1 when the iteration does not
-    converge in MAXIT solves or the k x k system is singular (fw[15][1]: solves done)."""
+    lam[lock] = f. The stick rows and the slip elements' reactions of lam and of each unit solution are
+    the same in every iteration (computed once: the reaction at the current loads is their combination,
+    `reaction` being linear in the multipliers). Returns True, or False with fw[15][0] = element + 1 when
+    the iteration does not converge in MAXIT solves or the k x k system is singular (fw[15][1]: solves
+    done)."""
     mode, sdir, E6, EL = fw[0], fw[1], fw[3], fw[4]
-    S, rhs, f, fp, U, info, R, lamc = fw[7], fw[8], fw[9], fw[10], fw[11], fw[15], fw[17], fw[19]
+    S, rhs, f, fp, U, info, Rc = fw[7], fw[8], fw[9], fw[10], fw[11], fw[15], fw[17]
+    b0, RR, S0 = fw[19], fw[28], fw[29]
     lock = fc[0]
     k = mode.shape[0]
-    nc = lam.shape[0]
-    for e in range(k):
+    for e in range(k):   # the iteration's constants
         f[e] = 0.0
+        b0[e] = 0.0
+        for m in range(k):
+            S0[e, m] = 0.0
+        if mode[e] == 2:
+            r = lock[e]
+            for m in range(k):
+                if mode[m] != 0:
+                    S0[e, m] = _row_dot(Jc, bi, bj, r, E6[m])
+            b0[e] = gamma[r] - _row_dot(Jc, bi, bj, r, x6)
+        elif mode[e] == 1:
+            reaction(fc, e, Jc, bi, bj, A, lam, RR[e, 0])
+            for m in range(k):
+                if mode[m] != 0:
+                    reaction(fc, e, Jc, bi, bj, A, EL[m], RR[e, 1 + m])
     done = False
     worst = 0
     for it in range(MAXIT):
-        for i in range(nc):   # the multipliers at the current loads: the terms' directions
-            s = lam[i]
-            for m in range(k):
-                if mode[m] != 0:
-                    s += f[m] * EL[m, i]
-            lamc[i] = s
         for e in range(k):
             for m in range(k):
-                S[e, m] = 0.0
-            rhs[e] = 0.0
+                S[e, m] = S0[e, m]
+            rhs[e] = b0[e]
             if mode[e] == 0:
                 S[e, e] = 1.0
-            elif mode[e] == 2:
-                r = lock[e]
-                for m in range(k):
-                    if mode[m] != 0:
-                        S[e, m] = _row_dot(Jc, bi, bj, r, E6[m])
-                rhs[e] = gamma[r] - _row_dot(Jc, bi, bj, r, x6)
-            else:
+            elif mode[e] == 1:
                 c = fc[4][e, 1] * sdir[e]
-                reaction(fc, e, Jc, bi, bj, A, lamc, R)
-                normal_load(fc, e, A, R, U, True, False)
-                reaction(fc, e, Jc, bi, bj, A, lam, R)
-                rhs[e] = c * (fc[4][e, 2] + normal_load(fc, e, A, R, U, False, True))
+                for a in range(2):   # the reaction at the current loads: the terms' directions
+                    for d in range(3):
+                        x = RR[e, 0, a, d]
+                        for m in range(k):
+                            if mode[m] != 0:
+                                x += f[m] * RR[e, 1 + m, a, d]
+                        Rc[a, d] = x
+                normal_load(fc, e, A, Rc, U, True, False)
+                rhs[e] = c * (fc[4][e, 2] + normal_load(fc, e, A, RR[e, 0], U, False, True))
                 S[e, e] = 1.0
                 for m in range(k):
                     if mode[m] != 0:
-                        reaction(fc, e, Jc, bi, bj, A, EL[m], R)
-                        S[e, m] -= c * normal_load(fc, e, A, R, U, False, True)
+                        S[e, m] -= c * normal_load(fc, e, A, RR[e, 1 + m], U, False, True)
         for e in range(k):
             fp[e] = f[e]
         if not _small_solve(fw, S, rhs, f):
@@ -215,7 +225,7 @@ def couple(fc, fw, Jc, bi, bj, A, gamma, x6, lam):
         for fr in range(x6.shape[0]):
             for c in range(6):
                 x6[fr, c] += f[m] * E6[m, fr, c]
-        for i in range(nc):
+        for i in range(lam.shape[0]):
             lam[i] += f[m] * EL[m, i]
     for e in range(k):
         lam[lock[e]] = f[e] if mode[e] != 0 else 0.0

@@ -257,9 +257,9 @@ def _friction_work(fc, nf, nc, nv) -> tuple:
     k = len(fc[0])
     z = np.zeros
     return (np.zeros(k, np.int64), z(k), z(k), z((k, nf, 6)), z((k, nc)), z((nf, 6)), z(nc), z((k, k)), z(k), z(k),
-            z(k), z((k, 4, 3)), z(nv), z(nc), z((nf, 6)), np.zeros(2, np.int64), z(k), z((3, 3)), z(k), z(nc),
+            z(k), z((k, 4, 3)), z(nv), z(nc), z((nf, 6)), np.zeros(2, np.int64), z(k), z((3, 3)), z(k), z(k),
             np.full(k, -1, np.int64), z((k, k)), z(k), z((k, k)), z((k, k)), np.zeros(k, np.int64),
-            np.zeros(k, np.int64), np.zeros(k, np.int64))
+            np.zeros(k, np.int64), np.zeros(k, np.int64), z((k, k + 1, 3, 3)), z((k, k)))
 
 
 def _contacts(sys) -> tuple:
