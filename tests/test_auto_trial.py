@@ -1,6 +1,8 @@
 """auto's hand-over trial (solvers.radau_run.continue_radau): where Radau's first steps after the switch are
 settled at a few times DOP853's and cost more evaluations (tumbling boxes in compliant contact, which every
-method must resolve), DOP853 takes over after the trial's first part, and the run matches DOP853's own."""
+method must resolve), or stay well below DOP853's (a box sliding with friction: its lightly damped rocking on
+the four corners, which DOP853 steps over at its stability limit and Radau resolves), DOP853 takes over after
+the trial's first part, and the run matches DOP853's own."""
 import numpy as np
 from scipy.spatial.transform import Rotation
 
@@ -40,3 +42,31 @@ def test_contact_trial_decided_after_its_first_part_and_matches_dop853():
     for b in m.bodies:
         assert np.max(np.abs(res.position(b) - ref.position(b))) < 1e-3
     assert abs(res.kinetic_energy()[-1] - ref.kinetic_energy()[-1]) < 1e-3
+
+
+def test_radau_resolving_a_rocking_mode_hands_back_after_the_first_part():
+    """A box sliding down a 30 degree incline on its four corners (K = 1e6 N/m, mu = 0.3): friction's
+    moment excites the box's rocking on the corners (2450 rad/s, lightly damped, far above the tolerance);
+    DOP853 steps at its stability limit there (stiffness detected), Radau's steps resolve the rocking at a
+    fraction of DOP853's: DOP853 takes over after the trial's first part, and the run matches its own."""
+    theta = np.radians(30)
+    n = np.array([0.0, -np.sin(theta), np.cos(theta)])
+    t_dir = np.array([0.0, np.cos(theta), np.sin(theta)]) * -1.0
+    K, a = 1e6, 0.1
+    m = mb.Model(gravity=(0, 0, -G))
+    delta = G * np.cos(theta) / (4 * K)
+    R = Rotation.from_rotvec([theta, 0.0, 0.0]).as_matrix()
+    b = m.add_body("box", 1.0, (a * a / 6,) * 3, position=n * (a / 2 - delta), orientation=R, velocity=0.5 * t_dir)
+    m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), n), b.add_shape("geo", mb.Box((a, a, a))), K, 1.0, 400.0,
+                  1e-4, mu=0.3, friction_velocity=1e-3)
+    res = mb.simulate(m, 0.4, 0.005, rtol=1e-6, monitor=False)
+    ref = mb.simulate(m, 0.4, 0.005, method="dop853", rtol=1e-6, monitor=False)
+    st = res.stats
+    assert [h[1:] for h in st["order_history"]] == [("DOP853 (compiled)", 8), ("Radau", 5), ("DOP853 (compiled)", 8)], \
+        st["method"]
+    t_s, t_back = st["order_history"][1][0], st["order_history"][2][0]
+    assert t_back < t_s + radau_run.PROBE_SHARE * (0.4 - t_s), (t_s, t_back)
+    assert np.max(np.abs(res.position("box") - ref.position("box"))) < 1e-5
+    down = res.position("box") @ t_dir
+    acc = 2.0 * np.polyfit(res.time[res.time >= 0.1], down[res.time >= 0.1], 2)[0]
+    assert abs(acc / (G * (np.sin(theta) - 0.3 * np.cos(theta))) - 1) < 1e-3

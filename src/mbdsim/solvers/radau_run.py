@@ -219,6 +219,10 @@ PROBE_STEPS, PROBE_SHARE, PAY = 50, 0.1, 2.0
 # that a stiff model's implicit steps take (steps of DOP853's size or shorter: Radau still resolving a fast
 # mode the explicit run left excited, which its growing steps damp; the whole trial decides)
 SETTLED, EARLY = 2.0, 10.0
+# ... or, the same first part, where Radau's steps stay below RESOLVING times DOP853's without growing: it
+# resolves a fast mode that DOP853 steps over at its stability limit (a lightly damped rocking mode that
+# friction excites, its amplitude far above the tolerance), so it will not get cheaper
+RESOLVING = 0.5
 
 
 def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reason):
@@ -249,7 +253,8 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
     trial = not (run.joint_space or len(sys.lock_rows) or getattr(sys.model, "sensors", None))
     t_p = _probe_end(pre["stats"], float(times[0]), t_s, rest) if trial else None
     # the trial's first, short part (PROBE_STEPS of DOP853's steps): DOP853 on at once where Radau's steps
-    # stay within EARLY of DOP853's and cost more (contact that every method must resolve)
+    # stay within EARLY of DOP853's, or below RESOLVING of them, and cost more (contact that every method
+    # must resolve)
     t_e = _probe_end(pre["stats"], float(times[0]), t_s, rest, 0.0) if t_p is not None else None
     t_e = t_e if t_e is not None and t_e < t_p else None
     t_1 = t_p if t_e is None else t_e
@@ -268,7 +273,8 @@ def continue_radau(sys, rep, times, stiff, rtol, atol, max_step, progress, reaso
         tol = (rtol, atol, max_step)
         if t_e is not None:
             way = _radau_under_way(second, rr)
-            if way is not None and PAY * way[1] > explicit[1] and SETTLED * explicit[0] <= way[0] < EARLY * explicit[0]:
+            if way is not None and PAY * way[1] > explicit[1] and \
+                    (SETTLED * explicit[0] <= way[0] < EARLY * explicit[0] or way[0] < RESOLVING * explicit[0]):
                 return _after_probe(sys, rep, res, second, rest[rest >= t_e], explicit, rr, tol, progress, reason)
             # not decided: Radau on to the trial's end, where the choice is made on that part's steps
             rr, second, res = _radau_on(sys, rep, res, second, rest[(rest >= t_e) & (rest <= t_p)], rr, tol, progress)
