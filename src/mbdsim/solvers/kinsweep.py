@@ -94,6 +94,17 @@ class KinematicRun:
         out[todo] = _full_multipliers(self.sys, self.rows, times[todo], Y[todo], VD[todo], LAM[todo])
         return out
 
+    def outputs(self, times, Y):
+        """(VD, LAM): accelerations and multipliers of the independent rows recomputed at the output rows
+        Y = [q, v] (times [s]), as `CompiledRun.outputs`; SolverError naming the time if singular."""
+        sys, a, w = self.sys, self.cm.arrays(), self.work.arrays()
+        VD, LAM = np.zeros((len(times), sys.nv)), np.zeros((len(times), sys.nc))
+        for k, t in enumerate(np.asarray(times, float)):
+            y = np.array(Y[k], dtype=float)
+            if fastdyn.accelerations(a, w, float(t), y[:sys.nq], y[sys.nq:], y[:sys.nq], VD[k], LAM[k], True) != OK:
+                raise SolverError(_MESSAGES[fastdyn.SINGULAR] + " at an output time", time=float(t))
+        return VD, LAM
+
     def states_at(self, times, Y, VD, LAM, MN, ts):
         """(q, v, vd, lambda_) at the times ts [s]: the same kinematic solve from the output at or before
         each t (all of ts in one compiled call); an output time gives its stored sample (times, Y, VD,
