@@ -1,4 +1,5 @@
-"""Issue 29's models against the peers that can build them, measured in the same run: time at equal accuracy.
+"""Issue 29's models against the peers that can build them (MuJoCo, Exudyn), measured in the same run:
+time at equal accuracy.
 
     python3 bench/peers_vocabulary.py            # writes bench/PEERS_VOCABULARY.md and peers_vocabulary.json
     python3 bench/peers_vocabulary.py --quick    # fewer settings
@@ -8,18 +9,25 @@ Models (each with a closed form, computed here, as the reference):
 * gear train: three shafts on revolutes to ground coupled by two gear pairs (ratios -0.5 and -0.4), a
   torsion spring (k = 2 N m/rad) on the output shaft, started with the output turning at 1 rad/s: the
   output angle is (w0 / w) sin(w t), w^2 = k / J_eff, J_eff = J3 + J2 / r2^2 + J1 / (r1 r2)^2; 2 s.
-  mbdsim: `add_gear`; MuJoCo: hinge joints coupled by `<equality joint polycoef>` (soft constraints).
+  mbdsim: `add_gear`; MuJoCo: hinge joints coupled by `<equality joint polycoef>` (soft constraints);
+  Exudyn: three 1-D coordinates coupled by two ObjectConnectorCoordinate (factor1 = ratio), a
+  CoordinateSpringDamper on the output.
 * stiff two-mass chain: ground -k1- m1 -k2- m2 along x, k2 = 1e4 k1 (k1 = 100 N/m, 1 kg each), released on
   the slow mode's shape: x(t) = a v_slow cos(w_slow t) exactly; 2 s. mbdsim: translational joints and
-  spring-dampers; MuJoCo: slide joints with joint stiffness (the second slide relative to the first mass).
+  spring-dampers; MuJoCo: slide joints with joint stiffness (the second slide relative to the first mass);
+  Exudyn: two 1-D masses and two CoordinateSpringDampers.
 * friction slider: a 1 kg block on a horizontal translational joint, Coulomb mu = 0.3 (normal force m g
   from the joint's reaction), launched at 2 m/s: x = v0 t - mu g t^2 / 2 until it stops at v0 / (mu g),
-  then rest; 1 s. mbdsim: `add_friction`; MuJoCo: a slide joint with frictionloss = mu m g.
+  then rest; 1 s. mbdsim: `add_friction`; MuJoCo: a slide joint with frictionloss = mu m g; Exudyn: a 1-D
+  mass on a CoordinateSpringDamperExt with stiffness 0, dynamicFrictionForce = mu m g, regularised for
+  |v| < 1e-4 m/s (its error floor, ~4e-9, scales as v_reg^2).
+Exudyn's builds and runner are in bench/peers_exudyn.py.
 
-Each engine is swept (mbdsim: rtol of the default method "auto"; MuJoCo: RK4's fixed step) and the time to
-reach an error (max over the outputs, relative to the motion's amplitude) is read off the Pareto front as
-in bench/run.py. Ratios are mbdsim time / MuJoCo time at the same error; where one engine never reaches an
-error, its best error is reported instead. Absolute times on this shared machine move by 30 %.
+Each engine is swept (mbdsim: rtol of the default method "auto"; MuJoCo: RK4's fixed step; Exudyn:
+SolveDynamic's fixed step with GeneralizedAlpha at spectral radius 1 and with RK44, one front over both)
+and the time to reach an error (max over the outputs, relative to the motion's amplitude) is read off the
+Pareto front as in bench/run.py. Ratios are mbdsim time / peer time at the same error; where one engine
+never reaches an error, its best error is reported instead. Absolute times on this shared machine move by 30 %.
 """
 from __future__ import annotations
 
@@ -39,6 +47,7 @@ import numpy as np  # noqa: E402
 
 import mbdsim as mb  # noqa: E402
 from run import front, time_at, fmt_t  # noqa: E402
+import peers_exudyn as pe  # noqa: E402
 
 try:
     import mujoco
@@ -212,13 +221,16 @@ def error(t, x, exact):
 CASES = {
     "gear train (2 stages, torsion spring)": dict(
         T=GEAR["T"], exact=gear_exact, mbdsim=gear_mbdsim,
-        mujoco=lambda dt: (lambda x, r, rd: dict(xml=x, qvel0=r, read=rd))(*gear_mujoco(dt))),
+        mujoco=lambda dt: (lambda x, r, rd: dict(xml=x, qvel0=r, read=rd))(*gear_mujoco(dt)),
+        exudyn=lambda mbs: pe.gear_exudyn(mbs, GEAR)),
     "stiff two-mass chain (k2 = 1e4 k1), slow mode": dict(
         T=CHAIN["T"], exact=chain_exact, mbdsim=chain_mbdsim,
-        mujoco=lambda dt: (lambda x, q, rd: dict(xml=x, qpos0=q, read=rd))(*chain_mujoco(dt))),
+        mujoco=lambda dt: (lambda x, q, rd: dict(xml=x, qpos0=q, read=rd))(*chain_mujoco(dt)),
+        exudyn=lambda mbs: pe.chain_exudyn(mbs, CHAIN, CHAIN["a"] * chain_modes()[1])),
     "friction slider coasting to rest": dict(
         T=FRIC["T"], exact=fric_exact, mbdsim=fric_mbdsim,
-        mujoco=lambda dt: (lambda x, v, rd: dict(xml=x, qvel0=v, read=rd))(*fric_mujoco(dt))),
+        mujoco=lambda dt: (lambda x, v, rd: dict(xml=x, qvel0=v, read=rd))(*fric_mujoco(dt)),
+        exudyn=lambda mbs: pe.fric_exudyn(mbs, FRIC, G)),
 }
 
 
@@ -243,6 +255,20 @@ def sweep(case, quick, log):
             e = error(t, x, case["exact"]) if np.all(np.isfinite(x)) else math.nan
             rows.append(dict(engine="mujoco", setting=f"RK4 dt {dt:g}", time_s=el, error=e, method="RK4"))
             log(f"    mujoco RK4 dt {dt:g}: {el * 1e3:.2f} ms, error {e:.2e}")
+    if pe.exu is not None:
+        for solver in pe.SOLVERS:
+            for div in divs:
+                dt = OUT_DT / div
+                with warnings.catch_warnings():
+                    warnings.simplefilter("ignore")
+                    el, t, x = pe.run_exudyn(case["exudyn"], case["T"], dt, OUT_DT, solver, 1 if quick else 3)
+                ok = t is not None and np.all(np.isfinite(x))
+                e = error(t, x, case["exact"]) if ok else math.nan
+                rows.append(dict(engine="exudyn", setting=f"{solver} dt {dt:g}", time_s=el, error=e, method=solver))
+                log(f"    exudyn {solver} dt {dt:g}: {el * 1e3:.2f} ms, error {e:.2e}"
+                    + ("" if t is not None else f" ({x})"))
+                if t is None and math.isnan(el):
+                    break   # the solver refuses the model: no use trying smaller steps
     return rows
 
 
@@ -255,10 +281,13 @@ def _time_at(pts, target):
     return (None, "n/a") if how == "extrap" and t > 1e3 else (t, how)
 
 
+ENGINES = ("mbdsim", "mujoco", "exudyn")
+
+
 def summary(rows):
     out = {}
-    for eng in ("mbdsim", "mujoco"):
-        pts = [(r["time_s"], r["error"]) for r in rows if r["engine"] == eng]
+    for eng in ENGINES:
+        pts = [(r["time_s"], r["error"]) for r in rows if r["engine"] == eng and math.isfinite(r["time_s"])]
         f = front(pts)
         out[eng] = dict(best_error=min((e for _, e in f), default=math.nan),
                         at={f"{tg:g}": _time_at(pts, tg) for tg in TARGETS})
@@ -275,23 +304,28 @@ def main():
         log(f"== {name}")
         rows = sweep(case, args.quick, log)
         results[name] = dict(rows=rows, summary=summary(rows))
-    md = ["# Issue 29's models against MuJoCo (time at equal accuracy, one run)", "",
+    md = ["# Issue 29's models against MuJoCo and Exudyn (time at equal accuracy, one run)", "",
           "Written by `python3 bench/peers_vocabulary.py`" + (" --quick" if args.quick else "") +
-          f" (MuJoCo {getattr(mujoco, '__version__', 'absent')}). Error: max over 0.01 s outputs of the "
-          "difference to the closed form, relative to the motion's amplitude. Ratio: mbdsim time / MuJoCo "
-          "time to reach the same error (`<=`: the cheapest run is already more accurate, `~*`: "
-          "extrapolated); `n/a`: not reached (see the best error).", "",
-          "| model | target error | mbdsim | MuJoCo | ratio | best error mbdsim / MuJoCo | mbdsim method (rtol 1e-6) |",
-          "|---|---|---|---|---|---|---|"]
+          f" (MuJoCo {getattr(mujoco, '__version__', 'absent')}, Exudyn {pe.EXUDYN}). Error: max over 0.01 s "
+          "outputs of the difference to the closed form, relative to the motion's amplitude. Ratio: mbdsim "
+          "time / peer time to reach the same error (`<=`: the cheapest run is already more accurate, `~*`: "
+          "extrapolated); `n/a`: not reached (see the best error). Exudyn's front is over both of its "
+          "solvers (GeneralizedAlpha with spectral radius 1, RK44; fixed steps; RK44 refuses the gear "
+          "train's node-to-node coordinate constraints). Exudyn's friction: regularised for |v| < "
+          f"{pe.FRICTION_VREG:g} m/s (floor ~4e-9, as v_reg^2); its adaptive step reduction at the stop "
+          "moves the later samples off the 0.01 s grid, where they are compared with the closed form.", "",
+          "| model | target error | mbdsim | MuJoCo | Exudyn | mbdsim / MuJoCo | mbdsim / Exudyn | "
+          "best error mbdsim / MuJoCo / Exudyn | mbdsim method (rtol 1e-6) |",
+          "|---|---|---|---|---|---|---|---|---|"]
     for name, r in results.items():
         s = r["summary"]
         meth = next((x["method"] for x in r["rows"] if x["engine"] == "mbdsim" and x["setting"] == "rtol 1e-06"), "?")
         for tg in TARGETS:
-            tm, hm = s["mbdsim"]["at"][f"{tg:g}"]
-            tj, hj = s["mujoco"]["at"][f"{tg:g}"]
-            ratio = f"{tm / tj:.3g}x" if tm and tj else "n/a"
-            md.append(f"| {name} | {tg:g} | {fmt_t(tm, hm)} | {fmt_t(tj, hj)} | {ratio} | "
-                      f"{s['mbdsim']['best_error']:.1e} / {s['mujoco']['best_error']:.1e} | {meth} |")
+            (tm, hm), (tj, hj), (tx, hx) = (s[e]["at"][f"{tg:g}"] for e in ENGINES)
+            ratio = lambda a, b: f"{a / b:.3g}x" if a and b else "n/a"  # noqa: E731
+            best = " / ".join(f"{s[e]['best_error']:.1e}" for e in ENGINES)
+            md.append(f"| {name} | {tg:g} | {fmt_t(tm, hm)} | {fmt_t(tj, hj)} | {fmt_t(tx, hx)} | "
+                      f"{ratio(tm, tj)} | {ratio(tm, tx)} | {best} | {meth} |")
     md += ["", "## Sweeps", "", "```", *lines, "```", ""]
     with open(os.path.join(HERE, "PEERS_VOCABULARY.md"), "w") as fh:
         fh.write("\n".join(md))
