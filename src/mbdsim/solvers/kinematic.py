@@ -132,6 +132,7 @@ def _compiled_sweep(sys, rep, times):
     (torsion springs, rotational stops), solves completely and passes no singular configuration
     (conditioning of every sample, from one batched SVD, at least SINGULAR_TOL); else None, and the
     analysis below (which treats singular passages and reports failures) runs instead."""
+    from ..errors import AnalysisInterrupted
     from ..model.element_specs import Stop, TorsionSpring
     from ..system.compiled import NotCompiled
     from .kinsweep import integrate_kinematic
@@ -141,6 +142,8 @@ def _compiled_sweep(sys, rep, times):
         res = integrate_kinematic(sys, rep, times)
     except NotCompiled:
         return None
+    if res is not None and isinstance(res.error, AnalysisInterrupted):
+        return res   # Ctrl-C: what was solved, not the analysis again on the path below
     if res is None or not res.success or len(res.time) != len(times):
         return None
     if len(rep.rows) and sys.nv <= DENSE_LIMIT:
