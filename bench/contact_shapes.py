@@ -22,6 +22,8 @@ import mbdsim as mb
 
 HERE = Path(__file__).parent
 sys.path.insert(0, str(HERE.parent / "tests"))
+sys.path.insert(0, str(HERE))
+from sections import replace_section  # noqa: E402
 REPEATS = 3
 G = 9.81
 
@@ -246,14 +248,7 @@ def main():
                      f"{'n/a' if not np.isfinite(ej) else f'{ej:.3g}'} | {ratio(sm)} | {ratio(sa)} |")
     text = "\n".join(lines) + "\n"
     (HERE / "CONTACT_RESULTS.md").write_text(text)
-    res = (HERE / "RESULTS.md").read_text()
-    start = res.find("## Shape contact (issue 30)")
-    if start >= 0:
-        end = res.find("\n## ", start + 5)
-        res = res[:start] + text + ("\n" + res[end + 1:] if end >= 0 else "")
-    else:
-        res = res.rstrip("\n") + "\n\n" + text
-    (HERE / "RESULTS.md").write_text(res)
+    replace_section(HERE / "RESULTS.md", text)
 
 
 if __name__ == "__main__":

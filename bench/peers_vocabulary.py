@@ -47,6 +47,7 @@ import numpy as np  # noqa: E402
 
 import mbdsim as mb  # noqa: E402
 from run import front, time_at, fmt_t  # noqa: E402
+from sections import replace_section  # noqa: E402
 import peers_exudyn as pe  # noqa: E402
 
 try:
@@ -326,9 +327,12 @@ def main():
             best = " / ".join(f"{s[e]['best_error']:.1e}" for e in ENGINES)
             md.append(f"| {name} | {tg:g} | {fmt_t(tm, hm)} | {fmt_t(tj, hj)} | {fmt_t(tx, hx)} | "
                       f"{ratio(tm, tj)} | {ratio(tm, tx)} | {best} | {meth} |")
+    table = md[2:]
     md += ["", "## Sweeps", "", "```", *lines, "```", ""]
     with open(os.path.join(HERE, "PEERS_VOCABULARY.md"), "w") as fh:
         fh.write("\n".join(md))
+    replace_section(os.path.join(HERE, "RESULTS.md"), "\n".join(
+        ["## Issue 29's models against MuJoCo and Exudyn", ""] + table + ["", "Sweeps: bench/PEERS_VOCABULARY.md."]))
     with open(os.path.join(HERE, "peers_vocabulary.json"), "w") as fh:
         json.dump(results, fh, indent=1, default=str)
 
