@@ -74,3 +74,18 @@ def test_copy_replace_and_bad_slots():
     assert typeof(other) == typeof(Slots((np.zeros(3), np.zeros((2, 2)))))   # a type of another size: retyped
     with pytest.raises(TypeError, match="only arrays and tuples of arrays"):
         Slots((np.zeros(2), [1.0]))
+
+
+def test_slot_type_reused_only_for_the_same_structure():
+    """A tuple of the same structure (dtypes, dimensions, layout, writeability) reuses the type typed once;
+    any difference that numba's type sees gives numba's own type for it, never the cached one."""
+    a = (np.zeros(3), (np.zeros((2, 2)), np.zeros(4, np.int64)))
+    b = (np.ones(5), (np.ones((3, 3)), np.arange(2)))   # same structure, other sizes
+    assert Slots(a)._numba_type_ is Slots(b)._numba_type_
+    ro = np.zeros(3)
+    ro.flags.writeable = False
+    others = [(ro, a[1]), (np.zeros(3, np.float32), a[1]), (np.zeros((3, 1)), a[1]),
+              (np.zeros(6)[::2], a[1]), (np.zeros(3), (np.zeros((2, 2)).T[:, :1], a[1][1]))]
+    for t in others:
+        assert Slots(t)._numba_type_.tup == typeof(t), t
+    assert Slots(others[0])._numba_type_.tup != Slots(a)._numba_type_.tup   # (read-only: numba's own type)
