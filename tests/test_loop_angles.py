@@ -51,6 +51,18 @@ def four_bar(springs, torque=0.0):
 
 def reference(springs, torque, t_end, times):
     """th1(times) [rad] of the planar one-DOF equation of motion, continued (scipy DOP853, 1e-12)."""
+    f, state, start = planar_equation(springs, torque)
+    sol = solve_ivp(f, (0.0, t_end), [TH1_0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times,
+                    max_step=1e-3)
+    state["b"] = start
+    alpha = np.array([f(t, y)[1] for t, y in zip(sol.t, sol.y.T)])   # (in time order: the branch followed)
+    return sol.y[0], alpha
+
+
+def planar_equation(springs, torque):
+    """(f, state, start): f(t, [th1, w1]) = [w1, crank acceleration] of the planar one-DOF equation of
+    motion (Meff th1_dd = rhs; the last Meff in state["meff"]), following the assembly branch in state["b"] (reset it to `start`, the
+    initial coupler and rocker angles, before a new sweep in time)."""
     g = np.array([0.0, -G])
     th20, th30 = closure(TH1_0)
 
@@ -82,13 +94,10 @@ def reference(springs, torque, t_end, times):
         for joint, (k, cd) in springs.items():
             x, xd, dx = rel[joint]
             rhs -= (k * x + cd * xd) * dx
+        state["meff"] = Meff
         return [w1, rhs / Meff]
 
-    sol = solve_ivp(f, (0.0, t_end), [TH1_0, 0.0], method="DOP853", rtol=1e-12, atol=1e-12, t_eval=times,
-                    max_step=1e-3)
-    state["b"] = (th20, th30)
-    alpha = np.array([f(t, y)[1] for t, y in zip(sol.t, sol.y.T)])   # (in time order: the branch followed)
-    return sol.y[0], alpha
+    return f, state, (th20, th30)
 
 
 def crank_angle(res):
@@ -131,3 +140,34 @@ def test_crank_turning_several_revolutions_winds_the_loop_springs_beyond_pi():
     assert np.max(np.abs(acc - alpha)) < 1e-6 * np.max(np.abs(alpha))
     x = res.spring_length("kA")   # the spring's continued angle (res.spring_force: its torque)
     assert x[-1] < -4 * np.pi
+
+
+def test_driven_four_bar_with_wound_loop_springs_in_the_compiled_kinematic_sweep():
+    """mb.kinematics of the four-bar driven at 40 rad/s (20 rad, several turns, between outputs) with
+    springs on the coupler pins A and B (loop joints: angles continued in the kernel, A winding by
+    -2 pi per crank turn) and on O: the compiled sweep, its driver torque against the planar equation at
+    constant speed (tau = -Meff x the free crank's acceleration) at the outputs and, by the same solve
+    restarted from each output's angle references, at times between them (dense output)."""
+    springs = {"A": (2.0, 0.05), "B": (3.0, 0.1), "O": (1.0, 0.0)}
+    speed = 40.0
+    model = four_bar(springs)
+    model.add_motion("drive", "O", displacement=f"{speed!r}*t")
+    res = mb.kinematics(model, 3.0, 0.5)
+    assert res.success and res.stats["method"] == "kinematic (compiled sweep)", res.stats
+
+    def torque(times):
+        f, state, _ = planar_equation(springs, 0.0)
+        out = []
+        for t in times:   # in time order, each sample a fraction of a turn past the last (branch followed)
+            for tt in np.linspace(out[-1][0] if out else 0.0, t, 40):
+                acc = f(tt, [TH1_0 + speed * tt, speed])[1]
+            out.append((t, -state["meff"] * acc))
+        return np.array([x[1] for x in out])
+    tau = res.driver_effort("drive")
+    ref = torque(res.time)
+    assert np.max(np.abs(tau - ref)) < 1e-8 * np.max(np.abs(ref)), np.max(np.abs(tau - ref))
+    ts = np.array([0.137, 1.01, 2.3, 2.96])
+    between = res.at(ts).driver_effort("drive")
+    ref_b = torque(ts)
+    assert np.max(np.abs(between - ref_b)) < 1e-8 * np.max(np.abs(ref_b)), np.max(np.abs(between - ref_b))
+    assert res.spring_length("kA")[-1] < -5 * 2 * np.pi   # wound: the continued angle, many turns

@@ -167,18 +167,23 @@ def _store(q, v, vd, lam, Y, VD, LAM, row):
 
 
 @entry(_nrt=False)
-def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
+def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, REF, q, v, vd, lam, tol, chunk, stats, S, dx6, a6, p6):
     """Solve the outputs tout[iout:] [s] in turn from the solved state (q, v, vd, lam) at st[0], writing
     [q, v] rows into Y, vd into VD and the multipliers into LAM: the minimum-norm ones of all rows where
-    MN is set (`min_norm_at`), else those of the independent rows (zero at the others); stops after
-    `chunk` outputs; st and p6 as in `advance`. Returns (status, next iout); on failure st[0] and (q, v)
-    are the last solved state."""
+    MN is set (`min_norm_at`), else those of the independent rows (zero at the others), and into REF
+    (nout, len(wk[44][7])) the references [rad] of the joint angles continued in the kernel (torsion
+    springs, stops, expressions on a loop joint's angle: `accept_state`) at each output, from which
+    `states_at` restarts; stops after `chunk` outputs; st and p6 as in `advance`. Returns (status, next
+    iout); on failure st[0] and (q, v) are the last solved state."""
     written = 0
+    ref = wk[44][7]
     while iout < tout.shape[0]:
         status, MN[iout] = _solved_at(cm, wk, st, tout[iout], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
         if status != OK:
             return status, iout
         _store(q, v, vd, lam, Y, VD, LAM, iout)
+        for m in range(REF.shape[1]):
+            REF[iout, m] = ref[m]
         iout += 1
         written += 1
         stats[0] += 1
@@ -188,13 +193,15 @@ def sweep(cm, wk, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, tol, chunk, sta
 
 
 @entry(_nrt=False)
-def states_at(cm, wk, times, Y, VD, LAM, MN, ts, Yo, VDo, LAMo, MNo, tol, stats, S, dx6, a6, p6, q, v, vd, lam,
-              st):
+def states_at(cm, wk, times, Y, VD, LAM, MN, REF, ts, Yo, VDo, LAMo, MNo, tol, stats, S, dx6, a6, p6, q, v, vd,
+              lam, st):
     """States, accelerations and multipliers at the times ts [s] (inside the run) into Yo, VDo, LAMo
     (MNo: minimum-norm multipliers, as MN of `sweep`): the same solve as `sweep`, from the output at or
-    before each t (times, Y, VD, LAM, MN: the run's outputs; an output time gives its row as stored).
+    before each t (times, Y, VD, LAM, MN, REF: the run's outputs; the continued joint angles restart from
+    that output's references REF, which leaves wk[44][7] changed; an output time gives its row as stored).
     Returns the number of times done (< len(ts) on failure)."""
     nq, n = q.shape[0], times.shape[0]
+    ref = wk[44][7]
     for j in range(ts.shape[0]):
         lo, hi = 0, n   # k: the last output with times[k] <= ts[j] (0 before the first)
         while hi - lo > 1:
@@ -216,6 +223,8 @@ def states_at(cm, wk, times, Y, VD, LAM, MN, ts, Yo, VDo, LAMo, MNo, tol, stats,
             _to6(cm, VD[k - 1], p6)
             st[2] = times[k] - times[k - 1]
         MNo[j] = MN[k]
+        for m in range(REF.shape[1]):
+            ref[m] = REF[k, m]
         if ts[j] > times[k]:
             status, MNo[j] = _solved_at(cm, wk, st, ts[j], q, v, vd, lam, tol, stats, S, dx6, a6, p6)
             if status != OK:

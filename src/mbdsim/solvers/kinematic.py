@@ -128,16 +128,14 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
 
 def _compiled_sweep(sys, rep, times):
     """The Result of the compiled kinematic sweep (solvers.kinsweep: the same equations, every sample in
-    compiled code) when the model is carried by the compiled core, has no joint angles to continue
-    (torsion springs, rotational stops), solves completely and passes no singular configuration
+    compiled code; joint angles of torsion springs and rotational stops continued in the kernel, each
+    sub-step turning a body by at most fastkin.MAX_TURN) when the model is carried by the compiled
+    core, solves completely and passes no singular configuration
     (conditioning of every sample, from one batched SVD, at least SINGULAR_TOL); else None, and the
     analysis below (which treats singular passages and reports failures) runs instead."""
     from ..errors import AnalysisInterrupted
-    from ..model.element_specs import Stop, TorsionSpring
     from ..system.compiled import NotCompiled
     from .kinsweep import integrate_kinematic
-    if any(isinstance(e, (TorsionSpring, Stop)) for e in sys.model.forces.values()):
-        return None
     try:
         res = integrate_kinematic(sys, rep, times)
     except NotCompiled:

@@ -18,7 +18,7 @@ from ..errors import SolverError
 from ..results.result import Result
 from ..results.stream import ProgressError, notify
 from ..system.compiled import Work, compile_system
-from . import fastdyn, fastkin, pyloads
+from . import anglerefs, fastdyn, fastkin, pyloads
 from .compiled_run import CHUNK, PROGRESS_FAILED, _MESSAGES, _full_multipliers, failure, residual_check
 from .fastdyn import INTERRUPTED, OK
 
@@ -36,6 +36,7 @@ class KinematicRun:
         self.pyloads = pyloads.attach(sys, self.cm, self.work)   # Python-callable loads, called back
         self.stats = np.zeros(6, dtype=np.int64)   # see fastkin: outputs, sub-steps, retried, projections, factorisations
         self.run_error = None   # the error that ended the sweep (a raising progress callback or load callable)
+        self.refs = np.zeros((0, 0))   # the continued joint angles' references [rad] at each output (`sweep`)
 
     @property
     def joint_space(self) -> bool:
@@ -58,6 +59,7 @@ class KinematicRun:
         nout, nq = len(tout), sys.nq
         Y, VD, LAM = np.zeros((nout, nq + sys.nv)), np.zeros((nout, sys.nv)), np.zeros((nout, sys.nc))
         MN = np.zeros(nout, dtype=np.bool_)
+        REF = self.refs = np.zeros((nout, len(w[44][7])))   # the continued joint angles' references there
         q, v = np.array(y0[:nq], dtype=float), np.array(y0[nq:], dtype=float)
         vd, lam = np.zeros(sys.nv), np.zeros(sys.nc)
         st = np.array([float(t0), np.inf, 0.0])
@@ -66,12 +68,12 @@ class KinematicRun:
         iout = 0
         if status == OK:
             MN[0] = fastkin.min_norm_at(a, w, lam)
-            Y[0], VD[0], LAM[0] = y0, vd, lam
+            Y[0], VD[0], LAM[0], REF[0] = y0, vd, lam, w[44][7]
             iout = 1
         S, dx6, a6, p6 = self._scratch()
         try:
             while status == OK and iout < nout:
-                status, iout = fastkin.sweep(a, w, st, tout, iout, Y, VD, LAM, MN, q, v, vd, lam, PROJ_TOL,
+                status, iout = fastkin.sweep(a, w, st, tout, iout, Y, VD, LAM, MN, REF, q, v, vd, lam, PROJ_TOL,
                                              CHUNK, self.stats, S, dx6, a6, p6)
                 notify(progress, st[0], None if partial is None else
                        (lambda n=iout: partial(Y, VD, LAM, MN, n)))
@@ -115,9 +117,12 @@ class KinematicRun:
         Yo, VDo, LAMo = np.zeros((n, Y.shape[1])), np.zeros((n, sys.nv)), np.zeros((n, sys.nc))
         S, dx6, a6, p6 = self._scratch()
         MNo = np.zeros(n, dtype=np.bool_)
-        done = fastkin.states_at(self.cm.arrays(), self.work.arrays(), np.asarray(times, float), Y, VD, LAM, MN,
-                                 ts, Yo, VDo, LAMo, MNo, PROJ_TOL, np.zeros(6, np.int64), S, dx6, a6, p6,
-                                 np.zeros(sys.nq), np.zeros(sys.nv), np.zeros(sys.nv), np.zeros(sys.nc), np.zeros(3))
+        w = self.work.arrays()
+        with anglerefs.kept(w[44][7]):   # (restarts from each output's references; the run's own kept)
+            done = fastkin.states_at(self.cm.arrays(), w, np.asarray(times, float), Y, VD, LAM, MN,
+                                     self.refs[:len(times)], ts, Yo, VDo, LAMo, MNo, PROJ_TOL, np.zeros(6, np.int64),
+                                     S, dx6, a6, p6, np.zeros(sys.nq), np.zeros(sys.nv), np.zeros(sys.nv),
+                                     np.zeros(sys.nc), np.zeros(3))
         if done < n:
             raise SolverError(_MESSAGES[fastdyn.PROJECTION] + " (kinematic solve)", time=float(ts[done]))
         nq = sys.nq
