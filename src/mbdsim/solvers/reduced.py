@@ -39,10 +39,18 @@ def tangent_basis(sys, q, t, rows, scale=None) -> np.ndarray:
     """N (nv, d): columns scale * (orthonormal basis of the null space of phi_q[rows] * scale), where
     d = nv - rank; an orthonormal basis of the admissible increments when scale is None."""
     s = np.ones(sys.nv) if scale is None else np.asarray(scale, dtype=float)
-    J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][rows] * s if len(rows) else np.zeros((0, sys.nv))
+    J = constraint_terms(sys, q, np.zeros(sys.nv), t)[1][rows] if len(rows) else np.zeros((0, sys.nv))
+    return null_basis(J, s)
+
+
+def null_basis(J, s) -> np.ndarray:
+    """N (nv, d): s * (orthonormal basis of the null space of J * s), J (rows, nv) the rows' Jacobian and
+    s (nv,) the scale of each velocity variable; d = nv - rank (rank: singular values above 1e-9 of the
+    largest, or of 1)."""
+    s = np.asarray(s, dtype=float)
     if J.shape[0] == 0:
         return np.diag(s)
-    _, sv, vt = np.linalg.svd(J, full_matrices=True)
+    _, sv, vt = np.linalg.svd(J * s, full_matrices=True)
     rank = int(np.sum(sv > 1e-9 * max(1.0, sv[0])))
     return s[:, None] * vt[rank:].T
 

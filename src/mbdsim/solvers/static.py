@@ -16,6 +16,11 @@ potential that fool the work measure) the iteration continues as pseudo-transien
 implicit Euler steps (K + I / tau) dz = f of the overdamped flow dz/dtau = f with tau growing as the
 residual falls (switched evolution relaxation).
 
+Evaluations (solvers.static_eval): each iteration evaluates one batch of configurations (the chart's
+centre, the 2 d central differences of K, the trust step's dz/2 and dz) in one compiled call
+(solvers.faststatic: projection, loads, unbalanced load) where the model compiles in absolute coordinates,
+res.stats["method"] then ending in "(compiled)"; else by the force elements' numpy evaluators.
+
 Stability: at the solution the eigenvalues of K_s classify it: all positive, stable; a negative one,
 unstable; zeros, neutral (indeterminate along those directions). A start that is already an unstable
 equilibrium (the pendulum exactly upright) is returned as it is, flagged unstable, with an
@@ -32,12 +37,12 @@ from .._blas import blas_single_thread
 from ..errors import SolverError
 from ..results.result import Result
 from ..system.assemble import assemble_system
-from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .assembly import assemble_state
 from .common import project_positions
-from .reduced import Chart, describe_direction, length_scale, tangent_basis, tangent_residual, velocity_scale
+from .reduced import describe_direction, length_scale, null_basis, velocity_scale
+from .static_eval import evaluator
 from ..results.state import state_factory
 from typing import TYPE_CHECKING
 
@@ -113,11 +118,12 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
         sys = assemble_system(model)
         rep = assemble_state(sys, sys.q0, np.zeros(sys.nv), start_time)
         times, sf = time_grid(start_time, end_time, output_step), state_factory(sys)
-        sols, q, error = [], rep.q, None
+        ev = evaluator(sys, rep.rows, sf)
+        sols, refs, q, error = [], [], rep.q, None
         for t in times:
             try:
-                q = _onto(sys, q, t, rep.rows)
-                sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit))
+                sols.append(solve_static(sys, q, t, rep.rows, sf, tol, maxit, ev=ev))
+                refs.append(ev.angle_refs())
                 notify(bar, t)
             except (Exception, KeyboardInterrupt) as exc:   # noqa: BLE001 - every failure ends the run, named
                 from .common import analysis_error
@@ -127,8 +133,11 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
     _warn_unstable(sols)
 
     def evaluate(ts):
-        near = [sols[int(np.argmin([abs(s.t - x) for s in sols]))] for x in ts]
-        out = [solve_static(sys, _onto(sys, s.q, x, rep.rows), x, rep.rows, sf, tol, maxit) for s, x in zip(near, ts)]
+        out = []
+        for x in ts:   # from the nearest sample, its joint-angle references restored
+            k = int(np.argmin([abs(s.t - x) for s in sols]))
+            ev.set_angle_refs(refs[k])
+            out.append(solve_static(sys, sols[k].q, x, rep.rows, sf, tol, maxit, ev=ev))
         return _arrays(sys, out)[1:]
     ok = error is None
     msg = f"quasi-static equilibrium at {len(sols)} times" if ok else \
@@ -138,42 +147,41 @@ def quasi_static(model: Model, end_time: float, output_step: float | None = None
     return res
 
 
-def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100, relax=False) -> StaticSolution:
-    """Equilibrium of an assembled System from configuration q (on the constraints) at time t [s];
-    relax=True starts with the pseudo-transient continuation (the fallback) instead of the trust region."""
+def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100, relax=False, ev=None) -> StaticSolution:
+    """Equilibrium of an assembled System from configuration q (projected onto the constraints first) at
+    time t [s]; relax=True starts with the pseudo-transient continuation (the fallback) instead of the trust
+    region. ev: the evaluator of the loads (solvers.static_eval; default: compiled where the model compiles)."""
+    ev = ev if ev is not None else evaluator(sys, rows, sf)
     L = length_scale(sys, q)
     scale = velocity_scale(sys, L)
-    zero = np.zeros(sys.nv)
-
-    def reduced(qq, N):
-        Q = applied_forces(sys, body_frames(sys, qq, zero), t, sf(t, qq, zero) if sf else None)
-        r = tangent_residual(sys, qq, t, rows, Q)[0]
-        return N.T @ r, r
-
-    Q0 = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
-    force_scale = max(1.0, float(np.max(np.abs(Q0), initial=0.0)), 10 * float(np.max(np.abs(sys.M), initial=0.0)))
+    cur = _at(ev, sys, q, t, rows)
+    q = cur.X[0]
+    force_scale = max(1.0, float(np.max(np.abs(cur.Q0), initial=0.0)), 10 * float(np.max(np.abs(sys.M), initial=0.0)))
     delta, tau, mode = 0.5, None, "trust-region Newton"
     if relax:
         mode = "pseudo-transient continuation"
     for it in range(maxit + 1):
-        _follow_angles(sys, q, zero, t)
-        chart = Chart(sys, q, t, rows, tangent_basis(sys, q, t, rows, scale))
-        f, r = reduced(q, chart.N)
-        if np.max(np.abs(r), initial=0.0) <= tol * force_scale:
-            return _classify(sys, chart, it, mode, reduced, force_scale * L, L, sf)
-        if it == maxit:
+        if it:
+            cur = _at(ev, sys, q, t, rows)
+        N = null_basis(cur.J0, scale)
+        f, r = N.T @ cur.r0, cur.r0
+        converged = np.max(np.abs(r), initial=0.0) <= tol * force_scale
+        if it == maxit and not converged:
             break
-        K = _stiffness(chart, lambda qq: reduced(qq, chart.N)[0])
+        K = _stiffness(ev, q, N, t)
+        if converged:
+            ev.record(t)
+            return _classify(sys, q, t, N, K, cur.Q0, it, mode + (" (compiled)" if ev.compiled else ""),
+                             force_scale * L, L)
         if mode.startswith("pseudo") and tau is None:
             tau = 1.0 / max(float(np.max(np.abs(K), initial=0.0)), 1e-12 * force_scale)
         if mode.startswith("trust"):
             dz, pred = _trust_step(K, f, delta)
-            try:
-                _follow_angles(sys, q, chart.N @ dz, t)
-                f_half, f_new = reduced(chart.q(dz / 2), chart.N)[0], reduced(q_new := chart.q(dz), chart.N)[0]
-            except SolverError:
+            pair = ev.batch(q, N, np.vstack([dz / 2, dz]), t, False)
+            if pair.done < 2:
                 delta *= 0.25
                 continue
+            f_half, f_new = pair.F
             actual = float((f + 4 * f_half + f_new) @ dz) / 6   # work of the loads = decrease of V
             rho = actual / pred if pred > 0 else -np.inf
             n = float(np.linalg.norm(dz))
@@ -182,25 +190,36 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100, relax=False) ->
             elif rho > 0.75 and n > 0.99 * delta:
                 delta = min(2 * delta, DELTA_MAX)
             if rho > 0.1:
-                q = q_new
+                q = pair.X[1]
             elif delta < 1e-9:                       # the work measure cannot guide: relax instead
                 mode = "pseudo-transient continuation"
         else:   # implicit Euler on dz/dtau = f, kept downhill: K_s + I / tau positive definite
             neg = max(0.0, -float(np.linalg.eigvalsh(0.5 * (K + K.T))[0])) if len(f) else 0.0
             dz = np.linalg.lstsq(K + np.eye(len(f)) * max(1.0 / tau, 1.5 * neg), f, rcond=None)[0]
             dz *= min(1.0, DELTA_MAX / max(float(np.linalg.norm(dz)), 1e-300))
-            try:
-                _follow_angles(sys, q, chart.N @ dz, t)
-                q = chart.q(dz)
-            except SolverError:
+            one = ev.batch(q, N, dz[None], t, False)
+            if one.done < 1:
                 tau *= 0.25
                 continue
-            f_new = float(np.linalg.norm(reduced(q, chart.N)[0]))
+            q = one.X[0]
+            f_new = float(np.linalg.norm(one.F[0]))
             tau *= min(10.0, float(np.linalg.norm(f)) / max(f_new, 1e-300))   # switched evolution relaxation
-    where = describe_direction(sys, q, chart.N @ f, L, t)
+    where = describe_direction(sys, q, N @ f, L, t)
     raise SolverError(f"no static equilibrium: the loads along [{where}] are not balanced by any stiffness "
                       f"(indeterminate or unbounded direction); static equilibrium not found in {maxit} "
                       f"iterations (residual {np.max(np.abs(r)):.3g})", time=t, state=q)
+
+
+def _at(ev, sys, q, t, rows):
+    """The evaluation at q projected onto the constraints at t (the joint angles' references accepted
+    there); a compiled projection that fails is retried from the reference projection's configuration;
+    SolverError when the motions cannot be satisfied."""
+    cur = ev.batch(q, np.zeros((sys.nv, 0)), np.zeros((1, 0)), t, True)
+    if cur.done == 0 and ev.compiled:
+        cur = ev.batch(_onto(sys, q, t, rows), np.zeros((sys.nv, 0)), np.zeros((1, 0)), t, True)
+    if cur.done == 0:
+        raise SolverError("the motions cannot be satisfied (no configuration on the constraints)", time=t, state=q)
+    return cur
 
 
 def _trust_step(K, f, delta):
@@ -241,27 +260,27 @@ def _norm(x) -> float:
     return m * float(np.linalg.norm(x / m)) if 0.0 < m < np.inf else m
 
 
-def _stiffness(chart, force, h=FD_STEP):
-    """K = -d f / d z by central differences along the chart, shape (d, d)."""
-    d = chart.dim
-    K = np.zeros((d, d))
-    for k in range(d):
-        e = np.zeros(d)
-        e[k] = h
-        K[:, k] = -(force(chart.q(e)) - force(chart.q(-e))) / (2 * h)
-    return K
+def _stiffness(ev, q, N, t, h=FD_STEP):
+    """K = -d f / d z (d, d) by central differences along the chart at q (one batch of 2 d configurations);
+    SolverError when one of them cannot be projected."""
+    d = N.shape[1]
+    if not d:
+        return np.zeros((0, 0))
+    E = np.eye(d) * h
+    b = ev.batch(q, N, np.vstack([E, -E]), t, False)
+    if b.done < 2 * d:
+        raise SolverError("the constraints cannot be satisfied near this configuration", time=t, state=q)
+    return -(b.F[:d] - b.F[d:]).T / (2 * h)
 
 
-def _classify(sys, chart, it, method, reduced, energy_scale, L, sf):
-    """StaticSolution at the converged configuration with the stiffness eigenvalues and directions."""
-    q, t = chart.q0, chart.t
-    K = _stiffness(chart, lambda qq: reduced(qq, chart.N)[0]) if chart.dim else np.zeros((0, 0))
-    lam, V = np.linalg.eigh(0.5 * (K + K.T)) if chart.dim else (np.zeros(0), np.zeros((0, 0)))
+def _classify(sys, q, t, N, K, Q, it, method, energy_scale, L):
+    """StaticSolution at the converged configuration q (loads Q there) with the stiffness eigenvalues and
+    directions and the minimum-norm multipliers of every row in force."""
+    lam, V = np.linalg.eigh(0.5 * (K + K.T)) if N.shape[1] else (np.zeros(0), np.zeros((0, 0)))
     thr = 1e-7 * max(float(np.max(np.abs(lam), initial=0.0)), energy_scale)
-    unstable = [describe_direction(sys, q, chart.N @ V[:, k], L, t) for k in range(len(lam)) if lam[k] < -thr]
-    neutral = [describe_direction(sys, q, chart.N @ V[:, k], L, t) for k in range(len(lam)) if abs(lam[k]) <= thr]
+    unstable = [describe_direction(sys, q, N @ V[:, k], L, t) for k in range(len(lam)) if lam[k] < -thr]
+    neutral = [describe_direction(sys, q, N @ V[:, k], L, t) for k in range(len(lam)) if abs(lam[k]) <= thr]
     zero = np.zeros(sys.nv)
-    Q = applied_forces(sys, body_frames(sys, q, zero), t, sf(t, q, zero) if sf else None)
     J = constraint_terms(sys, q, zero, t)[1][sys.fixed_rows]
     lam_all = np.zeros(sys.nc)
     if J.shape[0]:
