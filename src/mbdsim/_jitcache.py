@@ -43,7 +43,7 @@ KERNEL_SOURCES = ("system/kernels.py", "system/exprvm.py", "system/_exprvm_ops.p
                   "solvers/loopcoord.py", "solvers/pathcoord.py", "solvers/fastsolve.py",
                   "solvers/fastfriction.py", "solvers/fastridge.py", "solvers/fastmeshpair.py",
                   "solvers/fastswitch.py", "solvers/fastcross.py", "solvers/fastenergy.py",
-                  "solvers/fastenergystep.py", "solvers/fastlaw.py")
+                  "solvers/fastenergystep.py", "solvers/fastlaw.py", "solvers/faststatic.py")
 
 
 # numba's flags of mbdsim's two kinds of kernels (mbdsim._jit: @kernel, @entry); numba's index does not record
