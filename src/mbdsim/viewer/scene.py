@@ -245,11 +245,13 @@ def scene_from_table(df, signal=None, max_frames: int = MAX_FRAMES, title: str =
     """A scene from an exported results table (`res.to_dataframe()` read back from .csv/.parquet).
 
     Such a table holds centre-of-mass positions only ("<body>.x [m]", ".y", ".z"): every body is drawn
-    as a sphere at its centre of mass without rotation, with its path; no joints or force elements.  `signal` is a
+    as a sphere at its centre of mass without rotation, with its path; no joints or force elements (a shape
+    contact's centre of pressure, "<contact>.x [m]" beside "<contact>.nx [-]", is not a body).  `signal` is a
     column name (matched leniently) or None."""
     from ..plotting import TIME_COLUMN, match_column
     time_col = match_column(df.columns, TIME_COLUMN)
     names = [c[:-len(".x [m]")] for c in df.columns if str(c).endswith(".x [m]")]
+    names = [n for n in names if f"{n}.nx [-]" not in df.columns]   # a shape contact's centre of pressure
     if not names:
         raise ModelError(f"results table {title!r}", "columns", "has no body position columns "
                          "('<body>.x [m]', '.y [m]', '.z [m]'); was it written from res.to_dataframe()?")
