@@ -112,9 +112,10 @@ def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int 
     scene.joints = [_joint(j, index) for j in model.joints.values()]
     scene.springs, scene.shapes = _elements(model, index)
     from ..geometry.visual import body_meshes   # shapes placed with Body.add_shape (issue 30)
-    for b in system.bodies:
+    for b in [model.ground] + [b for b in system.bodies if not b.is_ground]:   # ground's shapes too
         for d in body_meshes(b):
-            scene.shapes.append({**d, "body": _on(b, index)})
+            color = "#9aa5b1" if b.is_ground else scene.bodies[index[b.name]]["color"]
+            scene.shapes.append({**d, "body": _on(b, index), "color": color})
     if signal is not None:
         scene.signal = _signal(sub, signal)
     if contact_forces:
@@ -170,7 +171,10 @@ def _given_geometry(geometry: dict, model) -> dict:
 
 
 def _body_shape(body, given, scale: float, model) -> dict:
-    """Shape of a body in body axes: given geometry, else its own contact sphere, else the equivalent box."""
+    """Shape of a body in body axes: given geometry, else {"kind": "shapes"} for a body with shapes placed
+    by Body.add_shape (drawn by them, in Scene.shapes), else its own contact sphere, else the equivalent box."""
+    if given is None and body.shapes:
+        return {"kind": "shapes"}
     shape = given if given is not None else _contact_sphere(body, model)
     if shape is not None:
         return _shape_dict(body, shape)
