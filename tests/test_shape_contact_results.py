@@ -109,3 +109,33 @@ def test_table_scene_does_not_draw_the_centre_of_pressure_as_a_body():
     res = mb.simulate(m, 0.05, 0.01)
     scene = scene_from_table(res.to_dataframe())
     assert [b["name"] for b in scene.bodies] == ["box"]
+
+
+def test_box_thrown_tumbling_comes_to_rest_face_down_at_the_impact_height():
+    """Thrown at 3 m/s spinning at 25 rad/s (bench/contact_shapes.py's tumbling scene): it lands on a corner,
+    tumbles over edges and faces and rests on a face, its CM (m g / (4 k))^(1/e) below a/2, the centre of
+    pressure under the CM, the normal the floor's."""
+    from scipy.spatial.transform import Rotation
+    k, e = 1e5, 1.5
+    m = mb.Model(gravity=(0, 0, -G))
+    b = m.add_body("box", MASS, (MASS * A * A / 6,) * 3, position=(0, 0, 0.2),
+                   orientation=Rotation.from_rotvec((0.5, 0.3, 0.2)).as_matrix(), velocity=(3, 0, 0),
+                   angular_velocity=(1, 25, -2))
+    m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), b.add_shape("geo", mb.Box((A, A, A))), k, e, 50.0,
+                  1e-3, mu=0.5, friction_velocity=1e-2)
+    res = mb.simulate(m, 2.0, 0.005, rtol=1e-5, monitor=False)
+    assert res.success
+    R = res.orientation("box")
+    down = [int(np.argmax(np.abs(Rk[2]))) * 2 + int(Rk[2, np.argmax(np.abs(Rk[2]))] > 0) for Rk in R]
+    df = res.to_dataframe()
+    touching = df["c.points [-]"].to_numpy() > 0
+    npts = df["c.points [-]"].to_numpy()
+    assert {1, 2, 4} <= set(npts)   # on a corner, on an edge and on a face
+    on = [d for d, t in zip(down, touching) if t]
+    assert any(a != b for a, b in zip(on, on[1:]))   # tipped over an edge onto another face while touching
+    assert float(res.kinetic_energy()[-1]) < 1e-9
+    assert np.max(np.abs(R[-1, 2])) == pytest.approx(1.0, abs=1e-9)
+    c = res.position("box")[-1]
+    assert c[2] == pytest.approx(A / 2 - (MASS * G / (4 * k)) ** (1 / e), abs=1e-7)
+    assert np.allclose(columns(df, "c", ("x [m]", "y [m]"))[-1], c[:2], atol=1e-9)
+    assert np.allclose(columns(df, "c", ("nx [-]", "ny [-]", "nz [-]"))[-1], (0, 0, 1), atol=1e-12)
