@@ -1,13 +1,16 @@
 """Shape contact (issue 30) against MuJoCo on the same scenes, measured in the same run.
 
 Scenes: a box sliding down a 30 degree incline (mu 0.3), a cylinder rolling down a 15 degree incline, a
-pile of eight boxes dropped on the floor, an eccentric cam on a flat-faced follower (mbdsim only: the
+box thrown spinning onto the floor that tumbles over edges and faces to rest (the same answer where physics
+fixes one: at rest a face down with the CM a/2 over the floor, no kinetic energy; how far it travels depends
+on each engine's contact model and is only reported), a pile of eight boxes dropped on the floor, an eccentric cam on a flat-faced follower (mbdsim only: the
 closed-form lift).  Timed: the integration call only (mb.simulate, which includes its assembly checks; the
 mj_step loop), best of `REPEATS`, after a warm-up run that compiles.  Where physics allows the same
 answer, the error against the closed form is given for both engines.  Writes bench/CONTACT_RESULTS.md
 and the "Shape contact" section of bench/RESULTS.md.
 
-    PYTHONPATH=src python3 bench/contact_shapes.py
+    PYTHONPATH=src python3 bench/contact_shapes.py            # all scenes, written
+    PYTHONPATH=src python3 bench/contact_shapes.py tumble     # some (slide roll tumble pile cam), printed only
 """
 from __future__ import annotations
 
@@ -106,6 +109,47 @@ def mb_pile(method="dop853"):
     return sec, ke
 
 
+# a box thrown spinning onto the floor: it lands on a corner, tumbles over edges and faces and comes to rest
+TUMBLE_A, TUMBLE_T = 0.1, 2.0
+TUMBLE_POS, TUMBLE_V, TUMBLE_W = (0.0, 0.0, 0.2), (3.0, 0.0, 0.0), (1.0, 25.0, -2.0)   # [m], [m/s], [rad/s]
+
+
+def tumble_rotation():
+    from scipy.spatial.transform import Rotation
+    return Rotation.from_rotvec((0.5, 0.3, 0.2))
+
+
+def tumble_model():
+    """The thrown cube (side 0.1 m, 1 kg) over the floor: IMPACT 1e5 N/m^1.5, exponent 1.5, mu 0.5 (as the
+    pile); velocity and angular velocity in ground."""
+    a = TUMBLE_A
+    m = mb.Model(gravity=(0, 0, -G))
+    b = m.add_body("box", 1.0, (a * a / 6,) * 3, position=TUMBLE_POS, orientation=tumble_rotation().as_matrix(),
+                   velocity=TUMBLE_V, angular_velocity=TUMBLE_W)
+    m.add_contact("c", mb.Plane(m.ground, (0, 0, 0), (0, 0, 1)), b.add_shape("geo", mb.Box((a, a, a))), 1e5, 1.5,
+                  50.0, 1e-3, mu=0.5, friction_velocity=1e-2)
+    return m
+
+
+def rest_measures(z, R, v, w, a=TUMBLE_A):
+    """What physics fixes at rest, whatever the path: the CM at a/2 over the floor less the contact's
+    penetration (mbdsim's IMPACT law: (m g / (4 k))^(1/e) = 8.44e-4 m on four corners; MuJoCo: its soft
+    constraint's), a face down (tilt of the nearest body axis from the vertical [deg]), no kinetic energy [J]
+    of the unit-mass cube (I = a^2/6)."""
+    tilt = float(np.degrees(np.arccos(min(1.0, np.max(np.abs(R[2, :]))))))
+    ke = 0.5 * float(v @ v) + 0.5 * a * a / 6 * float(w @ w)
+    return {"z - a/2 [m]": float(z - a / 2), "tilt [deg]": tilt, "kinetic energy [J]": ke}
+
+
+def mb_tumble(method="dop853"):
+    m = tumble_model()
+    sec, res = _best(lambda: mb.simulate(m, TUMBLE_T, 0.01, method=method, rtol=1e-5, monitor=False))
+    r = rest_measures(res.position("box")[-1, 2], res.orientation("box")[-1], res.velocity("box")[-1],
+                      res.angular_velocity("box")[-1])
+    r["travel [m]"] = float(res.position("box")[-1, 0] - TUMBLE_POS[0])
+    return sec, r
+
+
 def mb_cam(method="dop853"):
     from test_shape_contact_cam import E_CAM, cam_model, lift_off_speed
     w = 0.7 * lift_off_speed()
@@ -179,6 +223,41 @@ def mj_pile():
     return sec, float(0.5 * np.sum(data.qvel ** 2))   # (unit masses; rotational part approximate)
 
 
+def mj_tumble():
+    """The thrown cube in MuJoCo, mj_step at 1 ms (its free joint's angular velocity is in body axes)."""
+    import mujoco
+    rot = tumble_rotation()
+    q = rot.as_quat()
+    p = TUMBLE_POS
+    xml = f"""<mujoco><option gravity="0 0 -9.81"/><worldbody>
+      <geom type="plane" size="5 5 0.1" friction="0.5 0 0"/>
+      <body name="box" pos="{p[0]} {p[1]} {p[2]}" quat="{q[3]} {q[0]} {q[1]} {q[2]}"><freejoint/>
+        <geom type="box" size="{TUMBLE_A / 2} {TUMBLE_A / 2} {TUMBLE_A / 2}" mass="1" friction="0.5 0 0"/></body>
+      </worldbody></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    dt = model.opt.timestep = 1e-3   # as the other scenes
+    R0 = rot.as_matrix()
+
+    def run():
+        d = mujoco.MjData(model)
+        d.qvel[:3], d.qvel[3:6] = TUMBLE_V, R0.T @ np.asarray(TUMBLE_W, float)
+        mujoco.mj_forward(model, d)
+        for _ in range(int(round(TUMBLE_T / dt))):
+            mujoco.mj_step(model, d)
+        return d
+    sec, d = _best(run)
+    R = d.body("box").xmat.reshape(3, 3)
+    r = rest_measures(d.body("box").xpos[2], R, d.qvel[:3].copy(), R @ d.qvel[3:6])
+    r["travel [m]"] = float(d.body("box").xpos[0] - TUMBLE_POS[0])
+    return sec, r
+
+
+def _fmt(x):
+    if isinstance(x, dict):
+        return ", ".join(f"{k} {v:.3g}" for k, v in x.items())
+    return f"{x:.3g}" if np.isfinite(x) else "n/a"
+
+
 def mj_cam(dt=2e-4):
     """The cam scene in MuJoCo: the eccentric disc on a hinge spun at w by a 1000 kg m^2 flywheel (the
     contact's torque leaves its speed constant to 1e-6), the follower a slide joint whose spring
@@ -216,21 +295,35 @@ def mj_cam(dt=2e-4):
     return sec, float(np.max(np.abs(zs - zs[0] - E_CAM * (1 - np.cos(w * ts)))) / E_CAM)
 
 
-def main():
+SCENES = {"slide": ("box sliding (30 deg, mu 0.3)", "mb_box_slide", "mj_box_slide", "acceleration error"),
+          "roll": ("cylinder rolling (15 deg)", "mb_cyl_roll", "mj_cyl_roll", "acceleration error"),
+          "tumble": (f"box thrown tumbling, {TUMBLE_T:g} s", "mb_tumble", "mj_tumble",
+                     "at rest: CM height over a/2, tilt from face down, kinetic energy; travel (path-dependent)"),
+          "pile": ("pile of 8 boxes, 1.5 s", "mb_pile", "mj_pile", "final kinetic energy [J]"),
+          "cam": ("cam on flat follower, 1 turn", "mb_cam", "mj_cam", "max lift error / e")}
+
+
+def main(argv=()):
+    """All scenes, written into CONTACT_RESULTS.md and RESULTS.md; with scene keys (SCENES: slide, roll,
+    tumble, pile, cam) on the command line, those only, printed and not written."""
     warnings.simplefilter("ignore")
     import os
+    unknown = [k for k in argv if k not in SCENES]
+    if unknown:
+        raise SystemExit(f"unknown scene(s) {unknown}; scenes: {', '.join(SCENES)}")
     load0 = os.getloadavg()[0]
     rows = []
-    for name, fm, fj, what in (("box sliding (30 deg, mu 0.3)", mb_box_slide, mj_box_slide, "acceleration error"),
-                               ("cylinder rolling (15 deg)", mb_cyl_roll, mj_cyl_roll, "acceleration error"),
-                               ("pile of 8 boxes, 1.5 s", mb_pile, mj_pile, "final kinetic energy [J]"),
-                               ("cam on flat follower, 1 turn", mb_cam, mj_cam, "max lift error / e")):
+    for key in argv or SCENES:
+        name, fm, fj, what = SCENES[key]
+        fm, fj = globals()[fm], globals()[fj]
         sm, em = fm()
         sa, ea = fm("auto")   # the default method: DOP853 with the hand-over to Radau IIA on stiffness
         sj, ej = fj() if fj else (np.nan, np.nan)
         rows.append((name, what, sm, em, sa, ea, sj, ej))
-        print(f"{name}: mbdsim DOP853 {sm:.4g} s ({em:.3g}), default {sa:.4g} s ({ea:.3g}), MuJoCo {sj:.4g} s "
-              f"({ej:.3g})", flush=True)
+        print(f"{name}: mbdsim DOP853 {sm:.4g} s ({_fmt(em)}), default {sa:.4g} s ({_fmt(ea)}), MuJoCo {sj:.4g} s "
+              f"({_fmt(ej)})", flush=True)
+    if argv:
+        return
     lines = ["## Shape contact (issue 30)", "",
              f"Generated by `python3 bench/contact_shapes.py` on {time.strftime('%Y-%m-%d')}; best of {REPEATS} runs "
              "of the integration call each, both engines in the same run.  mbdsim: compliant IMPACT contact, "
@@ -243,13 +336,12 @@ def main():
              "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
     for name, what, sm, em, sa, ea, sj, ej in rows:
         ratio = (lambda x: f"{x / sj:.3g}x" if np.isfinite(sj) else "n/a")  # noqa: E731
-        lines.append(f"| {name} | {what} | {sm:.4g} s | {em:.3g} | {sa:.4g} s | {ea:.3g} | "
-                     f"{'n/a' if not np.isfinite(sj) else f'{sj:.4g} s'} | "
-                     f"{'n/a' if not np.isfinite(ej) else f'{ej:.3g}'} | {ratio(sm)} | {ratio(sa)} |")
+        lines.append(f"| {name} | {what} | {sm:.4g} s | {_fmt(em)} | {sa:.4g} s | {_fmt(ea)} | "
+                     f"{'n/a' if not np.isfinite(sj) else f'{sj:.4g} s'} | {_fmt(ej)} | {ratio(sm)} | {ratio(sa)} |")
     text = "\n".join(lines) + "\n"
     (HERE / "CONTACT_RESULTS.md").write_text(text)
     replace_section(HERE / "RESULTS.md", text)
 
 
 if __name__ == "__main__":
-    main()
+    main(tuple(sys.argv[1:]))

@@ -26,7 +26,7 @@ def box_geometry(kind, a, tmp_path):
     if kind == "convex":
         return mb.ConvexMesh(v)
     import trimesh
-    path = tmp_path / "cube.stl"
+    path = tmp_path / f"cube.{kind}"   # stl, obj or ply, written by trimesh and read back by mb.Mesh
     trimesh.creation.box((a, a, a)).export(path)
     return mb.Mesh(path)
 
@@ -49,7 +49,7 @@ def fitted_acceleration(res, t_dir, t0):
     return 2.0 * np.polyfit(res.time[keep], s[keep], 2)[0]
 
 
-@pytest.mark.parametrize("kind", ["box", "convex", "stl"])
+@pytest.mark.parametrize("kind", ["box", "convex", "stl", "obj", "ply"])
 def test_box_slides_down_an_incline_at_g_sin_minus_mu_cos(kind, tmp_path):
     theta, mu = np.radians(30), 0.3
     m, t = box_on_incline(theta, kind, tmp_path, v0=0.5, mu=mu, friction_velocity=1e-3)
@@ -60,7 +60,7 @@ def test_box_slides_down_an_incline_at_g_sin_minus_mu_cos(kind, tmp_path):
     assert abs(a / ref - 1) < 1e-3, (a, ref)
 
 
-@pytest.mark.parametrize("kind", ["box", "convex", "stl"])
+@pytest.mark.parametrize("kind", ["box", "convex", "stl", "obj", "ply"])
 def test_box_stays_on_an_incline_steeper_friction_than_tan(kind, tmp_path):
     theta = np.radians(20)
     m, t = box_on_incline(theta, kind, tmp_path, mu_static=0.6, mu_dynamic=0.5, stiction_velocity=1e-3,

@@ -112,4 +112,4 @@ class Mesh:
         return _mass(f"mesh {self.path!r}" if self.path else "mesh", self.mesh, density)
 
     def __repr__(self) -> str:
-        return f"Mesh({self.path or ''!s}{len(self.vertices)} vertices, {len(self.faces)} faces)"
+        return f"Mesh({self.path + ', ' if self.path else ''}{len(self.vertices)} vertices, {len(self.faces)} faces)"

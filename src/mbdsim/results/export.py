@@ -26,10 +26,13 @@ drivers         "<motion>.effort [N m]" (rotation) or "[N]" (translation), Resul
 force elements  "<element>.force [N]" (spring-damper, translational stop, contact: Result.spring_force;
                 translational joint friction) or "<element>.torque [N m]" (torsion spring, rotational
                 stop, revolute joint friction); bushings "<element>.Fx [N]" ... "<element>.Tz [N m]", the
-                load on marker_j's body in marker_i axes; shape contacts "<element>.Fx [N]" .Fy .Fz,
-                ".points [-]", ".penetration [m]", ".slip_velocity [m/s]" (results.contacts).  Applied
-                forces and torques are inputs and
-                are not repeated.
+                load on marker_j's body in marker_i axes
+shape contacts  (results.contacts) "<element>.Fx [N]" .Fy .Fz (total force on shape_j); the centre of
+                pressure "<element>.x [m]" .y .z (touching points weighted by their normal forces) and
+                the unit normal of the resultant normal force "<element>.nx [-]" .ny .nz (shape_i towards
+                shape_j), both NaN when nothing touches; ".points [-]" (touching points),
+                ".penetration [m]" (deepest), ".slip_velocity [m/s]" (fastest slip)
+                Applied forces and torques are inputs and are not repeated.
 """
 from __future__ import annotations
 

@@ -112,9 +112,10 @@ def build_scene(res, signal=None, geometry: dict | None = None, max_frames: int 
     scene.joints = [_joint(j, index) for j in model.joints.values()]
     scene.springs, scene.shapes = _elements(model, index)
     from ..geometry.visual import body_meshes   # shapes placed with Body.add_shape (issue 30)
-    for b in system.bodies:
+    for b in [model.ground] + [b for b in system.bodies if not b.is_ground]:   # ground's shapes too
         for d in body_meshes(b):
-            scene.shapes.append({**d, "body": _on(b, index)})
+            color = "#9aa5b1" if b.is_ground else scene.bodies[index[b.name]]["color"]
+            scene.shapes.append({**d, "body": _on(b, index), "color": color})
     if signal is not None:
         scene.signal = _signal(sub, signal)
     if contact_forces:
@@ -170,7 +171,10 @@ def _given_geometry(geometry: dict, model) -> dict:
 
 
 def _body_shape(body, given, scale: float, model) -> dict:
-    """Shape of a body in body axes: given geometry, else its own contact sphere, else the equivalent box."""
+    """Shape of a body in body axes: given geometry, else {"kind": "shapes"} for a body with shapes placed
+    by Body.add_shape (drawn by them, in Scene.shapes), else its own contact sphere, else the equivalent box."""
+    if given is None and body.shapes:
+        return {"kind": "shapes"}
     shape = given if given is not None else _contact_sphere(body, model)
     if shape is not None:
         return _shape_dict(body, shape)
@@ -245,11 +249,13 @@ def scene_from_table(df, signal=None, max_frames: int = MAX_FRAMES, title: str =
     """A scene from an exported results table (`res.to_dataframe()` read back from .csv/.parquet).
 
     Such a table holds centre-of-mass positions only ("<body>.x [m]", ".y", ".z"): every body is drawn
-    as a sphere at its centre of mass without rotation, with its path; no joints or force elements.  `signal` is a
+    as a sphere at its centre of mass without rotation, with its path; no joints or force elements (a shape
+    contact's centre of pressure, "<contact>.x [m]" beside "<contact>.nx [-]", is not a body).  `signal` is a
     column name (matched leniently) or None."""
     from ..plotting import TIME_COLUMN, match_column
     time_col = match_column(df.columns, TIME_COLUMN)
     names = [c[:-len(".x [m]")] for c in df.columns if str(c).endswith(".x [m]")]
+    names = [n for n in names if f"{n}.nx [-]" not in df.columns]   # a shape contact's centre of pressure
     if not names:
         raise ModelError(f"results table {title!r}", "columns", "has no body position columns "
                          "('<body>.x [m]', '.y [m]', '.z [m]'); was it written from res.to_dataframe()?")

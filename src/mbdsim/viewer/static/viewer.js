@@ -46,6 +46,7 @@ function material(color, opts = {}) {
 }
 
 function shapeMesh(sh, color) {
+  if (sh.kind === 'shapes') return new THREE.Group();   // drawn by its Body.add_shape shapes (data.shapes)
   const geo = sh.kind === 'box' ? new THREE.BoxGeometry(...sh.size) : new THREE.SphereGeometry(sh.radius, 32, 16);
   const mesh = new THREE.Mesh(geo, material(color));
   if (sh.quat) mesh.quaternion.set(...sh.quat);
@@ -75,7 +76,8 @@ for (const sh of data.shapes) {
     geo.setAttribute('position', new THREE.Float32BufferAttribute(sh.vertices, 3));
     geo.setIndex(sh.faces);
     geo.computeVertexNormals();
-    mesh = new THREE.Mesh(geo, material(0xb08d57, { transparent: true, opacity: 0.85, side: THREE.DoubleSide }));
+    mesh = new THREE.Mesh(geo, material(sh.color || 0xb08d57, { transparent: true, opacity: 0.85, side: THREE.DoubleSide }));
+    mesh.name = 'shape:' + (sh.body < 0 ? 'ground' : data.bodies[sh.body].name) + '.' + sh.name;
   } else if (sh.kind === 'sphere') {
     mesh = new THREE.Mesh(new THREE.SphereGeometry(sh.radius, 24, 12),
       new THREE.MeshBasicMaterial({ color: 0x333333, wireframe: true, transparent: true, opacity: 0.25 }));
