@@ -171,3 +171,24 @@ def test_driven_four_bar_with_wound_loop_springs_in_the_compiled_kinematic_sweep
     ref_b = torque(ts)
     assert np.max(np.abs(between - ref_b)) < 1e-8 * np.max(np.abs(ref_b)), np.max(np.abs(between - ref_b))
     assert res.spring_length("kA")[-1] < -5 * 2 * np.pi   # wound: the continued angle, many turns
+
+
+def test_an_expression_reading_the_angle_of_a_joint_onto_a_particle_is_refused_naming_it():
+    """A pin whose body_j is a particle has no angle (the particle has no orientation): a load expression
+    reading it is a ModelError naming the load, the field and the joint, as a torsion spring on it is;
+    the pin's slide-free rate variable is refused the same way, a body's angle on another joint is fine."""
+    m = mb.Model("pj", gravity=(0, -9.81, 0))
+    b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1))
+    p = m.add_particle("p", 0.5, position=(1, 0, 0))
+    m.add_revolute("hub", m.ground, b, (0, 0, 0), (0, 0, 1))
+    m.add_revolute("pin", b, p, (1, 0, 0), (0, 0, 1))
+    for text in ("-2*pin", "-0.1*pin_dot"):
+        with pytest.raises(mb.ModelError) as err:
+            m.add_torque("tq", b, ("0", "0", text))
+        assert err.value.entity == "torque 'tq'" and err.value.field == "torque[2]"
+        assert "joint 'pin'" in str(err.value) and "particle" in str(err.value)
+    with pytest.raises(mb.ModelError):
+        m.add_torsion_spring("k", "pin", 10.0)
+    m.add_torque("tq", b, ("0", "0", "-2*hub"))
+    res = mb.simulate(m, 0.2, 0.1)
+    assert res.success and "compiled" in res.stats["method"]

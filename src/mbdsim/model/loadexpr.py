@@ -198,6 +198,11 @@ def parse_load(model, text, entity, field, allow_acc=False) -> LoadExpr:
                          f"body.marker; variables: t, TIME, the joints {', '.join(joints) or '(none)'}"
                          f"{'; inputs ' + ', '.join(inputs) if inputs else ''})") from None
     used = {v: m for v, m in joints.items() if e.depends_on(v)}
+    for v, m in used.items():
+        jt = model.joints[m.joint]
+        if m.dof == "rotation" and getattr(jt.body_j, "is_particle", False):
+            raise ModelError(entity, field, f"reads {v!r}, the angle of joint '{m.joint}', whose body_j "
+                             f"'{jt.body_j.name}' is a particle: it has no rotation, so the joint no angle")
     used.update({v: Measure("input", i=v) for v in inputs if e.depends_on(v)})
     used.update(hook.found)
     return LoadExpr(e, used)

@@ -450,8 +450,9 @@ def _compile_system(sys, rows, state, friction=False, tol=None) -> CompiledModel
         raise NotCompiled("not compiled yet: " + "; ".join(sys.not_compiled))
     if len(sys.lock_rows) and not friction:
         names = ", ".join(repr(n) for n in getattr(sys, "switched", {}))   # issue 29: docs/theory.md 12c
-        raise NotCompiled(f"joint friction (stick/slip) is compiled for the DOP853 step loop only: {names} "
-                          "run on the event-driven reference (force_elements/friction.py)")
+        raise NotCompiled(f"joint friction (stick/slip) {names}: compiled with its mode events in the step loops "
+                          "of mb.simulate (solvers.compiled_run, radau_run, hht_run), which compile with "
+                          "friction=True; this compilation is without it")
     M6 = np.zeros((nf, 6, 6))
     M6[:, range(6), range(6)] = 1.0
     M6[1:, range(3), range(3)] = sys.mass[1:, None]
