@@ -55,7 +55,8 @@ def kinematics(model: Model, end_time: float, output_step: float | None = None, 
     prediction coming from the last non-singular sample and the rates at a singular sample from that
     sample's extrapolation.  A model the compiled core carries that passes no singular configuration
     is solved by the compiled kinematic sweep (mbdsim.solvers.kinsweep, the same equations;
-    res.stats["method"] "kinematic (compiled sweep)"), with progress told each sample's time once the sweep is done."""
+    res.stats["method"] "kinematic (compiled sweep)"), with progress told each sample's time once the sweep is done.
+    Sensors (Model.add_sensor) are not watched: they end or mark simulations (mb.simulate)."""
     from .._progress import progress_of
     from ..results.stream import run_writing
     from .dynamic import _check_markers
@@ -137,7 +138,7 @@ def _compiled_sweep(sys, rep, times):
     from ..system.compiled import NotCompiled
     from .kinsweep import integrate_kinematic
     try:
-        res = integrate_kinematic(sys, rep, times)
+        res = integrate_kinematic(sys, rep, times, sensors=False)   # (kinematics watches no sensors)
     except NotCompiled:
         return None
     if res is not None and isinstance(res.error, AnalysisInterrupted):

@@ -129,7 +129,7 @@ class KinematicRun:
         return Yo[:, :nq], Yo[:, nq:], VDo, self.multipliers(ts, Yo, VDo, LAMo, MNo)
 
 
-def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
+def integrate_kinematic(sys, rep, times, progress=None, sensors=True) -> Result | None:
     """Kinematic analysis of the zero-DOF System `sys` (rep: its assembled state, rep.dof == 0) over the
     output grid `times` [s]; None when the compiled model is a joint-coordinate tree or a successful
     sweep met a change point (loop rows dependent at a solved configuration, e.g. a driven parallelogram
@@ -138,8 +138,9 @@ def integrate_kinematic(sys, rep, times, progress=None) -> Result | None:
     METHOD, "steps" the outputs solved (the first is the assembled state), "substeps" and "rejected" the
     sub-steps taken and retried between outputs, "nfev" and "njev" 0 (no right-hand side, no Jacobian
     by differences), "factorizations" and "projections" counted, "order" None (no integration formula:
-    every output is exact to the Newton tolerance PROJ_TOL)."""
-    if getattr(sys.model, "sensors", None):   # located on an integrator's dense output (DOP853 runs it)
+    every output is exact to the Newton tolerance PROJ_TOL). sensors=False: the model's sensors are not
+    watched (mb.kinematics: sensors end simulations), so they do not send the model to DOP853."""
+    if sensors and getattr(sys.model, "sensors", None):   # located on an integrator's dense output (DOP853 runs it)
         from ..system.compiled import NotCompiled
         raise NotCompiled(f"sensor '{next(iter(sys.model.sensors))}': the kinematic sweep does not watch sensors")
     run = KinematicRun(sys, rep)
