@@ -117,16 +117,51 @@ def test_wound_spring_equilibrium_beyond_a_turn_compiled():
     assert res.spring_length("clock")[0] == pytest.approx(5.5, abs=1e-9)
 
 
+def test_bead_on_a_helix_held_by_a_spring_compiled_against_the_reference_evaluator(monkeypatch):
+    """Point-on-curve (the curve parameter follows the foot point in the kernels, so the tangent basis
+    leaves it out): a bead on a helix pulled by a spring; the same equilibrium, reaction and stability from
+    the reference evaluator, and one stable direction (no spurious neutral one along the parameter)."""
+    def model():
+        m = mb.Model("bead", gravity=(0, -G, 0))
+        bead = m.add_particle("bead", 0.2, position=(0.3 * np.cos(-1.0), 0.3 * np.sin(-1.0), -0.1))
+        m.add_point_on_curve("path", bead.add_marker("c"), m.ground,
+                             mb.Curve(("0.3*cos(s)", "0.3*sin(s)", "0.1*s"), (-8, 8)))
+        m.add_spring_damper("sp", (m.ground, (0.5, 0.0, 0.2)), bead, 20.0, free_length=0.1)
+        return m
+    res = mb.equilibrium(model())
+    assert res.stats["method"] == "trust-region Newton (compiled)" and res.stats["stable"]
+    assert len(res.stats["stiffness_eigenvalues"]) == 1 and not res.stats["neutral_directions"]
+    monkeypatch.setattr(static, "evaluator", lambda sys, rows, sf: static_eval.Reference(sys, rows, sf))
+    ref = mb.equilibrium(model())
+    assert ref.stats["method"] == "trust-region Newton"
+    assert np.max(np.abs(res.position("bead") - ref.position("bead"))) < 1e-10
+    assert np.max(np.abs(res.reaction_force("path") - ref.reaction_force("path"))) < 1e-8
+    p = res.position("bead")[0]   # on the helix, and the spring's pull balances gravity along its tangent
+    s = np.arctan2(p[1], p[0]) + 2 * np.pi * np.round((p[2] / 0.1 - np.arctan2(p[1], p[0])) / (2 * np.pi))
+    assert np.allclose(p, [0.3 * np.cos(s), 0.3 * np.sin(s), 0.1 * s], atol=1e-9)
+    d = np.array([0.5, 0.0, 0.2]) - p
+    pull = 20.0 * (np.linalg.norm(d) - 0.1) * d / np.linalg.norm(d)
+    tangent = np.array([-0.3 * np.sin(s), 0.3 * np.cos(s), 0.1])
+    assert abs((pull + [0, -0.2 * G, 0]) @ tangent) < 1e-8
+
+
 def test_models_the_kernels_do_not_carry_use_the_reference_evaluator():
-    """A bead on a vertical circle (point-on-curve, an auxiliary curve parameter the compiled statics does
-    not carry): the reference evaluator, named as such (no "compiled"), hanging at the bottom; joint
-    friction, which statics cannot load, is refused naming the element."""
-    m = mb.Model("bead", gravity=(0, -G, 0))
-    bead = m.add_particle("bead", 0.2, position=(0.3 * np.cos(-1.0), 0.3 * np.sin(-1.0), 0.0))
-    m.add_point_on_curve("path", bead.add_marker("c"), m.ground, mb.Curve(("0.3*cos(s)", "0.3*sin(s)", "0"), (-4, 3)))
+    """A gear pair (a coupler, whose auxiliary angles the compiled statics does not carry): the reference
+    evaluator, named as such (no "compiled"), at the closed-form equilibrium; joint friction, which
+    statics cannot load, is refused naming the element."""
+    m = mb.Model("gears")
+    a = m.add_body("a", 1.0, inertia=(0.1, 0.1, 0.1))
+    b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(1.0, 0, 0))
+    ja = m.add_revolute("ja", m.ground, a, (0, 0, 0), (0, 0, 1))
+    jb = m.add_revolute("jb", m.ground, b, (1.0, 0, 0), (0, 0, 1))
+    m.add_gear("g", ja, jb, -0.5)
+    m.add_torsion_spring("k", jb, 4.0)
+    m.add_torque("drive", a, (0.0, 0.0, 1.0))
     res = mb.equilibrium(m)
     assert res.stats["method"] == "trust-region Newton" and res.stats["stable"]
-    assert np.allclose(res.position("bead")[0], [0.0, -0.3, 0.0], atol=1e-9)
+    # V = k theta_b^2 / 2 - 1 N m theta_a with theta_b = -0.5 theta_a: minimum at theta_a = 1 / (0.25 k)
+    assert res.joint_coordinate(ja)[0] == pytest.approx(1.0 / (0.25 * 4.0), abs=1e-9)
+    assert res.joint_coordinate(jb)[0] == pytest.approx(-0.5 / (0.25 * 4.0), abs=1e-9)
     model = arm(3, 20.0)
     model.add_friction("fr", "j1", 0.3, 0.2, pin_radius=0.01)
     with pytest.raises(mb.ModelError) as err:

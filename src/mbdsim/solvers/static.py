@@ -41,7 +41,7 @@ from ..system.equations import constraint_terms
 from ..system.frames import body_frames
 from .assembly import assemble_state
 from .common import project_positions
-from .reduced import describe_direction, length_scale, null_basis, velocity_scale
+from .reduced import describe_direction, length_scale, velocity_scale
 from .static_eval import evaluator
 from ..results.state import state_factory
 from typing import TYPE_CHECKING
@@ -163,7 +163,7 @@ def solve_static(sys, q, t, rows, sf=None, tol=1e-10, maxit=100, relax=False, ev
     for it in range(maxit + 1):
         if it:
             cur = _at(ev, sys, q, t, rows)
-        N = null_basis(cur.J0, scale)
+        N = ev.basis(cur.J0, scale)
         f, r = N.T @ cur.r0, cur.r0
         converged = np.max(np.abs(r), initial=0.0) <= tol * force_scale
         if it == maxit and not converged:

@@ -3,8 +3,9 @@ q(z) = project(q0 (+) N z) at one time, each giving the reduced load f = N^T r a
 load r = Q - phi_q^T lambda_ (least-squares multipliers).
 
 `evaluator(sys, rows, sf)` returns the compiled one (`Compiled`: solvers.faststatic, every configuration of a
-batch in one call) when the model compiles in absolute coordinates without joint friction, couplers in closed
-loops or point-on-curve constraints, else the reference (`Reference`: numpy, the force elements' own
+batch in one call) when the model compiles in absolute coordinates without joint friction or couplers in
+closed loops (point-on-curve constraints included: their curve parameters follow the foot point, so the
+tangent basis leaves them out), else the reference (`Reference`: numpy, the force elements' own
 evaluators). Both give, for the first row of a batch, the configuration, the loads Q (nv,) [N, N m] and the
 Jacobian of the rows solved for (for the tangent basis); velocity-like vectors: CM translations in ground
 axes, rotations in body axes (the System's layout).
@@ -17,7 +18,7 @@ from ..errors import SolverError
 from ..system.dynamics import applied_forces
 from ..system.equations import constraint_terms
 from ..system.frames import body_frames
-from .reduced import Chart, tangent_residual
+from .reduced import Chart, null_basis, tangent_residual
 
 PROJ_TOL = 1e-12   # Newton tolerance of the compiled chart's projection: max |phi| [m or rad]
 
@@ -60,6 +61,10 @@ class Reference:
                 J0 = constraint_terms(sys, x, zero, t)[1][self.rows] if len(self.rows) else np.zeros((0, sys.nv))
         return Batch(F, R, X, Q0, J0, r0, m)
 
+    def basis(self, J0, scale):
+        """The tangent basis N (nv, d) at the first row of a batch (`reduced.null_basis`)."""
+        return null_basis(J0, scale)
+
     def angle_refs(self):
         """None: the force elements keep their own references, by time (`static._follow_angles`)."""
         return None
@@ -87,6 +92,20 @@ class Compiled:
         w = self.work.arrays()
         self.nrows = len(cm.arrays()[32]) + len(w[46])
         self.anchors = _angle_measures(sys, cm)
+        # point-on-curve: the kernels eliminate the curve parameters (foot points), so the rows leave their
+        # columns empty; the tangent basis is that of the other velocity variables
+        aux = np.asarray(getattr(sys, "aux_v_idx", ()), dtype=int)
+        self.free = None if not (len(aux) and len(cm.arrays()[49][0])) else np.setdiff1d(np.arange(sys.nv), aux)
+
+    def basis(self, J0, scale):
+        """The tangent basis N (nv, d) at the first row of a batch (`reduced.null_basis`), without the
+        curve parameters of point-on-curve constraints (zero rows of N)."""
+        if self.free is None:
+            return null_basis(J0, scale)
+        Nf = null_basis(J0[:, self.free], np.asarray(scale)[self.free])
+        N = np.zeros((self.sys.nv, Nf.shape[1]))
+        N[self.free] = Nf
+        return N
 
     def batch(self, q0, N, Z, t, accept):
         from . import faststatic
@@ -151,16 +170,16 @@ def _angle_measures(sys, cm) -> dict:
 
 
 def evaluator(sys, rows, sf):
-    """The compiled evaluator when the model compiles in absolute coordinates (no joint friction, loop
-    couplers or point-on-curve constraints), else the reference."""
+    """The compiled evaluator when the model compiles in absolute coordinates (no joint friction or loop
+    couplers), else the reference."""
     from ..system.compiled import NotCompiled, compile_system
-    if len(getattr(sys, "lock_rows", ())) or getattr(sys.model, "path_constraints", None):
+    if len(getattr(sys, "lock_rows", ())):
         return Reference(sys, rows, sf)
     try:
         cm = compile_system(sys, rows)
     except NotCompiled:
         return Reference(sys, rows, sf)
     a = cm.arrays()
-    if int(cm.dims[5]) == 1 or len(a[50][0]) or len(a[49][0]) or len(a[48][0]):
+    if int(cm.dims[5]) == 1 or len(a[50][0]) or len(a[48][0]):
         return Reference(sys, rows, sf)
     return Compiled(sys, rows, cm)
