@@ -120,7 +120,12 @@ def test_visuals_are_placed_on_their_bodies_and_drawn(tmp_path):
     html = mb.animate(model, tmp_path / "arm.html", end_time=0.01)
     data = json.loads(re.search(r'id="mbdsim-data">(.*?)</script>', Path(html).read_text(), re.S).group(1))
     moving = sum(len(b.shapes) for b in model.bodies.values() if b is not model.ground)
-    assert len(data["shapes"]) == moving > 0
+    assert moving > 0   # every shape is drawn, the base link's on ground too (body -1), each on its body
+    assert len(data["shapes"]) == moving + len(model.ground.shapes)
+    names = {b: i for i, b in enumerate(n for n in model.bodies if model.bodies[n] is not model.ground)}
+    drawn = sorted(s["body"] for s in data["shapes"])
+    assert drawn == sorted([-1] * len(model.ground.shapes) + [k for n, k in names.items()
+                                                                for _ in model.bodies[n].shapes])
 
 
 def test_package_mesh_is_resolved(tmp_path):

@@ -32,7 +32,7 @@ def _child(cache: Path) -> list[str]:
     src = Path(mbdsim.__file__).resolve().parent.parent
     env = dict(os.environ, PYTHONPATH=str(src), NUMBA_CACHE_DIR=str(cache), MBDSIM_QUIET_COMPILE="1")
     out = subprocess.run([sys.executable, "-X", "faulthandler", "-c", CHILD], env=env, capture_output=True, text=True, timeout=600)
-    open("/tmp/s32/child_err.txt", "w").write(out.stderr); assert out.returncode == 0, out.stderr[-3000:]
+    assert out.returncode == 0, out.stderr[-3000:]
     return out.stdout.split()
 
 
