@@ -145,23 +145,49 @@ def test_bead_on_a_helix_held_by_a_spring_compiled_against_the_reference_evaluat
     assert abs((pull + [0, -0.2 * G, 0]) @ tangent) < 1e-8
 
 
-def test_models_the_kernels_do_not_carry_use_the_reference_evaluator():
-    """A gear pair (a coupler, whose auxiliary angles the compiled statics does not carry): the reference
-    evaluator, named as such (no "compiled"), at the closed-form equilibrium; joint friction, which
-    statics cannot load, is refused naming the element."""
-    m = mb.Model("gears")
-    a = m.add_body("a", 1.0, inertia=(0.1, 0.1, 0.1))
-    b = m.add_body("b", 1.0, inertia=(0.1, 0.1, 0.1), position=(1.0, 0, 0))
-    ja = m.add_revolute("ja", m.ground, a, (0, 0, 0), (0, 0, 1))
-    jb = m.add_revolute("jb", m.ground, b, (1.0, 0, 0), (0, 0, 1))
+def shafts(n, k=4.0):
+    """n shafts on ground pins about z (1 kg, no gravity), a torsion spring k [N m/rad] on each but the
+    first, a torque of 1 N m about z on the first."""
+    m = mb.Model("shafts")
+    joints = []
+    for i in range(n):
+        b = m.add_body(f"s{i}", 1.0, inertia=(0.1, 0.1, 0.1), position=(float(i), 0, 0))
+        joints.append(m.add_revolute(f"j{i}", m.ground, b, (float(i), 0, 0), (0, 0, 1)))
+        if i:
+            m.add_torsion_spring(f"k{i}", joints[-1], k)
+    m.add_torque("drive", "s0", (0.0, 0.0, 1.0))
+    return m, joints
+
+
+def test_gear_pair_compiled_at_the_virtual_work_balance(monkeypatch):
+    """A gear pair (a two-body coupler: its continued angles carried by the kernels, left out of the
+    tangent basis): V = k theta_1^2 / 2 - 1 N m theta_0 with theta_1 = -0.5 theta_0, minimum at theta_0 =
+    1 / (0.25 k); the same from the reference evaluator."""
+    m, (ja, jb) = shafts(2)
     m.add_gear("g", ja, jb, -0.5)
-    m.add_torsion_spring("k", jb, 4.0)
-    m.add_torque("drive", a, (0.0, 0.0, 1.0))
+    res = mb.equilibrium(m)
+    assert res.stats["method"] == "trust-region Newton (compiled)" and res.stats["stable"]
+    assert len(res.stats["stiffness_eigenvalues"]) == 1
+    assert res.joint_coordinate(ja)[0] == pytest.approx(1.0, abs=1e-9)
+    assert res.joint_coordinate(jb)[0] == pytest.approx(-0.5, abs=1e-9)
+    monkeypatch.setattr(static, "evaluator", lambda sys, rows, sf: static_eval.Reference(sys, rows, sf))
+    m2, _ = shafts(2)
+    m2.add_gear("g", "j0", "j1", -0.5)
+    ref = mb.equilibrium(m2)
+    assert "compiled" not in ref.stats["method"]
+    assert np.max(np.abs(res.reaction_torque("j1") - ref.reaction_torque("j1"))) < 1e-8
+
+
+def test_models_the_kernels_do_not_carry_use_the_reference_evaluator():
+    """A coupler on three shafts (theta_2 = theta_0 + theta_1: a wide row, bordered in the kernels): the
+    reference evaluator, named as such (no "compiled"), at the closed form theta = (2, -1, 1) tau / k;
+    joint friction, which statics cannot load, is refused naming the element."""
+    m, joints = shafts(3)
+    m.add_user_constraint("diff", "j0 + j1 - j2")
     res = mb.equilibrium(m)
     assert res.stats["method"] == "trust-region Newton" and res.stats["stable"]
-    # V = k theta_b^2 / 2 - 1 N m theta_a with theta_b = -0.5 theta_a: minimum at theta_a = 1 / (0.25 k)
-    assert res.joint_coordinate(ja)[0] == pytest.approx(1.0 / (0.25 * 4.0), abs=1e-9)
-    assert res.joint_coordinate(jb)[0] == pytest.approx(-0.5 / (0.25 * 4.0), abs=1e-9)
+    for jt, x in zip(joints, (0.5, -0.25, 0.25)):
+        assert res.joint_coordinate(jt)[0] == pytest.approx(x, abs=1e-9)
     model = arm(3, 20.0)
     model.add_friction("fr", "j1", 0.3, 0.2, pin_radius=0.01)
     with pytest.raises(mb.ModelError) as err:
