@@ -32,6 +32,7 @@ def run():
 
 def test_dead_centre_is_warned_with_its_time_and_recorded(run):
     res, _, warned = run
+    assert res.stats["method"] == "kinematic (compiled sweep)"   # through the dead centre by continuity
     assert len(warned) == 1 and "t = 0.5 s" in str(warned[0].message) and "push" in str(warned[0].message)
     assert [r["time"] for r in res.stats["singular"]] == [0.5]
     assert res.stats["singular"][0]["conditioning"] < 1e-4 and "O" in res.stats["singular"][0]["joints"]

@@ -130,36 +130,57 @@ def _kinematics(model, end_time, output_step, start_time, progress) -> Result:
 def _compiled_sweep(sys, rep, times):
     """The Result of the compiled kinematic sweep (solvers.kinsweep: the same equations, every sample in
     compiled code; joint angles of torsion springs and rotational stops continued in the kernel, each
-    sub-step turning a body by at most fastkin.MAX_TURN) when the model is carried by the compiled
-    core, solves completely and passes no singular configuration
-    (conditioning of every sample, from one batched SVD, at least SINGULAR_TOL); else None, and the
-    analysis below (which treats singular passages and reports failures) runs instead."""
+    sub-step turning a body by at most fastkin.MAX_TURN) when the model is carried by the compiled core and
+    solves completely; else None, and the analysis below (which reports failures) runs instead. Singular
+    configurations (a dead centre, a change point) are passed by continuity: where the constraints do not
+    determine the rates the kernel keeps those of its prediction, as the per-sample analysis extrapolates
+    them from the last regular sample; the samples whose conditioning (`Monitor`, from one batched SVD of
+    every sample) is below SINGULAR_TOL are recorded in res.stats["singular"] and each passage warned."""
     from ..errors import AnalysisInterrupted
     from ..system.compiled import NotCompiled
     from .kinsweep import integrate_kinematic
     try:
-        res = integrate_kinematic(sys, rep, times, sensors=False)   # (kinematics watches no sensors)
+        res = integrate_kinematic(sys, rep, times, sensors=False, continuity=True)   # (sensors: not watched)
     except NotCompiled:
         return None
     if res is not None and isinstance(res.error, AnalysisInterrupted):
         return res   # Ctrl-C: what was solved, not the analysis again on the path below
     if res is None or not res.success or len(res.time) != len(times):
         return None
-    if len(rep.rows) and sys.nv <= DENSE_LIMIT:
-        from ..system.equations import jacobians
-        from ..system.metrics import geometric_scale
-        scale = geometric_scale(sys)
-        block = max(1, 2**22 // max(1, sys.nc * sys.nv))   # samples per batch: Jacobians of <= 32 MB at a time
-        r = len(rep.rows)   # the rank the rows must keep: that of all rows (the kernel re-selects its own)
-        for k in range(0, len(res.time), block):
-            J = jacobians(sys, res.q[k:k + block]) * scale
-            J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
-            sv = np.linalg.svd(J, compute_uv=False)
-            if np.any(sv[:, r - 1] < SINGULAR_TOL * np.maximum(sv[:, 0], 1e-300)):
-                return None
-    res.stats = {"method": "kinematic (compiled sweep)", "singular": [],
-                 **{k: res.stats[k] for k in ("steps", "substeps", "factorizations", "projections", "assembly")}}
+    records = _singular_samples(sys, rep, res)
+    _warn_singular(records)
+    res.stats = {"method": "kinematic (compiled sweep)", "singular": records,
+                 **{k: res.stats[k] for k in ("steps", "substeps", "factorizations", "projections", "assembly",
+                                              "change_points")}}
     return res
+
+
+def _singular_samples(sys, rep, res) -> list:
+    """The records (time [s], conditioning, joints, sample) of the samples of `res` whose conditioning is
+    below SINGULAR_TOL: one batched SVD of the scaled, row-normalised Jacobians of all rows (rank: that of
+    the independent rows; the kernel re-selects its own), `Monitor` at the flagged samples for the joints."""
+    if not len(rep.rows) or sys.nv > DENSE_LIMIT:
+        return []
+    from ..system.equations import jacobians
+    from ..system.metrics import geometric_scale
+    scale = geometric_scale(sys)
+    block = max(1, 2**22 // max(1, sys.nc * sys.nv))   # samples per batch: Jacobians of <= 32 MB at a time
+    r = len(rep.rows)
+    flagged = []
+    for k in range(0, len(res.time), block):
+        J = jacobians(sys, res.q[k:k + block]) * scale
+        J = J / np.maximum(np.linalg.norm(J, axis=2, keepdims=True), 1e-300)
+        sv = np.linalg.svd(J, compute_uv=False)
+        flagged += [k + i for i in np.flatnonzero(sv[:, r - 1] < SINGULAR_TOL * np.maximum(sv[:, 0], 1e-300))]
+    if not flagged:
+        return []
+    mon = Monitor(sys, rep.rows)
+    out = []
+    for i in flagged:
+        cond, joints = mon(res.q[i], float(res.time[i]))
+        if cond < SINGULAR_TOL:
+            out.append({"time": float(res.time[i]), "conditioning": cond, "joints": joints, "sample": int(i)})
+    return out
 
 
 class Monitor:

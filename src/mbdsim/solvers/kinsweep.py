@@ -129,7 +129,7 @@ class KinematicRun:
         return Yo[:, :nq], Yo[:, nq:], VDo, self.multipliers(ts, Yo, VDo, LAMo, MNo)
 
 
-def integrate_kinematic(sys, rep, times, progress=None, sensors=True) -> Result | None:
+def integrate_kinematic(sys, rep, times, progress=None, sensors=True, continuity=False) -> Result | None:
     """Kinematic analysis of the zero-DOF System `sys` (rep: its assembled state, rep.dof == 0) over the
     output grid `times` [s]; None when the compiled model is a joint-coordinate tree or a successful
     sweep met a change point (loop rows dependent at a solved configuration, e.g. a driven parallelogram
@@ -139,7 +139,10 @@ def integrate_kinematic(sys, rep, times, progress=None, sensors=True) -> Result 
     sub-steps taken and retried between outputs, "nfev" and "njev" 0 (no right-hand side, no Jacobian
     by differences), "factorizations" and "projections" counted, "order" None (no integration formula:
     every output is exact to the Newton tolerance PROJ_TOL). sensors=False: the model's sensors are not
-    watched (mb.kinematics: sensors end simulations), so they do not send the model to DOP853."""
+    watched (mb.kinematics: sensors end simulations), so they do not send the model to DOP853;
+    continuity=True (mb.kinematics): a change point's rates are those of the prediction (the sub-steps'
+    Taylor series), the sweep's result is returned (res.stats["change_points"]: the configurations where
+    the factorisation dropped dependent rows) instead of None."""
     if sensors and getattr(sys.model, "sensors", None):   # located on an integrator's dense output (DOP853 runs it)
         from ..system.compiled import NotCompiled
         raise NotCompiled(f"sensor '{next(iter(sys.model.sensors))}': the kinematic sweep does not watch sensors")
@@ -151,7 +154,7 @@ def integrate_kinematic(sys, rep, times, progress=None, sensors=True) -> Result 
     partial = lambda Y, VD, LAM, MN, n: _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n],  # noqa: E731
                                                 MN[:n], stats={"assembly": rep})
     Y, VD, LAM, MN, n, status, t_fail, y_fail = run.sweep(times[0], y0, times, progress, partial)
-    if status == OK and run.stats[5]:   # rates left to continuity somewhere: integrate instead
+    if status == OK and run.stats[5] and not continuity:   # rates left to continuity somewhere: integrate instead
         return None
     success, message, error = True, "ok", None
     if status != OK:
@@ -161,7 +164,7 @@ def integrate_kinematic(sys, rep, times, progress=None, sensors=True) -> Result 
     s = run.stats
     stats = {"steps": int(n), "substeps": int(s[1]), "rejected": int(s[2]), "nfev": 0, "njev": 0,
              "factorizations": int(s[4]), "projections": int(s[3]), "order": None, "method": METHOD,
-             "formulation": "absolute coordinates (tree elimination)", "assembly": rep}
+             "formulation": "absolute coordinates (tree elimination)", "assembly": rep, "change_points": int(s[5])}
     res = _result(sys, rep, run, times[:n], Y[:n], VD[:n], LAM[:n], MN[:n], success, message, stats)
     res.error = error
     return res
