@@ -140,3 +140,41 @@ def test_contact_force_arrows_render_in_chromium(driver, tmp_path):
         assert drawn == arrows
         logs = [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
         assert logs == [], logs
+
+
+def test_add_shape_shapes_render_where_their_body_is(driver, tmp_path):
+    """Issue 30: shapes placed with Body.add_shape (a box and a cylinder on a falling body, a box on ground)
+    are meshes of the page named shape:<body>.<name>; their vertices, posed by the page at a time, lie where
+    the Result puts the shape (the box's corners at the body's pose), without console errors."""
+    model = mb.Model("shapes", gravity=(0, 0, -9.81))
+    body = model.add_body("b", 1.0, (0.01,) * 3, position=(0.0, 0.0, 0.5), angular_velocity=(1.0, 2.0, 0.5))
+    body.add_shape("cube", mb.Box((0.2, 0.1, 0.05)), center=(0.1, 0.0, 0.5))
+    body.add_shape("rod", mb.Cylinder(0.02, 0.3, "x"))
+    model.ground.add_shape("base", mb.Box((0.4, 0.4, 0.02)), center=(0.0, 0.0, -0.01))
+    res = mb.simulate(model, end_time=0.3, output_step=0.01)
+    page = mb.animate(res, tmp_path / "shapes.html", signal=None)
+    driver.get(page.resolve().as_uri())
+    t_end = time.monotonic() + 30
+    while not driver.execute_script("return !!(window.mbdsimViewer && window.mbdsimViewer.ready)"):
+        assert time.monotonic() < t_end, "viewer did not start: " + str(driver.get_log("browser"))
+        time.sleep(0.05)
+    v = "window.mbdsimViewer"
+    driver.execute_script(f"{v}.setTime(0.3)")
+    names = driver.execute_script(f"const out = []; {v}.scene.traverse((o) => {{ if (o.name.startsWith('shape:')) "
+                                  "out.push(o.name); }); return out.sort();")
+    assert names == ["shape:b.cube", "shape:b.rod", "shape:ground.base"], names
+    world = driver.execute_script(
+        f"const m = {v}.scene.getObjectByName('shape:b.cube'); m.updateMatrixWorld(true);"
+        "const p = m.geometry.attributes.position, out = [];"
+        "for (let i = 0; i < p.count; i++) { const w = new m.position.constructor(p.getX(i), p.getY(i), p.getZ(i));"
+        " m.localToWorld(w); out.push([w.x, w.y, w.z]); } return out;")
+    world = np.array(world)
+    r, R = res.position("b")[-1], res.orientation("b")[-1]
+    corners = np.array([[sx * 0.1, sy * 0.05, sz * 0.025] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)])
+    expected = r + (corners + [0.1, 0.0, 0.0]) @ R.T   # the cube's centre 0.1 m along the body's x axis
+    # every drawn vertex of the cube is on it (bounded by its corners in the cube's axes), the corners drawn
+    local = (world - (r + R @ [0.1, 0.0, 0.0])) @ R
+    assert np.all(np.abs(local) <= np.array([0.1, 0.05, 0.025]) + 1e-5)
+    assert all(np.min(np.linalg.norm(world - c, axis=1)) < 1e-5 for c in expected)
+    logs = [e for e in driver.get_log("browser") if e["level"] in ("SEVERE", "ERROR")]
+    assert logs == [], logs
