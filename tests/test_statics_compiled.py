@@ -178,16 +178,28 @@ def test_gear_pair_compiled_at_the_virtual_work_balance(monkeypatch):
     assert np.max(np.abs(res.reaction_torque("j1") - ref.reaction_torque("j1"))) < 1e-8
 
 
-def test_models_the_kernels_do_not_carry_use_the_reference_evaluator():
-    """A coupler on three shafts (theta_2 = theta_0 + theta_1: a wide row, bordered in the kernels): the
-    reference evaluator, named as such (no "compiled"), at the closed form theta = (2, -1, 1) tau / k;
-    joint friction, which statics cannot load, is refused naming the element."""
+def test_differential_compiled_at_the_closed_form(monkeypatch):
+    """A coupler on three shafts (theta_2 = theta_0 + theta_1: a wide row, bordered in the kernels, its
+    Jacobian G from the terms' blocks): the closed form theta = (2, -1, 1) tau / k (minimum of
+    k theta_1^2 / 2 + k theta_2^2 / 2 - tau theta_0), and the reference evaluator's reactions."""
     m, joints = shafts(3)
     m.add_user_constraint("diff", "j0 + j1 - j2")
     res = mb.equilibrium(m)
-    assert res.stats["method"] == "trust-region Newton" and res.stats["stable"]
+    assert res.stats["method"] == "trust-region Newton (compiled)" and res.stats["stable"]
+    assert len(res.stats["stiffness_eigenvalues"]) == 2
     for jt, x in zip(joints, (0.5, -0.25, 0.25)):
         assert res.joint_coordinate(jt)[0] == pytest.approx(x, abs=1e-9)
+    monkeypatch.setattr(static, "evaluator", lambda sys, rows, sf: static_eval.Reference(sys, rows, sf))
+    m2, _ = shafts(3)
+    m2.add_user_constraint("diff", "j0 + j1 - j2")
+    ref = mb.equilibrium(m2)
+    assert ref.stats["method"] == "trust-region Newton"
+    for j in ("j0", "j1", "j2"):
+        assert np.max(np.abs(res.reaction_torque(j) - ref.reaction_torque(j))) < 1e-8
+
+
+def test_joint_friction_is_refused_by_statics_naming_it():
+    """Statics cannot load joint friction (indeterminate at rest): a ModelError naming the element."""
     model = arm(3, 20.0)
     model.add_friction("fr", "j1", 0.3, 0.2, pin_radius=0.01)
     with pytest.raises(mb.ModelError) as err:

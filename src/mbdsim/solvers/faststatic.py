@@ -23,19 +23,22 @@ from .. import _jitcache  # noqa: F401  (numba's cache directory, before any ker
 from .._jit import entry, kernel
 from ..system.kernels import scatter_dense
 from .fastdyn import OK, _from6, _to6, accept_state, increment_into, loads_into, newton_positions
+from .loopcoord import wide_unit_load
 
 
 @entry(_nrt=True)
 def reduced_forces(cm, wk, t, q0, N, Z, tol, accept, F, R, X, Q0, J0, r0):
     """The batch of the module docstring: F[k] = N^T r (d,), R[k] = max |r| and X[k] the configuration x
-    of row k of Z (m, d); Q0 (nv,), J0 (rows solved for, nv) and r0 (nv,) the loads, the rows' Jacobian
+    of row k of Z (m, d); Q0 (nv,), J0 (rows solved for: the independent rows, the re-selected loop rows
+    and the wide coupler rows, nv) and r0 (nv,) the loads, the rows' Jacobian
     and the unbalanced load at the first row's x. Returns the number of rows done: < m when the projection of row k failed (no
     configuration on the constraints there) or a Python-callable load failed there."""
     nq, nv, d = q0.shape[0], N.shape[0], N.shape[1]
     nf = cm[5].shape[0]
-    active, sel = cm[32], wk[46]
+    active, sel, wide = cm[32], wk[46], cm[50][17]
     na = active.shape[0]
-    nr = na + sel.shape[0]
+    nr = na + sel.shape[0] + wide.shape[0]   # (wide coupler rows last: their Jacobian from loopcoord)
+    wrow = np.zeros(nv)
     dz, dx6, F6 = np.zeros(nv), np.zeros((nf, 6)), np.zeros((nf, 6))
     v0, Q, r = np.zeros(nv), np.zeros(nv), np.zeros(nv)
     Jall = np.zeros((wk[5].shape[0], nv))
@@ -67,10 +70,18 @@ def reduced_forces(cm, wk, t, q0, N, Z, tol, accept, F, R, X, Q0, J0, r0):
         _from6(cm, F6, Q)
         Jall[:, :] = 0.0
         scatter_dense(wk[5], cm[12], cm[13], cm[5], cm[6], Jall)
-        for i in range(nr):
+        nsel = na + sel.shape[0]
+        for i in range(nsel):
             row = active[i] if i < na else sel[i - na]
             for c in range(nv):
                 Jd[i, c] = Jall[row, c]
+        for a in range(wide.shape[0]):   # G_a of each wide row (terms on three bodies or more)
+            wide_unit_load(cm[50], wk[52], a)
+            for c in range(nv):
+                wrow[c] = 0.0
+            _from6(cm, wk[52][13], wrow)
+            for c in range(nv):
+                Jd[nsel + a, c] = wrow[c]
         for i in range(nv):
             r[i] = Q[i]
         if nr > 0:

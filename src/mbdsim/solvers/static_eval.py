@@ -3,10 +3,9 @@ q(z) = project(q0 (+) N z) at one time, each giving the reduced load f = N^T r a
 load r = Q - phi_q^T lambda_ (least-squares multipliers).
 
 `evaluator(sys, rows, sf)` returns the compiled one (`Compiled`: solvers.faststatic, every configuration of a
-batch in one call) when the model compiles in absolute coordinates without joint friction or couplers whose
-terms move three bodies or more (point-on-curve constraints and two-body couplers, gears included: their
-curve parameters and continued angles follow the configuration, so the tangent basis leaves them out),
-else the reference (`Reference`: numpy, the force elements' own
+batch in one call) when the model compiles in absolute coordinates without joint friction (point-on-curve
+constraints and couplers included, gears and differentials: their curve parameters and continued angles
+follow the configuration, so the tangent basis leaves them out), else the reference (`Reference`: numpy, the force elements' own
 evaluators). Both give, for the first row of a batch, the configuration, the loads Q (nv,) [N, N m] and the
 Jacobian of the rows solved for (for the tangent basis); velocity-like vectors: CM translations in ground
 axes, rotations in body axes (the System's layout).
@@ -91,7 +90,7 @@ class Compiled:
         self.work = Work.for_model(cm)
         self.pyloads = pyloads.attach(sys, cm, self.work)
         w = self.work.arrays()
-        self.nrows = len(cm.arrays()[32]) + len(w[46])
+        self.nrows = len(cm.arrays()[32]) + len(w[46]) + len(cm.arrays()[50][17])
         self.anchors = _angle_measures(sys, cm)
         # point-on-curve and couplers: the kernels eliminate the curve parameters (foot points) and carry the
         # couplers' continued angles along, so the rows leave their columns empty; the tangent basis is that
@@ -172,8 +171,8 @@ def _angle_measures(sys, cm) -> dict:
 
 
 def evaluator(sys, rows, sf):
-    """The compiled evaluator when the model compiles in absolute coordinates (no joint friction, no coupler
-    row on three bodies or more), else the reference."""
+    """The compiled evaluator when the model compiles in absolute coordinates without joint friction, else
+    the reference."""
     from ..system.compiled import NotCompiled, compile_system
     if len(getattr(sys, "lock_rows", ())):
         return Reference(sys, rows, sf)
@@ -182,6 +181,6 @@ def evaluator(sys, rows, sf):
     except NotCompiled:
         return Reference(sys, rows, sf)
     a = cm.arrays()
-    if int(cm.dims[5]) == 1 or len(a[50][17]) or len(a[48][0]):   # (a[50][17]: wide coupler rows, bordered)
+    if int(cm.dims[5]) == 1 or len(a[48][0]):
         return Reference(sys, rows, sf)
     return Compiled(sys, rows, cm)
