@@ -5,8 +5,8 @@ load r = Q - phi_q^T lambda_ (least-squares multipliers).
 `evaluator(sys, rows, sf)` returns the compiled one (`Compiled`: solvers.faststatic, every configuration of a
 batch in one call) when the model compiles in absolute coordinates without joint friction (point-on-curve
 constraints and couplers included, gears and differentials: their curve parameters and continued angles
-follow the configuration, so the tangent basis leaves them out), else the reference (`Reference`: numpy, the force elements' own
-evaluators). Both give, for the first row of a batch, the configuration, the loads Q (nv,) [N, N m] and the
+follow the configuration, so the tangent basis leaves them out), else the reference (`Reference`: numpy,
+the force elements' own evaluators). Both give, for the first row of a batch, the configuration, the loads Q (nv,) [N, N m] and the
 Jacobian of the rows solved for (for the tangent basis); velocity-like vectors: CM translations in ground
 axes, rotations in body axes (the System's layout).
 """
@@ -100,7 +100,7 @@ class Compiled:
 
     def basis(self, J0, scale):
         """The tangent basis N (nv, d) at the first row of a batch (`reduced.null_basis`), without the
-        curve parameters of point-on-curve constraints (zero rows of N)."""
+        auxiliary velocity variables (curve parameters, couplers' continued angles: zero rows of N)."""
         if self.free is None:
             return null_basis(J0, scale)
         Nf = null_basis(J0[:, self.free], np.asarray(scale)[self.free])
@@ -128,9 +128,9 @@ class Compiled:
         coordinates (force_elements._common.joint_coordinate), as the reference path records them."""
         from ..system.force_elements._common import element_state
         ref = self.work.arrays()[44][7]
-        for name, m in self.anchors.items():
+        for name, m in self.anchors.items():   # (inserted in time order: Result.at solves between samples)
             st = element_state(self.sys, name)
-            st["angle_ref"] = [a for a in st.get("angle_ref", []) if a[0] < t] + [(float(t), float(ref[m]))]
+            st["angle_ref"] = sorted([a for a in st.get("angle_ref", []) if a[0] != t] + [(float(t), float(ref[m]))])
 
     def _raise_callback_error(self):
         pyl = self.pyloads
