@@ -24,6 +24,7 @@ from .._jit import entry, kernel
 from ..system.kernels import scatter_dense
 from .fastdyn import OK, _from6, _to6, accept_state, increment_into, loads_into, newton_positions
 from .loopcoord import wide_unit_load
+from .minnorm import _chol_solve, _cholesky
 
 
 @entry(_nrt=True)
@@ -114,8 +115,8 @@ def reduced_forces(cm, wk, t, q0, N, Z, tol, accept, F, R, X, Q0, J0, r0):
 @kernel(_nrt=False)
 def _normal_solve(J, Q, G, lam):
     """lam (nr,) = (J J^T)^-1 J Q, the least-squares multipliers of independent rows J (nr, nv), by the
-    Cholesky factorisation of G = J J^T (nr, nr, overwritten); False when a pivot is not positive
-    (dependent rows: the caller solves by least squares)."""
+    Cholesky factorisation of G = J J^T (nr, nr, overwritten; minnorm's factor and solve); False when it is
+    not positive definite (dependent rows: the caller solves by least squares)."""
     nr, nv = J.shape[0], J.shape[1]
     for i in range(nr):
         for k in range(i + 1):
@@ -123,32 +124,11 @@ def _normal_solve(J, Q, G, lam):
             for c in range(nv):
                 s += J[i, c] * J[k, c]
             G[i, k] = s
-    top = 0.0
-    for i in range(nr):
-        top = max(top, G[i, i])
-    for j in range(nr):   # lower triangle: G = L L^T
-        d = G[j, j]
-        for k in range(j):
-            d -= G[j, k] * G[j, k]
-        if not d > 1e-14 * top:
-            return False
-        d = np.sqrt(d)
-        G[j, j] = d
-        for i in range(j + 1, nr):
-            s = G[i, j]
-            for k in range(j):
-                s -= G[i, k] * G[j, k]
-            G[i, j] = s / d
-    for i in range(nr):   # L y = J Q
         s = 0.0
         for c in range(nv):
             s += J[i, c] * Q[c]
-        for k in range(i):
-            s -= G[i, k] * lam[k]
-        lam[i] = s / G[i, i]
-    for i in range(nr - 1, -1, -1):   # L^T lam = y
-        s = lam[i]
-        for k in range(i + 1, nr):
-            s -= G[k, i] * lam[k]
-        lam[i] = s / G[i, i]
+        lam[i] = s
+    if not _cholesky(G, nr):
+        return False
+    _chol_solve(G, nr, lam)
     return True
